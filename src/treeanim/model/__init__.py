@@ -1,0 +1,1 @@
+"""What a tree is: hierarchy arrays, procedural generation, preset loading (no GL here)."""

@@ -1,0 +1,89 @@
+"""Physical parameters a preset carries: modal ranges per kind and season, and constants.
+
+These are plain data; the physics package interprets them (DESIGN §4–§6).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+
+@dataclass(frozen=True)
+class ModeRange:
+    """Ranges of natural frequency (Hz) and damping ratio for one kind of object."""
+
+    f: tuple[float, float]
+    zeta: tuple[float, float]
+
+
+@dataclass(frozen=True)
+class SeasonModes:
+    """Mode ranges per kind for one season; a kind the tree lacks may be None."""
+
+    branch: ModeRange | None = None
+    leaf: ModeRange | None = None
+    blade: ModeRange | None = None
+
+    def of(self, kind: str) -> ModeRange | None:
+        """The range for ``kind`` ('branch', 'leaf' or 'blade')."""
+        return getattr(self, kind)
+
+
+def _default_season() -> SeasonModes:
+    return SeasonModes(
+        branch=ModeRange((0.5, 1.0), (0.2, 0.5)),
+        leaf=ModeRange((1.2, 1.8), (0.08, 0.12)),
+        blade=ModeRange((0.8, 1.2), (0.13, 0.17)),
+    )
+
+
+@dataclass(frozen=True)
+class PhysicsParams:
+    """Everything the simulation takes from a preset.
+
+    Attributes
+    ----------
+    summer, winter : SeasonModes
+        f and ζ ranges per kind at season 0 and season 1 (interpolated in between).
+    ei_max : float
+        EI_max of Eq. 10, the flexural rigidity of the tree's thickest section (N·m²/rad·m,
+        i.e. the bending stiffness k in N·m/rad of a segment of diameter D_max).
+    stiffness_exponent : float
+        m of Eq. 10 (4 for a tapered circular beam).
+    twist_c0 : float
+        c0 of Eq. 11 (1/N).
+    leaf_zeta_w_scale, leaf_zeta_v_scale : float
+        Leaves' ζ_w and ζ_v multipliers (§4.4: more drag across the lamina).
+    wind_gain_branch, wind_gain_leaf, wind_gain_blade : float
+        Drag gain per kind (N·s/m³): load = gain × exposed area × wind velocity.
+    wood_density, leaf_density : float
+        kg/m³, for the base-excitation inertia (DESIGN §6 step 3).
+    """
+
+    summer: SeasonModes = field(default_factory=_default_season)
+    winter: SeasonModes = field(default_factory=_default_season)
+    ei_max: float = 2.0e4
+    stiffness_exponent: float = 4.0
+    twist_c0: float = 0.5
+    leaf_zeta_w_scale: float = 1.5
+    leaf_zeta_v_scale: float = 0.5
+    wind_gain_branch: float = 1.0
+    wind_gain_leaf: float = 1.0
+    wind_gain_blade: float = 1.0
+    wood_density: float = 700.0
+    leaf_density: float = 500.0
+
+    def modes(self, kind: str, season: float) -> ModeRange | None:
+        """f and ζ ranges for ``kind``, linearly interpolated at ``season`` in [0, 1]."""
+        a, b = self.summer.of(kind), self.winter.of(kind)
+        if a is None or b is None:
+            return a or b
+        s = min(max(float(season), 0.0), 1.0)
+        lerp = lambda p, q: (p[0] + (q[0] - p[0]) * s, p[1] + (q[1] - p[1]) * s)  # noqa: E731
+        return ModeRange(lerp(a.f, b.f), lerp(a.zeta, b.zeta))
+
+
+#: Scalar keys of a preset's [physics] table, each a finite positive number.
+SCALAR_KEYS = tuple(
+    k for k in PhysicsParams.__dataclass_fields__ if k not in ("summer", "winter")
+)

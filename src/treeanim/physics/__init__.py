@@ -1,0 +1,1 @@
+"""Modal parameters, oscillators, curved-beam bending, the wind field and the Simulation."""
