@@ -1,0 +1,1 @@
+"""GLSL shader files, shipped as package data."""

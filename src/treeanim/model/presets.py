@@ -1,0 +1,294 @@
+"""Preset files: TOML in ``assets/presets/`` (shipped as ``treeanim.presets``), checked key by key.
+
+Every problem is reported as one :class:`PresetError` line naming the file, the key and what
+was expected.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import tomllib
+from importlib import resources
+from pathlib import Path
+
+from .errors import PresetError
+from .generate import BeamSpec, GrassSpec, LaminaSpec, LeafSpec, LevelSpec, TreeSpec, generate
+from .params import SCALAR_KEYS, ModeRange, PhysicsParams, SeasonModes
+from .tree import Tree
+
+#: Allowed ranges of numeric keys (inclusive); keys not listed must be finite and >= 0.
+BOUNDS: dict[str, tuple[float, float]] = {
+    "segments": (1, 64),
+    "length": (1e-4, 100.0),
+    "diameter": (1e-5, 10.0),
+    "taper": (0.0, 0.99),
+    "attach": (0.0, 1.0),
+    "down_angle": (0.0, 180.0),
+    "down_var": (0.0, 90.0),
+    "roll": (-360.0, 360.0),
+    "roll_var": (0.0, 180.0),
+    "curvature": (-180.0, 180.0),
+    "gravity": (-90.0, 90.0),
+    "up": (0.0, 1.0),
+    "lean": (0.0, 60.0),
+    "length_var": (0.0, 1.0),
+    "cone": (0.0, 0.95),
+    "count": (0.0, 100_000.0),
+    "winter_count": (0.0, 100_000.0),
+    "levels": (1, 32),
+    "petiole_segments": (1, 32),
+    "petiole_sides": (3, 32),
+    "petiole_length": (1e-4, 1.0),
+    "petiole_diameter": (1e-5, 0.1),
+    "lamina_length": (1e-3, 2.0),
+    "size_var": (0.0, 0.5),
+    "droop": (-90.0, 90.0),
+    "samples": (3, 512),
+    "teeth": (0, 200),
+    "tooth_depth": (0.0, 0.2),
+    "curl": (-2.0, 2.0),
+    "outline": (-2.0, 2.0),
+    "size": (1e-3, 1000.0),
+    "height": (1e-3, 100.0),
+    "width": (1e-5, 1.0),
+    "bend": (-180.0, 180.0),
+    "seed": (0, 2**63 - 1),
+    "f": (1e-3, 100.0),
+    "zeta": (0.0, 10.0),
+}
+
+_PRESET_PKG = "treeanim.presets"
+
+
+def _preset_dir():
+    return resources.files(_PRESET_PKG)
+
+
+def list_presets() -> list[str]:
+    """Names of the shipped presets, sorted."""
+    return sorted(p.name[:-5] for p in _preset_dir().iterdir() if p.name.endswith(".toml"))
+
+
+def load_preset(name: str) -> Tree:
+    """Generate the tree of a shipped preset.
+
+    Parameters
+    ----------
+    name : str
+        One of :func:`list_presets`.
+
+    Raises
+    ------
+    PresetError
+        Unknown name (the message lists the known ones) or a malformed preset.
+    """
+    known = list_presets()
+    if name not in known:
+        raise PresetError(f"unknown preset {name!r}; known presets: {', '.join(known)}")
+    with resources.as_file(_preset_dir() / f"{name}.toml") as path:
+        return load_tree(path)
+
+
+def load_tree(path: str | Path) -> Tree:
+    """Read a preset TOML file and generate its tree.
+
+    Raises
+    ------
+    PresetError
+        One line naming the file, the key and what was expected.
+    """
+    spec = read_spec(path)
+    try:
+        return generate(spec)
+    except ValueError as e:  # the generator names the key it could not use
+        raise PresetError(f"{path}: {e}") from None
+
+
+def read_spec(path: str | Path) -> TreeSpec:
+    """Parse and check a preset file into a :class:`TreeSpec` (no generation)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as e:
+        raise PresetError(f"{path}: cannot read preset file ({e.strerror or e})") from None
+    except UnicodeDecodeError:
+        raise PresetError(f"{path}: not a UTF-8 text file") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise PresetError(f"{path}: not valid TOML ({e})") from None
+    try:
+        spec = _tree_spec(data, str(path))
+        _check_leaves(spec)
+    except _KeyProblem as e:
+        raise PresetError(f"{path}: key '{e.key}': {e.expected}") from None
+    return spec
+
+
+# ---------------------------------------------------------------------------- checking
+class _KeyProblem(Exception):
+    def __init__(self, key: str, expected: str):
+        super().__init__(key, expected)
+        self.key, self.expected = key, expected
+
+
+def _describe(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:37] + "..."
+
+
+def _number(value, key: str, integer: bool):
+    name = key.rsplit(".", 1)[-1]
+    lo, hi = BOUNDS.get(name, (0.0, math.inf))
+    kind = "an integer" if integer else "a number"
+    ok_type = isinstance(value, int) if integer else isinstance(value, (int, float))
+    if isinstance(value, bool) or not ok_type:
+        raise _KeyProblem(key, f"expected {kind} in [{lo:g}, {hi:g}], got {_describe(value)}")
+    if not math.isfinite(value) or not lo <= value <= hi:
+        raise _KeyProblem(key, f"expected {kind} in [{lo:g}, {hi:g}], got {_describe(value)}")
+    return int(value) if integer else float(value)
+
+
+def _coerce(value, default, key: str):
+    """Check ``value`` against the type of ``default`` and the bounds of ``key``."""
+    if isinstance(default, str):
+        if not isinstance(value, str):
+            raise _KeyProblem(key, f"expected a string, got {_describe(value)}")
+        return value
+    if isinstance(default, (int, float)) and not isinstance(default, bool):
+        return _number(value, key, integer=isinstance(default, int))
+    if isinstance(default, tuple):
+        name = key.rsplit(".", 1)[-1]
+        if name == "outline":
+            if not isinstance(value, list) or len(value) < 3 or not all(
+                isinstance(p, list) and len(p) == 2 for p in value
+            ):
+                raise _KeyProblem(key, f"expected a list of at least 3 [x, y] points, got {_describe(value)}")
+            return tuple(tuple(_number(c, key, False) for c in p) for p in value)
+        if name == "levels":
+            if not isinstance(value, list):
+                raise _KeyProblem(key, f"expected a list of level numbers, got {_describe(value)}")
+            return tuple(_number(v, key, True) for v in value)
+        if not isinstance(value, list) or len(value) != 2:
+            raise _KeyProblem(key, f"expected a pair [min, max], got {_describe(value)}")
+        lo, hi = (_number(v, key, False) for v in value)
+        if lo > hi and name != "diameter":
+            raise _KeyProblem(key, f"expected [min, max] with min <= max, got {_describe(value)}")
+        return lo, hi
+    raise AssertionError(f"no rule for {key}")  # pragma: no cover - programming error
+
+
+def _table(data, key: str) -> dict:
+    if not isinstance(data, dict):
+        raise _KeyProblem(key, f"expected a table, got {_describe(data)}")
+    return data
+
+
+def _dataclass_from(cls, data: dict, prefix: str, required=()):
+    """Fill dataclass ``cls`` from a TOML table, checking every key."""
+    data = _table(data, prefix.rstrip("."))
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    defaults = cls()
+    for k in data:
+        if k not in fields:
+            raise _KeyProblem(prefix + k, f"unknown key; expected one of {', '.join(sorted(fields))}")
+    for k in required:
+        if k not in data:
+            raise _KeyProblem(prefix + k, "missing")
+    return cls(**{k: _coerce(v, getattr(defaults, k), prefix + k) for k, v in data.items()})
+
+
+def _modes(data, prefix: str) -> SeasonModes:
+    data = _table(data, prefix.rstrip("."))
+    out = {}
+    for kind, table in data.items():
+        if kind not in ("branch", "leaf", "blade"):
+            raise _KeyProblem(prefix + kind, "unknown key; expected branch, leaf or blade")
+        table = _table(table, prefix + kind)
+        for k in table:
+            if k not in ("f", "zeta"):
+                raise _KeyProblem(f"{prefix}{kind}.{k}", "unknown key; expected f or zeta")
+        for k in ("f", "zeta"):
+            if k not in table:
+                raise _KeyProblem(f"{prefix}{kind}.{k}", "missing; expected [min, max]")
+        f = _coerce(table["f"], (0.0, 0.0), f"{prefix}{kind}.f")
+        z = _coerce(table["zeta"], (0.0, 0.0), f"{prefix}{kind}.zeta")
+        out[kind] = ModeRange(f, z)
+    return SeasonModes(**out)
+
+
+def _physics(data) -> PhysicsParams:
+    data = _table(data, "physics")
+    for k in data:
+        if k not in (*SCALAR_KEYS, "summer", "winter"):
+            raise _KeyProblem(f"physics.{k}", f"unknown key; expected one of summer, winter, {', '.join(SCALAR_KEYS)}")
+    for k in ("summer", "winter"):
+        if k not in data:
+            raise _KeyProblem(f"physics.{k}", "missing; expected a table of f and zeta ranges per kind")
+    scalars = {}
+    for k in SCALAR_KEYS:
+        if k in data:
+            v = data[k]
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
+                raise _KeyProblem(f"physics.{k}", f"expected a finite positive number, got {_describe(v)}")
+            scalars[k] = float(v)
+    return PhysicsParams(summer=_modes(data["summer"], "physics.summer."),
+                         winter=_modes(data["winter"], "physics.winter."), **scalars)
+
+
+def _tree_spec(data: dict, source: str) -> TreeSpec:
+    top = ("name", "description", "type", "seed", "trunk", "levels", "leaves", "lamina", "grass", "beam", "physics")
+    for k in data:
+        if k not in top:
+            raise _KeyProblem(k, f"unknown key; expected one of {', '.join(top)}")
+    for k in ("name", "type", "physics"):
+        if k not in data:
+            raise _KeyProblem(k, "missing")
+    name = _coerce(data["name"], "", "name")
+    kind = _coerce(data["type"], "", "type")
+    if kind not in ("tree", "grass", "beam"):
+        raise _KeyProblem("type", f"expected 'tree', 'grass' or 'beam', got {kind!r}")
+    if "description" in data:
+        _coerce(data["description"], "", "description")
+    kw = dict(name=name, type=kind, seed=_coerce(data.get("seed", 0), 0, "seed"),
+              physics=_physics(data["physics"]), source=source)
+    if kind == "tree":
+        if "trunk" not in data:
+            raise _KeyProblem("trunk", "missing; a tree needs a [trunk] table")
+        levels = [_dataclass_from(LevelSpec, data["trunk"], "trunk.", required=("length", "diameter", "segments"))]
+        raw_levels = data.get("levels", [])
+        if not isinstance(raw_levels, list):
+            raise _KeyProblem("levels", f"expected an array of tables [[levels]], got {_describe(raw_levels)}")
+        for i, lv in enumerate(raw_levels):
+            levels.append(_dataclass_from(LevelSpec, lv, f"levels[{i}].", required=("count", "length", "diameter")))
+        kw["levels"] = tuple(levels)
+        if "leaves" in data:
+            kw["leaves"] = _dataclass_from(LeafSpec, data["leaves"], "leaves.", required=("count", "levels"))
+            if kw["leaves"].count > 0:
+                if "lamina" not in data:
+                    raise _KeyProblem("lamina", "missing; leaves need a [lamina] outline")
+                kw["lamina"] = _dataclass_from(LaminaSpec, data["lamina"], "lamina.", required=("outline",))
+    elif kind == "grass":
+        if "grass" not in data:
+            raise _KeyProblem("grass", "missing; a grass preset needs a [grass] table")
+        kw["grass"] = _dataclass_from(GrassSpec, data["grass"], "grass.", required=("count",))
+    else:
+        kw["beam"] = _dataclass_from(BeamSpec, data.get("beam", {}), "beam.")
+    return TreeSpec(**kw)
+
+
+def _check_leaves(spec: TreeSpec) -> None:
+    lf = spec.leaves
+    if lf.winter_count > lf.count:
+        raise _KeyProblem("leaves.winter_count", f"expected at most leaves.count ({lf.count}), got {lf.winter_count}")
+    n_levels = len(spec.levels)
+    for lv in lf.levels:
+        if spec.type == "tree" and lf.count > 0 and lv > n_levels:
+            raise _KeyProblem("leaves.levels", f"expected levels between 1 and {n_levels}, got {list(lf.levels)}")
+    la = spec.lamina
+    if la is not None:
+        if abs(la.outline[0][0]) > 1e-9 or abs(la.outline[-1][0]) > 1e-9:
+            raise _KeyProblem("lamina.outline", "expected the first (base) and last (tip) points on the midrib, x = 0")
+        if any(x < 0 for x, _ in la.outline):
+            raise _KeyProblem("lamina.outline", "expected the right half of the blade, x >= 0")

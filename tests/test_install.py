@@ -1,0 +1,39 @@
+"""A plain (non-editable) wheel install finds its presets and shaders."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_installed_wheel_finds_assets(tmp_path):
+    wheels = tmp_path / "wheels"
+    subprocess.run(
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(wheels), str(ROOT)],
+        check=True, capture_output=True, timeout=300,
+    )
+    (wheel,) = wheels.glob("treeanim-*.whl")
+    site = tmp_path / "site"
+    subprocess.run(
+        [sys.executable, "-m", "pip", "install", "--no-deps", "-q", "--target", str(site), str(wheel)],
+        check=True, capture_output=True, timeout=300,
+    )
+    shaders = sorted(p.name for p in (ROOT / "shaders").iterdir() if p.suffix in (".vert", ".frag", ".glsl"))
+    code = (
+        "import importlib.resources as r, json, treeanim as ta\n"
+        "t = ta.load_preset('small_cherry')\n"
+        "names = sorted(p.name for p in r.files('treeanim.shaders').iterdir() if p.name.split('.')[-1] in ('vert', 'frag', 'glsl'))\n"
+        "print(json.dumps({'file': ta.__file__, 'presets': ta.list_presets(), 'leaves': t.stats()['leaves'], 'shaders': names}))\n"
+    )
+    env = dict(os.environ, PYTHONPATH=str(site))
+    res = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    assert res.returncode == 0, res.stderr
+    import json
+
+    out = json.loads(res.stdout)
+    assert out["file"].startswith(str(site)), "the installed copy was imported, not the source tree"
+    assert set(out["presets"]) == {"beam", "small_cherry", "large_cherry", "tulip_poplar", "grassland"}
+    assert out["leaves"] == 816
+    assert out["shaders"] == shaders

@@ -1,0 +1,98 @@
+"""Malformed presets are refused with one clear line naming the file, the key and what was expected."""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import treeanim as ta
+from treeanim import PresetError
+
+GOOD = Path(ta.load_preset("small_cherry").source).read_text()
+
+
+def write(tmp_path, text, name="bad.toml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+# (what is wrong, how to break the good file, the key the message must name, words it must contain)
+CASES = [
+    ("not TOML", lambda s: s.replace("[trunk]", "[trunk"), None, "not valid TOML"),
+    ("missing key", lambda s: s.replace('type = "tree"\n', ""), "type", "missing"),
+    ("missing trunk length", lambda s: s.replace("length = 1.0\n", "", 1), "trunk.length", "missing"),
+    ("wrong type", lambda s: s.replace("segments = 2", 'segments = "two"', 1), "trunk.segments", "integer"),
+    ("negative count", lambda s: s.replace("count = 816", "count = -816"), "leaves.count", "[0,"),
+    ("NaN", lambda s: s.replace("diameter = 0.14", "diameter = nan"), "trunk.diameter", "number"),
+    ("angle out of range", lambda s: s.replace("down_angle = 36.0", "down_angle = 400.0"), "levels[0].down_angle", "180"),
+    ("unknown key", lambda s: s.replace("taper = 0.25", "tapr = 0.25"), "trunk.tapr", "unknown key"),
+    ("bad range", lambda s: s.replace("f = [0.5, 1.0]", "f = [1.0, 0.5]"), "physics.summer.branch.f", "min <= max"),
+    ("zero frequency", lambda s: s.replace("f = [0.5, 1.0]", "f = [0.0, 1.0]"), "physics.summer.branch.f", "number"),
+    ("winter above summer", lambda s: s.replace("winter_count = 52", "winter_count = 900"), "leaves.winter_count", "at most"),
+    ("outline on the left", lambda s: s.replace("[0.24, 0.30], [0.24, 0.46]", "[0.24, 0.30], [-0.1, 0.4], [0.24, 0.46]"),
+     "lamina.outline", "x >= 0"),
+    ("leaf level missing", lambda s: s.replace("levels = [4, 5, 6]", "levels = [9]"), "leaves.levels", "between"),
+    ("physics scalar", lambda s: s.replace("[physics.summer]", "[physics]\nei_max = -3\n[physics.summer]"),
+     "physics.ei_max", "positive"),
+]
+
+
+@pytest.mark.parametrize("what,mutate,key,words", CASES, ids=[c[0] for c in CASES])
+def test_bad_preset_api(tmp_path, what, mutate, key, words):
+    text = mutate(GOOD)
+    assert text != GOOD, "the mutation must change the file"
+    path = write(tmp_path, text)
+    with pytest.raises(PresetError) as err:
+        ta.load_tree(path)
+    msg = str(err.value)
+    assert isinstance(err.value, ValueError)
+    assert "\n" not in msg
+    assert str(path) in msg
+    if key:
+        assert f"'{key}'" in msg
+    assert words in msg
+
+
+def test_crossing_outline_is_refused(tmp_path):
+    text = GOOD.replace("[0.24, 0.30], [0.24, 0.46]", "[0.24, 0.30], [0.05, 0.7], [0.05, 0.4], [0.3, 0.55]")
+    assert text != GOOD
+    with pytest.raises(PresetError, match="'lamina.outline': the 'ovate serrated' outline crosses itself"):
+        ta.load_tree(write(tmp_path, text))
+
+
+def test_unknown_preset_lists_known():
+    with pytest.raises(PresetError) as err:
+        ta.load_preset("oak")
+    for name in ta.list_presets():
+        assert name in str(err.value)
+
+
+def test_missing_file():
+    with pytest.raises(PresetError, match="cannot read"):
+        ta.load_tree("/nonexistent/tree.toml")
+
+
+def run_cli(*args):
+    return subprocess.run([sys.executable, "-m", "treeanim", *args], capture_output=True, text=True, timeout=120)
+
+
+def test_cli_bad_preset_exit_2_no_traceback(tmp_path):
+    path = write(tmp_path, GOOD.replace("count = 816", "count = -816"))
+    res = run_cli("info", str(path))
+    assert res.returncode == 2
+    assert "Traceback" not in res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and "leaves.count" in lines[0] and str(path) in lines[0]
+
+
+def test_cli_unknown_preset(tmp_path):
+    res = run_cli("info", "oak")
+    assert res.returncode == 2 and "Traceback" not in res.stderr and "small_cherry" in res.stderr
+
+
+def test_cli_info_prints_table1_row():
+    res = run_cli("info", "large_cherry", "--season", "1")
+    assert res.returncode == 0, res.stderr
+    assert "344" in res.stdout and "1,376" in res.stdout and "48,504" in res.stdout
