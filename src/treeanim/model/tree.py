@@ -15,7 +15,8 @@ from .params import PhysicsParams
 
 KINDS = ("branch", "leaf", "blade")
 
-#: Triangles per node of a branch tube: 16 sides x 2 per segment, plus 16 for one cap per object.
+#: Sides of a branch tube: 2 x 16 triangles per segment plus a 16-triangle fan at each end,
+#: i.e. the paper's 32 triangles per node.
 BRANCH_SIDES = 16
 
 
@@ -168,7 +169,7 @@ class Tree:
     def triangles_per_object(self) -> np.ndarray:
         """(M,) int: triangles the renderer draws for each object.
 
-        Branch: a 16-sided tube over its segments plus one end cap, i.e. 32 per node.
+        Branch: a 16-sided tube over its segments closed by a fan at each end, i.e. 32 per node.
         Leaf: a petiole tube (``petiole_sides``) plus the lamina triangulation.
         Blade: a two-sided strip over its segments plus a tip triangle.
         """
