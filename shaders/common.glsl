@@ -1,0 +1,47 @@
+// Shared lighting: one sun plus a sky/ground hemisphere, distance haze, sRGB output.
+
+uniform vec3 u_sun_dir;        // unit, towards the sun
+uniform vec3 u_sun_color;      // linear
+uniform vec3 u_sky_zenith;     // linear
+uniform vec3 u_sky_horizon;    // linear
+uniform vec3 u_ground_bounce;  // linear, light from below
+uniform vec3 u_camera_pos;
+uniform float u_haze_distance; // metres at which haze reaches 63 %
+uniform float u_exposure;
+
+vec3 srgb_to_linear(vec3 c) { return pow(c, vec3(2.2)); }
+
+vec3 hemisphere(vec3 n) {
+    vec3 sky = mix(u_sky_horizon, u_sky_zenith, 0.5);
+    return mix(u_ground_bounce, sky, 0.5 + 0.5 * n.y);
+}
+
+vec3 apply_haze(vec3 c, vec3 world) {
+    float d = length(world - u_camera_pos);
+    float f = 1.0 - exp(-d / u_haze_distance);
+    return mix(c, u_sky_horizon, f);
+}
+
+float hash12(vec2 p) {
+    vec3 p3 = fract(vec3(p.xyx) * 0.1031);
+    p3 += dot(p3, p3.yzx + 33.33);
+    return fract((p3.x + p3.y) * p3.z);
+}
+
+float vnoise(vec2 p) {
+    vec2 i = floor(p);
+    vec2 f = fract(p);
+    f = f * f * (3.0 - 2.0 * f);
+    float a = hash12(i), b = hash12(i + vec2(1.0, 0.0));
+    float c = hash12(i + vec2(0.0, 1.0)), d = hash12(i + vec2(1.0, 1.0));
+    return mix(mix(a, b, f.x), mix(c, d, f.x), f.y);
+}
+
+vec4 to_display(vec3 linear_color) {
+    vec3 c = linear_color * u_exposure;
+    // Linear up to 0.8, then a soft shoulder towards 1 (keeps hues; no hard clipping).
+    c = mix(c, 0.8 + 0.2 * (1.0 - exp(-(c - 0.8) / 0.2)), step(0.8, c));
+    c = pow(c, vec3(1.0 / 2.2));
+    c += (hash12(gl_FragCoord.xy) - 0.5) / 255.0;            // dither against banding
+    return vec4(c, 1.0);
+}

@@ -1,0 +1,83 @@
+#version 330 core
+// Skinned tree: branch tubes, petioles, laminas and grass blades in one draw.
+
+#include "skin.glsl"
+
+in ivec4 in_ids;     // node, node2, object, material
+in vec3 in_offset;   // rest offset from the node
+in vec3 in_normal;   // rest normal
+in vec4 in_extra;    // weight of node2, per-object jitter, ambient occlusion, key
+in vec2 in_uv;       // surface coordinates (see render/mesh.py)
+
+uniform mat4 u_view_proj;
+uniform sampler2D u_objects;   // per object: r = visible, g = highlight
+uniform float u_season;        // 0 summer .. 1 winter
+
+out vec3 v_world;
+out vec3 v_normal;
+out vec3 v_albedo;
+out float v_ao;
+out vec2 v_uv;
+flat out int v_material;
+flat out float v_highlight;
+
+const int BARK = 0;
+const int PETIOLE = 1;
+const int LAMINA = 2;
+const int BLADE = 3;
+
+vec3 lin(vec3 c) { return pow(c, vec3(2.2)); }
+
+vec3 leaf_color(float jitter, float key) {
+    // Summer: saturated cherry greens, each leaf a little different in hue and value.
+    float j2 = fract(jitter * 13.37);
+    vec3 summer = mix(lin(vec3(0.13, 0.33, 0.05)), lin(vec3(0.33, 0.55, 0.10)), jitter);
+    summer = mix(summer, lin(vec3(0.24, 0.46, 0.16)), 0.35 * j2);
+    // Autumn: leaves that fall first turn first (key = drop order, 0 first).
+    float prog = smoothstep(0.05 + 0.35 * key, 0.30 + 0.45 * key, u_season);
+    vec3 yellow = lin(vec3(0.88, 0.70, 0.12));
+    vec3 orange = lin(vec3(0.92, 0.40, 0.06));
+    vec3 red = lin(vec3(0.70, 0.10, 0.06));
+    vec3 brown = lin(vec3(0.40, 0.17, 0.06));
+    vec3 c = mix(summer, yellow, smoothstep(0.0, 0.35, prog));
+    c = mix(c, mix(orange, red, j2), smoothstep(0.3, 0.7, prog) * (0.55 + 0.45 * jitter));
+    c = mix(c, brown, 0.75 * smoothstep(0.8, 1.0, prog));
+    return c;
+}
+
+void main() {
+    int obj = in_ids.z;
+    vec4 state = fetch_texel(u_objects, obj);
+    v_material = in_ids.w;
+    v_highlight = state.g;
+    v_ao = in_extra.z;
+    v_uv = in_uv;
+    if (state.r < 0.5) {                         // hidden: collapse beyond the far plane
+        v_world = vec3(0.0);
+        v_normal = vec3(0.0, 1.0, 0.0);
+        v_albedo = vec3(0.0);
+        gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
+        return;
+    }
+    vec3 p;
+    mat3 R;
+    skin_transform(in_ids.x, in_ids.y, in_extra.x, p, R);
+    v_world = p + R * in_offset;
+    v_normal = R * in_normal;
+    gl_Position = u_view_proj * vec4(v_world, 1.0);
+
+    float jitter = in_extra.y;
+    float key = in_extra.w;
+    if (v_material == BARK) {
+        v_albedo = lin(vec3(0.36, 0.28, 0.22)) * (0.8 + 0.4 * jitter);
+    } else if (v_material == PETIOLE) {
+        v_albedo = mix(leaf_color(jitter, key), lin(vec3(0.55, 0.28, 0.14)), 0.4);
+    } else if (v_material == LAMINA) {
+        v_albedo = leaf_color(jitter, key);
+    } else {
+        vec3 base = lin(vec3(0.10, 0.24, 0.05));
+        vec3 tip = mix(lin(vec3(0.42, 0.58, 0.16)), lin(vec3(0.55, 0.60, 0.22)), jitter);
+        vec3 c = mix(base, tip, key);
+        v_albedo = mix(c, lin(vec3(0.62, 0.55, 0.32)) * (0.6 + 0.4 * key), 0.6 * u_season);
+    }
+}

@@ -1,0 +1,384 @@
+"""Static, skinnable triangle meshes for a tree, built once per tree with numpy.
+
+A tree's mesh never changes while it animates: every vertex stores the node whose transform
+it follows and its offset from that node at rest, and the vertex shader (``shaders/skin.glsl``)
+places it each frame from the node positions and rotations the simulation produces::
+
+    world = positions[node] + R @ offset,   R = orthonormalise(mix(R[node], R[node2], weight))
+
+(DESIGN §6, §10). Rings at an object's inner joints follow both segments that meet there
+(weight 0.5), so tubes bend smoothly; every other vertex has ``node2 == node`` and weight 0.
+
+Geometry per object kind (triangle counts equal :meth:`Tree.triangles_per_object`):
+
+- branch: a ``BRANCH_SIDES`` (16)-sided tapered tube with a ring of 16 vertices at every node,
+  closed by a 16-triangle fan at each end (the tip fan is a low cone, so tips look rounded;
+  the base fan closes the tube inside its parent): 2·16·(n−1) + 2·16 = 32·n triangles, the
+  paper's 32 per node.
+- leaf: a ``tree.petiole_sides``-sided petiole tube over its segments (no caps), plus the
+  species' lamina triangulation placed on the petiole's tip node: v = direction of the
+  petiole's last segment, w = ``tree.rest_w`` orthogonalised against v, u = v × w; a lamina
+  point (x, y) sits at ``L·(x·u + y·v + curl·x²·w)`` from the tip, L = ``lamina_length``.
+- blade: a strip with 2 vertices per node across the blade's w axis (width =
+  ``node_diameter``; the strip's face contains the blade's tangent and faces along the bending
+  plane), plus one tip triangle to an apex half a segment beyond the tip: 2·(n−1) + 1.
+
+Vertex layout (:data:`VERTEX_DTYPE`, 64 bytes, interleaved, attribute format
+:data:`VERTEX_FORMAT`)::
+
+    in_ids    ivec4  (node, node2, object, material)
+    in_offset vec3   rest offset from rest_positions[node], metres
+    in_normal vec3   rest normal (unit)
+    in_extra  vec4   (weight of node2's rotation, per-object jitter in [0, 1),
+                      ambient occlusion in (0, 1], key)
+    in_uv     vec2   surface coordinates: bark and petioles (turn around the tube in [0, 1),
+                     metres along the object); laminas (x, y) in leaf units; blades
+                     (−1 / +1 across, fraction along)
+
+``key`` depends on the material: for lamina and petiole vertices the leaf's drop order
+normalised to [0, 1] (0 falls first, and turns colour first); for blades the fraction along
+the blade (0 base, 1 tip); 0 for bark. Materials: :data:`MATERIAL_BARK`,
+:data:`MATERIAL_PETIOLE`, :data:`MATERIAL_LAMINA`, :data:`MATERIAL_BLADE`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.tree import BRANCH_SIDES, Tree
+
+MATERIAL_BARK = 0
+MATERIAL_PETIOLE = 1
+MATERIAL_LAMINA = 2
+MATERIAL_BLADE = 3
+
+VERTEX_DTYPE = np.dtype(
+    [("ids", "<i4", (4,)), ("offset", "<f4", (3,)), ("normal", "<f4", (3,)), ("extra", "<f4", (4,)),
+     ("uv", "<f4", (2,))]
+)
+#: moderngl buffer format and attribute names matching :data:`VERTEX_DTYPE`.
+VERTEX_FORMAT = "4i 3f 3f 4f 2f"
+VERTEX_ATTRIBUTES = ("in_ids", "in_offset", "in_normal", "in_extra", "in_uv")
+
+
+@dataclass(eq=False)
+class TreeMesh:
+    """A tree's static mesh.
+
+    Attributes
+    ----------
+    vertices : (V,) structured array of :data:`VERTEX_DTYPE`
+    indices : (T, 3) uint32
+        Triangles, counter-clockwise seen from the side the rest normal points to.
+    object_triangles : (M,) int
+        Triangles of each object (equals ``tree.triangles_per_object()``).
+    """
+
+    vertices: np.ndarray
+    indices: np.ndarray
+    object_triangles: np.ndarray
+
+    @property
+    def triangle_count(self) -> int:
+        """Total number of triangles."""
+        return len(self.indices)
+
+    @property
+    def vertex_count(self) -> int:
+        """Total number of vertices."""
+        return len(self.vertices)
+
+    @property
+    def node(self) -> np.ndarray:
+        """(V,) int: the node each vertex follows."""
+        return self.vertices["ids"][:, 0]
+
+    @property
+    def object(self) -> np.ndarray:
+        """(V,) int: the object each vertex belongs to."""
+        return self.vertices["ids"][:, 2]
+
+    @property
+    def material(self) -> np.ndarray:
+        """(V,) int: each vertex's material."""
+        return self.vertices["ids"][:, 3]
+
+    def skin(self, positions: np.ndarray, rotations: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Deformed vertex positions and normals on the CPU (the vertex shader's formula).
+
+        For exporters and tests; the renderer does this on the GPU.
+
+        Parameters
+        ----------
+        positions : (N, 3) float
+            Node positions, world.
+        rotations : (N, 3, 3) float
+            Node rotations relative to rest.
+
+        Returns
+        -------
+        points, normals : (V, 3) float64
+        """
+        ids, extra = self.vertices["ids"], self.vertices["extra"]
+        positions = np.asarray(positions, float)
+        rotations = np.asarray(rotations, float)
+        w = extra[:, 0, None, None].astype(float)
+        R = blend_rotations(rotations[ids[:, 0]] * (1.0 - w) + rotations[ids[:, 1]] * w)
+        points = positions[ids[:, 0]] + np.einsum("vij,vj->vi", R, self.vertices["offset"].astype(float))
+        normals = np.einsum("vij,vj->vi", R, self.vertices["normal"].astype(float))
+        return points, normals
+
+
+def blend_rotations(m: np.ndarray) -> np.ndarray:
+    """Gram–Schmidt on the columns of linearly blended rotations (..., 3, 3), as the shader does."""
+    c0 = _unit(m[..., :, 0])
+    c1 = m[..., :, 1] - np.sum(m[..., :, 1] * c0, axis=-1, keepdims=True) * c0
+    c1 = _unit(c1)
+    return np.stack([c0, c1, np.cross(c0, c1)], axis=-1)
+
+
+def _unit(v: np.ndarray, fallback: np.ndarray | None = None) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    out = v / np.where(n > 1e-12, n, 1.0)
+    if fallback is not None:
+        out = np.where(n > 1e-9, out, fallback)
+    return out
+
+
+def _perpendicular(v: np.ndarray) -> np.ndarray:
+    helper = np.where(np.abs(v[..., 1:2]) < 0.9, [0.0, 1.0, 0.0], [1.0, 0.0, 0.0])
+    return _unit(np.cross(v, helper))
+
+
+def _object_nodes(tree: Tree, objs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Flattened nodes of objects ``objs``: (global node, index within object, object)."""
+    counts = tree.object_count[objs]
+    total = int(counts.sum())
+    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    k = np.arange(total) - np.repeat(first, counts)
+    return np.repeat(tree.object_start[objs], counts) + k, k, np.repeat(objs, counts)
+
+
+def arc_length(tree: Tree) -> np.ndarray:
+    """(N,) distance of each node from its object's base along the object, metres."""
+    seg = np.linalg.norm(np.diff(tree.rest_positions, axis=0), axis=1)
+    csum = np.concatenate([[0.0], np.cumsum(seg)])
+    return csum - np.repeat(csum[tree.object_start], tree.object_count)
+
+
+def _node_tangents(tree: Tree, nodes: np.ndarray, k: np.ndarray, obj: np.ndarray):
+    """Unit tangents at nodes (bisector at inner joints), plus base/tip masks and neighbours."""
+    P = tree.rest_positions
+    N = len(P)
+    n = tree.object_count[obj]
+    base, tip = k == 0, k == n - 1
+    nxt = np.where(tip, nodes, np.minimum(nodes + 1, N - 1))
+    prv = np.where(base, nodes, nodes - 1)
+    d_next = _unit(P[nxt] - P[nodes])
+    d_prev = _unit(P[nodes] - P[prv])
+    t = np.where(base[:, None], d_next, np.where(tip[:, None], d_prev, _unit(d_prev + d_next, d_next)))
+    return t, base, tip, nxt, prv
+
+
+class _Parts:
+    """Accumulates vertex and triangle blocks."""
+
+    def __init__(self) -> None:
+        self.verts: list[np.ndarray] = []
+        self.tris: list[np.ndarray] = []
+        self.tri_obj: list[np.ndarray] = []
+        self.count = 0
+
+    def add(self, node, node2, obj, material, offset, normal, weight, jitter, key, uv=0.0) -> int:
+        v = np.zeros(len(node), VERTEX_DTYPE)
+        v["ids"] = np.stack([node, node2, obj, np.broadcast_to(material, node.shape)], axis=1)
+        v["offset"] = offset
+        v["normal"] = normal
+        v["extra"][:, 0] = weight
+        v["extra"][:, 1] = jitter
+        v["extra"][:, 3] = key
+        v["uv"] = uv
+        base = self.count
+        self.verts.append(v)
+        self.count += len(v)
+        return base
+
+    def triangles(self, tris: np.ndarray, obj: np.ndarray) -> None:
+        self.tris.append(tris.reshape(-1, 3))
+        self.tri_obj.append(np.broadcast_to(obj, tris.shape[:-1]).reshape(-1))
+
+
+def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, caps: bool, material: int,
+           jitter: np.ndarray, key: np.ndarray) -> None:
+    """Tapered tubes with ``sides`` sides over the segments of objects ``objs``."""
+    if len(objs) == 0:
+        return
+    P = tree.rest_positions
+    nodes, k, obj = _object_nodes(tree, objs)
+    t, base, tip, nxt, prv = _node_tangents(tree, nodes, k, obj)
+    r = 0.5 * tree.node_diameter
+    span = np.linalg.norm(P[nxt] - P[prv], axis=1)
+    slope = np.where(span > 1e-12, (r[nxt] - r[prv]) / np.where(span > 1e-12, span, 1.0), 0.0)
+
+    # Ring frame: the object's w axis projected off the tangent (continuous along a planar
+    # object, no twist); a fixed perpendicular where w runs along the tangent.
+    w = tree.rest_w[obj]
+    a = _unit(w - np.sum(w * t, axis=1, keepdims=True) * t, _perpendicular(t))
+    b = np.cross(t, a)
+    ang = 2.0 * np.pi * np.arange(sides) / sides
+    radial = np.cos(ang)[None, :, None] * a[:, None, :] + np.sin(ang)[None, :, None] * b[:, None, :]
+    offset = r[nodes, None, None] * radial
+    normal = _unit(radial - slope[:, None, None] * t[:, None, :])
+
+    inner = ~(base | tip)
+    node2 = np.where(inner, nodes - 1, nodes)
+    weight = np.where(inner, 0.5, 0.0)
+    along = arc_length(tree)[nodes]
+    uv = np.stack([np.broadcast_to(np.arange(sides) / sides, (len(nodes), sides)),
+                   np.broadcast_to(along[:, None], (len(nodes), sides))], -1).reshape(-1, 2)
+    rep = lambda x: np.repeat(x, sides)  # noqa: E731
+    v0 = parts.add(rep(nodes), rep(node2), rep(obj), material, offset.reshape(-1, 3),
+                   normal.reshape(-1, 3), rep(weight), rep(jitter[obj]), rep(key[obj]), uv)
+
+    ring = v0 + sides * np.arange(len(nodes))  # first vertex of each node's ring
+    s0 = np.arange(sides)
+    s1 = (s0 + 1) % sides
+    seg = np.flatnonzero(~tip)  # a band from each non-tip node's ring to the next
+    i0, i1 = ring[seg, None], ring[seg, None] + sides
+    quads = np.stack(
+        [np.stack([i0 + s0, i0 + s1, i1 + s1], -1), np.stack([i0 + s0, i1 + s1, i1 + s0], -1)], axis=2
+    )  # (segments, sides, 2, 3)
+    parts.triangles(quads, obj[seg, None, None])
+
+    if caps:
+        ib, it = np.flatnonzero(base), np.flatnonzero(tip)
+        ends = np.concatenate([ib, it])
+        apex = np.concatenate([np.zeros((len(ib), 3)), 0.5 * r[nodes[it], None] * t[it]])
+        c0 = parts.add(nodes[ends], nodes[ends], obj[ends], material, apex,
+                       np.concatenate([-t[ib], t[it]]), 0.0, jitter[obj[ends]], key[obj[ends]],
+                       np.stack([np.zeros(len(ends)), along[ends]], -1))
+        cb = c0 + np.arange(len(ib))[:, None]
+        ct = c0 + len(ib) + np.arange(len(it))[:, None]
+        parts.triangles(np.stack([np.broadcast_to(cb, (len(ib), sides)), ring[ib, None] + s1,
+                                  ring[ib, None] + s0], -1), obj[ib, None])
+        parts.triangles(np.stack([np.broadcast_to(ct, (len(it), sides)), ring[it, None] + s0,
+                                  ring[it, None] + s1], -1), obj[it, None])
+
+
+def lamina_frames(tree: Tree, leaves: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Rest frame of each leaf's lamina: (tip node, u, v, w), each (L,) / (L, 3).
+
+    v is the direction of the petiole's last segment, w the leaf's ``rest_w`` orthogonalised
+    against v, u = v × w.
+    """
+    P = tree.rest_positions
+    tipn = tree.object_start[leaves] + tree.object_count[leaves] - 1
+    v = _unit(P[tipn] - P[tipn - 1])
+    w = tree.rest_w[leaves]
+    w = _unit(w - np.sum(w * v, axis=1, keepdims=True) * v, _perpendicular(v))
+    return tipn, np.cross(v, w), v, w
+
+
+def _laminas(parts: _Parts, tree: Tree, leaves: np.ndarray, jitter: np.ndarray, key: np.ndarray) -> None:
+    lam = tree.lamina
+    if lam is None or len(leaves) == 0 or len(lam.triangles) == 0:
+        return
+    x, y = lam.outline[:, 0], lam.outline[:, 1]
+    K = len(x)
+    tipn, u, v, w = lamina_frames(tree, leaves)
+    L = tree.lamina_length[leaves][:, None, None]
+    local = (x[None, :, None] * u[:, None, :] + y[None, :, None] * v[:, None, :]
+             + (lam.curl * x * x)[None, :, None] * w[:, None, :])
+    offset = L * local
+    normal = _unit(w[:, None, :] - (2.0 * lam.curl * x)[None, :, None] * u[:, None, :])
+    rep = lambda a: np.repeat(a, K)  # noqa: E731
+    v0 = parts.add(rep(tipn), rep(tipn), rep(leaves), MATERIAL_LAMINA, offset.reshape(-1, 3),
+                   normal.reshape(-1, 3), 0.0, rep(jitter[leaves]), rep(key[leaves]),
+                   np.tile(lam.outline, (len(leaves), 1)))
+    tris = v0 + K * np.arange(len(leaves))[:, None, None] + np.asarray(lam.triangles)[None]
+    parts.triangles(tris, leaves[:, None])
+
+
+def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray) -> None:
+    if len(blades) == 0:
+        return
+    P = tree.rest_positions
+    nodes, k, obj = _object_nodes(tree, blades)
+    t, base, tip, nxt, prv = _node_tangents(tree, nodes, k, obj)
+    w = tree.rest_w[obj]
+    across = _unit(w - np.sum(w * t, axis=1, keepdims=True) * t, _perpendicular(t))
+    normal = np.cross(across, t)
+    half = 0.5 * tree.node_diameter[nodes, None] * across
+    frac = k / (tree.object_count[obj] - 1)
+    inner = ~(base | tip)
+    node2 = np.where(inner, nodes - 1, nodes)
+    weight = np.where(inner, 0.5, 0.0)
+    rep = lambda a: np.repeat(a, 2, axis=0)  # noqa: E731
+    offset = np.stack([-half, half], axis=1).reshape(-1, 3)
+    uv = np.stack([np.tile([-1.0, 1.0], len(nodes)), rep(frac)], -1)
+    v0 = parts.add(rep(nodes), rep(node2), rep(obj), MATERIAL_BLADE, offset, rep(normal),
+                   rep(weight), rep(jitter[obj]), rep(frac), uv)
+    pair = v0 + 2 * np.arange(len(nodes))
+    seg = np.flatnonzero(~tip)
+    a0, a1, b0, b1 = pair[seg], pair[seg] + 1, pair[seg] + 2, pair[seg] + 3
+    parts.triangles(np.stack([np.stack([a0, a1, b1], -1), np.stack([a0, b1, b0], -1)], axis=1),
+                    obj[seg, None])
+    it = np.flatnonzero(tip)
+    seg_len = np.linalg.norm(P[nodes[it]] - P[prv[it]], axis=1)
+    ap = parts.add(nodes[it], nodes[it], obj[it], MATERIAL_BLADE, 0.5 * seg_len[:, None] * t[it],
+                   normal[it], 0.0, jitter[obj[it]], 1.0, np.array([0.0, 1.0]))
+    parts.triangles(np.stack([pair[it], pair[it] + 1, ap + np.arange(len(it))], -1), obj[it])
+
+
+def _ambient_occlusion(tree: Tree, verts: np.ndarray) -> np.ndarray:
+    """A cheap, static occlusion term from where a vertex sits in the crown (1 = open)."""
+    ids = verts["ids"]
+    rest = tree.rest_positions[ids[:, 0]] + verts["offset"]
+    mat = ids[:, 3]
+    ao = np.ones(len(verts))
+    leafy = (mat == MATERIAL_LAMINA) | (mat == MATERIAL_PETIOLE)
+    foliage = rest[leafy]
+    if len(foliage):
+        centre = foliage.mean(axis=0)
+        radius = max(float(np.percentile(np.linalg.norm(foliage - centre, axis=1), 95)), 1e-6)
+        d = np.linalg.norm(rest - centre, axis=1) / radius
+        up = np.clip(0.5 + 0.5 * (rest[:, 1] - centre[1]) / radius, 0.0, 1.0)
+        ao = (0.42 + 0.58 * np.clip(d, 0.0, 1.0) ** 1.3) * (0.82 + 0.18 * up)
+    height = max(float(np.ptp(tree.rest_positions[:, 1])), 1e-6)
+    ao *= 0.7 + 0.3 * np.clip(rest[:, 1] / (0.04 * height), 0.0, 1.0)  # contact with the ground
+    blade = mat == MATERIAL_BLADE
+    ao[blade] = 0.45 + 0.55 * verts["extra"][blade, 3]
+    return np.clip(ao, 0.05, 1.0)
+
+
+def build_mesh(tree: Tree, seed: int | None = None) -> TreeMesh:
+    """Build the static skinnable mesh of ``tree`` (vectorised; no loop over objects).
+
+    Parameters
+    ----------
+    tree : Tree
+    seed : int or None
+        Seed of the per-object colour jitter; None uses ``tree.seed``.
+    """
+    M = tree.n_objects
+    rng = np.random.default_rng([int(tree.seed if seed is None else seed), 0x7E11])
+    jitter = rng.random(M)
+    kind = np.asarray(tree.kind)
+    leaves = np.flatnonzero(kind == "leaf")
+    key = np.zeros(M)
+    if len(leaves):
+        key[leaves] = np.clip(tree.leaf_drop_rank[leaves], 0, None) / max(len(leaves) - 1, 1)
+
+    parts = _Parts()
+    _tubes(parts, tree, np.flatnonzero(kind == "branch"), BRANCH_SIDES, True, MATERIAL_BARK, jitter, key)
+    _tubes(parts, tree, leaves, int(tree.petiole_sides), False, MATERIAL_PETIOLE, jitter, key)
+    _laminas(parts, tree, leaves, jitter, key)
+    _blades(parts, tree, np.flatnonzero(kind == "blade"), jitter)
+
+    verts = np.concatenate(parts.verts) if parts.verts else np.zeros(0, VERTEX_DTYPE)
+    tris = np.concatenate(parts.tris).astype(np.uint32) if parts.tris else np.zeros((0, 3), np.uint32)
+    tri_obj = np.concatenate(parts.tri_obj) if parts.tri_obj else np.zeros(0, np.int64)
+    verts["extra"][:, 2] = _ambient_occlusion(tree, verts)
+    return TreeMesh(verts, np.ascontiguousarray(tris), np.bincount(tri_obj, minlength=M))

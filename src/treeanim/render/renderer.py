@@ -1,0 +1,374 @@
+"""The tree renderer: static skinned mesh on the GPU, per-frame node transforms as a texture.
+
+Per frame the CPU packs node positions and rotations into one RGBA32F texture (12 floats a
+node) and writes it; the vertex shader skins every vertex from it (``shaders/skin.glsl``).
+Nothing per vertex or per triangle is touched on the CPU after construction.
+
+Texture layout (both textures are ``TEXTURE_WIDTH`` texels wide, rows as many as needed,
+texel i at (i mod width, i div width), read with texelFetch):
+
+- nodes, RGBA32F, 3 texels a node j: ``3j = (p.x, p.y, p.z, r00)``,
+  ``3j+1 = (r01, r02, r10, r11)``, ``3j+2 = (r12, r20, r21, r22)``; p the world position,
+  r the rotation relative to rest, row-major.
+- objects, RGBA32F, 1 texel an object: ``(visible, highlight, 0, 0)``; rewritten only when
+  the visibility or highlight changes.
+"""
+
+from __future__ import annotations
+
+import math
+import weakref
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from ..model.tree import Tree
+from .camera import OrbitCamera
+from .mesh import VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh, build_mesh
+from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
+from .shaders import load_program
+
+#: Width in texels of the node and object textures (GL 3.3 guarantees 1024).
+TEXTURE_WIDTH = 1024
+
+
+def _lin(rgb) -> tuple[float, float, float]:
+    return tuple(float(c) ** 2.2 for c in rgb)
+
+
+@dataclass
+class Scene:
+    """Look of the scene: sun, sky, ground. Colours are sRGB in [0, 1]."""
+
+    sun_direction: tuple[float, float, float] = (0.40, 0.85, 0.35)
+    sun_color: tuple[float, float, float] = (1.0, 0.95, 0.86)
+    sun_intensity: float = 1.5
+    sky_zenith: tuple[float, float, float] = (0.25, 0.47, 0.80)
+    sky_horizon: tuple[float, float, float] = (0.76, 0.85, 0.93)
+    ground_bounce: tuple[float, float, float] = (0.30, 0.32, 0.22)
+    ambient: float = 0.75
+    exposure: float = 1.0
+    haze_distance: float | None = None  # metres; None: from the tree's size
+    ground_grid: float = 0.0            # strength of a 1 m grid on the ground (0: none)
+    show_sky: bool = True
+    show_ground: bool = True
+    shadow: bool = True
+
+
+class _Lines:
+    """GPU buffers of one overlay."""
+
+    def __init__(self, overlay: Overlay) -> None:
+        self.ref = weakref.ref(overlay)
+        self.vbo: moderngl.Buffer | None = None
+        self.vao: moderngl.VertexArray | None = None
+        self.count = 0
+        self.uploaded = False
+
+    def release(self) -> None:
+        for o in (self.vao, self.vbo):
+            if o is not None:
+                o.release()
+        self.vao = self.vbo = None
+
+
+class Renderer:
+    """Draws one tree (plus sky, ground and overlays) on any moderngl context of GL >= 3.3.
+
+    Parameters
+    ----------
+    ctx : moderngl.Context
+        A window's or a standalone context, current on this thread.
+    tree : Tree
+    mesh : TreeMesh or None
+        A prebuilt mesh of ``tree`` (None builds one).
+    scene : Scene or None
+    """
+
+    def __init__(self, ctx: moderngl.Context, tree: Tree, mesh: TreeMesh | None = None,
+                 scene: Scene | None = None) -> None:
+        if ctx.version_code < 330:
+            raise RuntimeError(f"the renderer needs OpenGL 3.3, the context has {ctx.version_code // 100}."
+                               f"{ctx.version_code % 100 // 10}")
+        self.ctx = ctx
+        self.tree = tree
+        self.mesh = mesh if mesh is not None else build_mesh(tree)
+        self.scene = scene if scene is not None else Scene()
+        self._applied_scene: tuple | None = None
+        self._released = False
+
+        self.tree_prog = load_program(ctx, "tree.vert", "tree.frag")
+        self.sky_prog = load_program(ctx, "sky.vert", "sky.frag")
+        self.ground_prog = load_program(ctx, "ground.vert", "ground.frag")
+        self.line_prog = load_program(ctx, "line.vert", "line.frag", "line_geom.glsl")
+
+        # --- static mesh
+        self.vbo = self.ibo = self.vao = None
+        if self.mesh.triangle_count:
+            self.vbo = ctx.buffer(self.mesh.vertices.tobytes())
+            self.ibo = ctx.buffer(self.mesh.indices.tobytes())
+            self.vao = ctx.vertex_array(self.tree_prog, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRIBUTES)],
+                                        index_buffer=self.ibo, index_element_size=4)
+        self._n_indices = 3 * self.mesh.triangle_count
+
+        # --- per-frame textures
+        N, M = tree.n_nodes, tree.n_objects
+        rows = max(1, math.ceil(3 * N / TEXTURE_WIDTH))
+        self._node_staging = np.zeros((rows * TEXTURE_WIDTH, 4), np.float32)
+        self._node_rows = self._node_staging.reshape(-1)[: 12 * N].reshape(N, 12)
+        self.node_texture = ctx.texture((TEXTURE_WIDTH, rows), 4, dtype="f4")
+        orows = max(1, math.ceil(M / TEXTURE_WIDTH))
+        self._object_staging = np.zeros((orows * TEXTURE_WIDTH, 4), np.float32)
+        self.object_texture = ctx.texture((TEXTURE_WIDTH, orows), 4, dtype="f4")
+        for tex in (self.node_texture, self.object_texture):
+            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            tex.repeat_x = tex.repeat_y = False
+        for prog in (self.tree_prog, self.line_prog):
+            self._uniform(prog, "u_nodes", 0)
+        self._uniform(self.tree_prog, "u_objects", 1)
+
+        # --- sky and ground
+        self.sky_vao = ctx.vertex_array(self.sky_prog, [])
+        self.ground_vbo = ctx.buffer(np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32).tobytes())
+        self.ground_vao = ctx.vertex_array(self.ground_prog, [(self.ground_vbo, "2f", "in_xz")])
+        self._place_ground()
+
+        self._lines: dict[int, _Lines] = {}
+        self._present: np.ndarray | None = None  # None: derived from the season at draw time
+        self._present_season: float | None = None
+        self._highlight = np.zeros(M, bool)
+        self._objects_dirty = True
+        self.update(tree.rest_positions, np.broadcast_to(np.eye(3), (N, 3, 3)))
+
+    # ------------------------------------------------------------------ helpers
+    @staticmethod
+    def _uniform(prog: moderngl.Program, name: str, value) -> None:
+        u = prog.get(name, None)
+        if u is not None:
+            u.value = value
+
+    def _write(self, progs, name: str, data: bytes) -> None:
+        for prog in progs:
+            u = prog.get(name, None)
+            if u is not None:
+                u.write(data)
+
+    def bounds(self, positions: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Axis-aligned box of the tree (nodes, plus the leaves' laminas), world."""
+        P = self.tree.rest_positions if positions is None else np.asarray(positions)
+        lo, hi = P.min(axis=0), P.max(axis=0)
+        pad = float(np.max(self.tree.lamina_length, initial=0.0)) + 0.5 * float(np.max(self.tree.node_diameter))
+        return lo - pad, hi + pad
+
+    def _place_ground(self) -> None:
+        tree = self.tree
+        P = tree.rest_positions
+        lo, hi = self.bounds()
+        size = float(np.max(hi - lo))
+        self.size = size
+        roots = tree.object_start[tree.parent < 0]
+        branch = tree.kind == "branch"
+        trunk_foot = P[roots[0]] if len(roots) and branch.any() else 0.5 * (lo + hi)
+        self.ground_centre = np.array([trunk_foot[0], 0.0, trunk_foot[2]])
+        self.ground_half = max(60.0, 25.0 * size)
+        self.earth_radius = float(7.0 * tree.node_diameter[roots[branch[tree.parent < 0]]].max()) \
+            if branch.any() else 0.0
+        leafy = tree.kind != "branch"
+        pts = P[np.isin(tree.node_object, np.flatnonzero(leafy))] if leafy.any() else P
+        self.crown_centre = pts.mean(axis=0)
+        spread = np.sqrt(np.mean(np.sum((pts[:, [0, 2]] - self.crown_centre[[0, 2]]) ** 2, axis=1)))
+        self.shadow_radius = float(max(1.2 * spread, 0.15 * size))
+
+    def _apply_scene(self) -> None:
+        s = self.scene
+        key = tuple(vars(s).values())
+        if key == self._applied_scene:
+            return
+        self._applied_scene = key
+        sun = np.asarray(s.sun_direction, float)
+        sun = tuple(sun / np.linalg.norm(sun))
+        lit = {
+            "u_sun_dir": sun,
+            "u_sun_color": tuple(c * s.sun_intensity for c in _lin(s.sun_color)),
+            "u_sky_zenith": tuple(c * s.ambient for c in _lin(s.sky_zenith)),
+            "u_sky_horizon": _lin(s.sky_horizon),
+            "u_ground_bounce": tuple(c * s.ambient for c in _lin(s.ground_bounce)),
+            "u_haze_distance": float(s.haze_distance or max(40.0 * self.size, 60.0)),
+            "u_exposure": float(s.exposure),
+        }
+        for prog in (self.tree_prog, self.sky_prog, self.ground_prog):
+            for k, v in lit.items():
+                self._uniform(prog, k, v)
+        # The sky's horizon colour is used unscaled (it is also the haze colour).
+        self._uniform(self.sky_prog, "u_sky_zenith", _lin(s.sky_zenith))
+        g = self.ground_prog
+        self._uniform(g, "u_ground_centre", tuple(self.ground_centre))
+        self._uniform(g, "u_ground_half", float(self.ground_half))
+        self._uniform(g, "u_earth_radius", float(self.earth_radius))
+        c = self.crown_centre
+        shadow_at = c - np.asarray(sun) * (c[1] / max(sun[1], 0.2))
+        self._uniform(g, "u_shadow_centre", tuple(shadow_at))
+        self._uniform(g, "u_shadow_radius", float(self.shadow_radius if s.shadow else 0.0))
+        self._uniform(g, "u_grid", float(s.ground_grid))
+
+    # ------------------------------------------------------------------ per frame
+    def update(self, positions: np.ndarray, rotations: np.ndarray, present: np.ndarray | None = None,
+               highlight=None) -> None:
+        """Upload the pose for the next draws.
+
+        Parameters
+        ----------
+        positions : (N, 3) float
+            Node positions, world (``Simulation.positions``).
+        rotations : (N, 3, 3) float
+            Node rotations relative to rest (``Simulation.rotations``).
+        present : (M,) bool or None
+            Objects shown (``Simulation.present``); None shows the leaves present at the
+            ``season`` passed to :meth:`draw` (``Tree.leaves_present``).
+        highlight : None, int, sequence of int or (M,) bool
+            Objects drawn highlighted (e.g. the grabbed one).
+        """
+        rows = self._node_rows
+        rows[:, 0:3] = positions
+        rows[:, 3:12] = np.reshape(rotations, (-1, 9))
+        self.node_texture.write(self._node_staging)
+
+        M = self.tree.n_objects
+        if present is None:
+            if self._present is not None:
+                self._present, self._present_season = None, None
+        else:
+            present = np.asarray(present, bool)
+            if self._present is None or not np.array_equal(present, self._present):
+                self._present = present.copy()
+                self._objects_dirty = True
+        hl = np.zeros(M, bool)
+        if highlight is not None:
+            h = np.asarray(highlight)
+            if h.dtype == bool and h.shape == (M,):
+                hl = h
+            elif h.size:
+                hl[h.astype(int).reshape(-1)] = True
+        if not np.array_equal(hl, self._highlight):
+            self._highlight = hl
+            self._objects_dirty = True
+
+    def _upload_objects(self, season: float) -> None:
+        if self._present is None and self._present_season != season:
+            self._present_season = season
+            self._objects_dirty = True
+        if not self._objects_dirty:
+            return
+        M = self.tree.n_objects
+        present = self._present if self._present is not None else self.tree.leaves_present(season)
+        self._object_staging[:M, 0] = present
+        self._object_staging[:M, 1] = self._highlight
+        self.object_texture.write(self._object_staging)
+        self._objects_dirty = False
+
+    def draw(self, camera: OrbitCamera, width: int, height: int, season: float = 0.0,
+             overlays=(), framebuffer: moderngl.Framebuffer | None = None) -> None:
+        """Draw sky, ground, tree and ``overlays`` into ``framebuffer`` (None: the one bound),
+        over its ``width`` × ``height`` pixels. A zero-sized viewport draws nothing.
+
+        Parameters
+        ----------
+        season : float
+            0 summer .. 1 winter: the leaves' colour (and, when :meth:`update` got no
+            ``present``, which leaves are shown).
+        overlays : iterable of Overlay
+        """
+        if self._released:
+            raise RuntimeError("draw() on a released Renderer")
+        width, height = int(width), int(height)
+        if width <= 0 or height <= 0:
+            return
+        ctx = self.ctx
+        if framebuffer is not None:
+            framebuffer.use()
+        ctx.viewport = (0, 0, width, height)
+        self._apply_scene()
+        season = float(np.clip(season, 0.0, 1.0))
+        self._upload_objects(season)
+
+        vp = camera.view_projection(width, height)
+        vp_bytes = vp.tobytes()
+        eye = tuple(float(x) for x in camera.eye)
+        self._write((self.tree_prog, self.ground_prog, self.line_prog), "u_view_proj", vp_bytes)
+        for prog in (self.tree_prog, self.sky_prog, self.ground_prog):
+            self._uniform(prog, "u_camera_pos", eye)
+        self._uniform(self.tree_prog, "u_season", season)
+
+        s = self.scene
+        hz = _lin(s.sky_horizon)
+        ctx.clear(hz[0] ** (1 / 2.2), hz[1] ** (1 / 2.2), hz[2] ** (1 / 2.2), 1.0, depth=1.0)
+        ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
+        if s.show_sky:
+            ctx.disable(moderngl.DEPTH_TEST)
+            self.sky_prog["u_inv_view_proj"].write(np.linalg.inv(vp.astype(np.float64)).astype(np.float32).tobytes())
+            self.sky_vao.render(moderngl.TRIANGLES, vertices=3)
+        ctx.enable(moderngl.DEPTH_TEST)
+        if s.show_ground:
+            self.ground_vao.render(moderngl.TRIANGLE_STRIP)
+        self.node_texture.use(0)
+        self.object_texture.use(1)
+        if self.vao is not None:
+            self.vao.render(moderngl.TRIANGLES, vertices=self._n_indices)
+        overlays = [o for o in overlays if o is not None]
+        if overlays:
+            self._draw_overlays(overlays, width, height)
+        self._collect_lines({id(o) for o in overlays})
+
+    # ------------------------------------------------------------------ overlays
+    def _draw_overlays(self, overlays, width: int, height: int) -> None:
+        ctx = self.ctx
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        self._uniform(self.line_prog, "u_viewport", (float(width), float(height)))
+        for ov in overlays:
+            buf = self._lines.get(id(ov))
+            if buf is None or buf.ref() is not ov:
+                if buf is not None:
+                    buf.release()
+                buf = self._lines[id(ov)] = _Lines(ov)
+            if not (ov.static and buf.uploaded):
+                ls = ov.lines(self.tree)
+                data = ls.packed().tobytes() if ls is not None and len(ls.points) >= 2 else b""
+                buf.count = len(data) // 32
+                buf.uploaded = True
+                if buf.count:
+                    if buf.vbo is None or buf.vbo.size < len(data):
+                        buf.release()
+                        buf.vbo = ctx.buffer(reserve=max(len(data), 4096) * 2, dynamic=True)
+                        buf.vao = ctx.vertex_array(self.line_prog, [(buf.vbo, LINE_FORMAT, *LINE_ATTRIBUTES)])
+                    buf.vbo.write(data)
+            if not buf.count:
+                continue
+            if ov.on_top:
+                ctx.disable(moderngl.DEPTH_TEST)
+            else:
+                ctx.enable(moderngl.DEPTH_TEST)
+            self._uniform(self.line_prog, "u_width", float(ov.width))
+            buf.vao.render(moderngl.LINES, vertices=buf.count - buf.count % 2)
+        ctx.disable(moderngl.BLEND)
+        ctx.enable(moderngl.DEPTH_TEST)
+
+    def _collect_lines(self, live: set[int]) -> None:
+        for key in [k for k, b in self._lines.items() if k not in live or b.ref() is None]:
+            self._lines.pop(key).release()
+
+    # ------------------------------------------------------------------ teardown
+    def release(self) -> None:
+        """Free every GPU resource (idempotent)."""
+        if self._released:
+            return
+        self._released = True
+        for b in self._lines.values():
+            b.release()
+        self._lines.clear()
+        for o in (self.vao, self.vbo, self.ibo, self.sky_vao, self.ground_vao, self.ground_vbo,
+                  self.node_texture, self.object_texture, self.tree_prog, self.sky_prog,
+                  self.ground_prog, self.line_prog):
+            if o is not None:
+                o.release()

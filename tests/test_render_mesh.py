@@ -1,0 +1,251 @@
+"""Render core without GL: mesh construction and CPU skinning, camera, picking."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import beam_tree, grass_patch, small_tree
+
+from treeanim.render.camera import OrbitCamera
+from treeanim.render.mesh import (
+    MATERIAL_BARK,
+    MATERIAL_BLADE,
+    MATERIAL_LAMINA,
+    MATERIAL_PETIOLE,
+    VERTEX_ATTRIBUTES,
+    VERTEX_DTYPE,
+    VERTEX_FORMAT,
+    build_mesh,
+    lamina_frames,
+)
+from treeanim.render.picking import Picker, pick
+
+
+def rot(axis, angle):
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+def identity(tree):
+    return np.broadcast_to(np.eye(3), (tree.n_nodes, 3, 3))
+
+
+@pytest.fixture(scope="module", params=["tree", "grass", "beam"])
+def any_tree(request):
+    return {"tree": small_tree, "grass": grass_patch, "beam": beam_tree}[request.param]()
+
+
+# ------------------------------------------------------------------------------ mesh
+def test_triangle_counts_equal_tree_counts(any_tree):
+    mesh = build_mesh(any_tree)
+    assert np.array_equal(mesh.object_triangles, any_tree.triangles_per_object())
+    assert mesh.triangle_count == int(any_tree.triangles_per_object().sum()) == len(mesh.indices)
+    assert mesh.indices.dtype == np.uint32 and mesh.indices.max() < mesh.vertex_count
+    # Every triangle belongs to one object: its three vertices share the object index.
+    obj = mesh.object[mesh.indices]
+    assert np.all(obj == obj[:, :1])
+
+
+def test_per_kind_triangles_follow_the_papers_rule():
+    tree = small_tree()
+    mesh = build_mesh(tree)
+    n = tree.object_count
+    branch = tree.kind == "branch"
+    leaf = tree.kind == "leaf"
+    assert np.all(mesh.object_triangles[branch] == 32 * n[branch])
+    lam = len(tree.lamina.triangles)
+    assert np.all(mesh.object_triangles[leaf] == 2 * tree.petiole_sides * (n[leaf] - 1) + lam)
+    grass = grass_patch()
+    gm = build_mesh(grass)
+    assert np.all(gm.object_triangles == 2 * (grass.object_count - 1) + 1)
+
+
+def test_vertex_layout():
+    assert VERTEX_DTYPE.itemsize == 64
+    assert VERTEX_FORMAT == "4i 3f 3f 4f 2f"
+    assert VERTEX_ATTRIBUTES == ("in_ids", "in_offset", "in_normal", "in_extra", "in_uv")
+    mesh = build_mesh(small_tree())
+    v = mesh.vertices
+    assert set(np.unique(mesh.material)) == {MATERIAL_BARK, MATERIAL_PETIOLE, MATERIAL_LAMINA}
+    assert np.all((v["extra"][:, 0] == 0) | (v["extra"][:, 0] == 0.5))
+    assert np.all((v["extra"][:, 1] >= 0) & (v["extra"][:, 1] < 1))
+    assert np.all((v["extra"][:, 2] > 0) & (v["extra"][:, 2] <= 1))
+    assert np.allclose(np.linalg.norm(v["normal"], axis=1), 1, atol=1e-5)
+    # All vertices of one object share its jitter (per-leaf colour).
+    jit = v["extra"][:, 1]
+    first = np.zeros(small_tree().n_objects)
+    first[mesh.object] = jit
+    assert np.array_equal(first[mesh.object], jit)
+
+
+def test_mesh_is_deterministic():
+    a, b = build_mesh(small_tree()), build_mesh(small_tree())
+    assert a.vertices.tobytes() == b.vertices.tobytes()
+    assert a.indices.tobytes() == b.indices.tobytes()
+
+
+def test_rest_geometry():
+    tree = small_tree()
+    mesh = build_mesh(tree)
+    pts, normals = mesh.skin(tree.rest_positions, identity(tree))
+    node = mesh.node
+    # Tube rings lie at the node's radius (cap centres, whose offset runs along their normal,
+    # are left out).
+    off = mesh.vertices["offset"]
+    bark = (mesh.material == MATERIAL_BARK) & (np.linalg.norm(np.cross(off, mesh.vertices["normal"]), axis=1) > 1e-6)
+    assert bark.sum() == 16 * tree.object_count[tree.kind == "branch"].sum()
+    ring_r = np.linalg.norm(pts[bark] - tree.rest_positions[node[bark]], axis=1)
+    assert np.allclose(ring_r, 0.5 * tree.node_diameter[node[bark]], rtol=1e-5)
+    # The lamina's tip (0, 1) sits one lamina length along the petiole's last segment.
+    leaves = np.flatnonzero(tree.kind == "leaf")
+    tipn, u, v, w = lamina_frames(tree, leaves)
+    k_tip = int(np.flatnonzero(np.all(tree.lamina.outline == [0.0, 1.0], axis=1))[0])
+    lam = mesh.material == MATERIAL_LAMINA
+    K = len(tree.lamina.outline)
+    lam_pts = pts[lam].reshape(len(leaves), K, 3)
+    expect = tree.rest_positions[tipn] + tree.lamina_length[leaves, None] * v
+    assert np.allclose(lam_pts[:, k_tip], expect, atol=1e-6)
+    # The lamina's normal is the leaf's w at its midrib.
+    lam_n = normals[lam].reshape(len(leaves), K, 3)
+    assert np.allclose(lam_n[:, k_tip], w, atol=1e-5)
+    # Blades: width = node diameter, across the blade's w axis.
+    grass = grass_patch()
+    gm = build_mesh(grass)
+    gp, _ = gm.skin(grass.rest_positions, identity(grass))
+    pairs = gp[: 2 * grass.n_nodes].reshape(-1, 2, 3)
+    assert np.allclose(np.linalg.norm(pairs[:, 1] - pairs[:, 0], axis=1), grass.node_diameter, rtol=1e-5)
+
+
+def test_rigid_motion_is_skinned_exactly():
+    tree = small_tree()
+    mesh = build_mesh(tree)
+    rest_pts, rest_n = mesh.skin(tree.rest_positions, identity(tree))
+    R = rot((0.3, 1.0, -0.2), 0.9)
+    t = np.array([0.4, -0.1, 2.0])
+    pts, normals = mesh.skin(tree.rest_positions @ R.T + t, np.broadcast_to(R, (tree.n_nodes, 3, 3)))
+    assert np.allclose(pts, rest_pts @ R.T + t, atol=1e-6)
+    assert np.allclose(normals, rest_n @ R.T, atol=1e-6)
+
+
+def test_joint_rings_follow_both_segments():
+    """Bend the beam at one inner node: the ring there turns half way, and keeps its radius."""
+    tree = beam_tree()
+    mesh = build_mesh(tree)
+    P = tree.rest_positions
+    j = 4
+    R = rot((0, 0, 1), 0.6)
+    positions = P.copy()
+    positions[j + 1:] = P[j] + (P[j + 1:] - P[j]) @ R.T
+    rotations = np.array(identity(tree))
+    rotations[j:] = R
+    pts, _ = mesh.skin(positions, rotations)
+    ring = (mesh.node == j) & (mesh.material == MATERIAL_BARK)
+    assert ring.sum() == 16
+    offs = pts[ring] - positions[j]
+    assert np.allclose(np.linalg.norm(offs, axis=1), 0.5 * tree.node_diameter[j], rtol=1e-5)
+    half = rot((0, 0, 1), 0.3)
+    assert np.allclose(offs, mesh.vertices["offset"][ring] @ half.T, atol=1e-6)
+    # Rings away from the joint follow their own segment rigidly.
+    after = (mesh.node == j + 2) & (mesh.material == MATERIAL_BARK)
+    assert np.allclose(pts[after] - positions[j + 2], mesh.vertices["offset"][after] @ R.T, atol=1e-6)
+
+
+def test_mesh_build_is_vectorised_fast():
+    """A tree with thousands of leaves builds in well under a second (no per-object loop)."""
+    import time
+
+    tree = small_tree(leaves_per_twig=60)
+    t0 = time.perf_counter()
+    mesh = build_mesh(tree)
+    elapsed = time.perf_counter() - t0
+    assert mesh.triangle_count == int(tree.triangles_per_object().sum())
+    assert elapsed < 1.0, elapsed
+
+
+# ------------------------------------------------------------------------------ camera
+def test_camera_ray_passes_through_projected_point():
+    cam = OrbitCamera(target=(0.2, 1.0, -0.1), distance=4.0, azimuth=35, elevation=20)
+    rng = np.random.default_rng(0)
+    for p in rng.uniform(-1, 2, size=(10, 3)):
+        x, y, depth = cam.project(p, 320, 200)[0]
+        o, d = cam.ray(x, y, 320, 200)
+        assert np.isclose(np.linalg.norm(d), 1.0)
+        off = (p - o) - ((p - o) @ d) * d
+        assert np.linalg.norm(off) < 1e-6
+    # The target projects to the centre.
+    x, y, _ = cam.project(cam.target, 320, 200)[0]
+    assert np.allclose([x, y], [160, 100], atol=1e-6)
+
+
+def test_camera_frame_orbit_pan_zoom():
+    cam = OrbitCamera(azimuth=-30, elevation=15)
+    lo, hi = np.array([-1.0, 0.0, -0.5]), np.array([1.5, 3.0, 0.8])
+    cam.frame((lo, hi), aspect=4 / 3)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    xy = cam.project(corners, 400, 300)[:, :2]
+    assert np.all((xy >= -1e-6) & (xy <= [400 + 1e-6, 300 + 1e-6]))
+    assert (xy[:, 0].max() - xy[:, 0].min() > 0.8 * 400) or (xy[:, 1].max() - xy[:, 1].min() > 0.8 * 300)
+    eye = cam.eye
+    cam.orbit(90, 200)
+    assert cam.elevation == 89.0 and np.isclose(np.linalg.norm(cam.eye - cam.target), cam.distance)
+    cam.orbit(0, -200)
+    assert cam.elevation == -89.0
+    d = cam.distance
+    cam.zoom(0.5)
+    assert np.isclose(cam.distance, 0.5 * d)
+    cam = OrbitCamera(distance=5.0)
+    p = cam.target + 0.3 * cam.right
+    x0 = cam.project(p, 200, 100)[0, 0]
+    cam.pan(10, 0, 100)
+    assert np.isclose(cam.project(p, 200, 100)[0, 0] - x0, 10.0, atol=1e-3)
+    assert np.linalg.norm(eye) > 0
+
+
+# ------------------------------------------------------------------------------ picking
+def test_pick_hits_the_object_under_the_ray_and_misses_sky():
+    tree = small_tree()
+    P = tree.rest_positions
+    picker = Picker(tree)
+    cam = OrbitCamera(azimuth=10, elevation=5)
+    cam.frame((P.min(0), P.max(0)), aspect=1.0)
+    W = H = 400
+    R = identity(tree)
+    for i in range(0, tree.n_objects, 7):
+        if tree.kind[i] != "branch":
+            continue
+        nodes = tree.object_nodes(i)
+        mid = 0.5 * (P[nodes[len(nodes) // 2 - 1]] + P[nodes[len(nodes) // 2]])
+        x, y, _ = cam.project(mid, W, H)[0]
+        o, d = cam.ray(x, y, W, H)
+        hit = picker.pick(P, R, o, d, pixel_angle=cam.pixel_angle(H), min_pixels=1.0)
+        assert hit is not None
+        # Whatever is hit is at or in front of the branch, and a branch hit is this one or
+        # something nearer to the eye.
+        assert hit.distance <= np.linalg.norm(mid - o) + 0.5 * tree.node_diameter.max() + 1e-6
+        if hit.object != i:
+            assert hit.distance < np.linalg.norm(mid - o)
+    o, d = cam.ray(W / 2, 2, W, H)  # top centre: sky above the tree
+    assert picker.pick(P, R, o, d + np.array([0, 1.0, 0]), pixel_angle=cam.pixel_angle(H)) is None
+
+
+def test_pick_lamina_follows_pose_and_present_mask():
+    tree = small_tree()
+    P = tree.rest_positions
+    leaf = int(np.flatnonzero(tree.kind == "leaf")[5])
+    tipn, u, v, w = lamina_frames(tree, np.array([leaf]))
+    centre = P[tipn[0]] + 0.5 * tree.lamina_length[leaf] * v[0]
+    o = centre + 2.0 * w[0]
+    d = -w[0]  # straight through the lamina
+    R = identity(tree)
+    hit = pick(tree, P, R, o, d)
+    assert hit is not None and hit.object == leaf
+    assert np.isclose(hit.distance, 2.0, atol=0.05)
+    present = np.ones(tree.n_objects, bool)
+    present[leaf] = False
+    other = pick(tree, P, R, o, d, present=present)
+    assert other is None or other.object != leaf
+    # Move the whole tree: the same world ray misses, the moved one hits.
+    shift = np.array([0.0, 0.0, 3.0])
+    assert getattr(pick(tree, P + shift, R, o, d), "object", None) != leaf
+    assert pick(tree, P + shift, R, o + shift, d).object == leaf
