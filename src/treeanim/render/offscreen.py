@@ -53,12 +53,25 @@ class OffscreenRenderer:
         self.ctx = create_egl_context() if ctx is None else ctx
         self.samples = 0 if samples <= 1 else min(int(samples), int(self.ctx.max_samples))
         self.renderer: Renderer | None = None
+        # Bound while our framebuffers are released: moderngl rebinds the last framebuffer
+        # used after creating one, and a deleted one would raise GL_INVALID_OPERATION.
+        self._default_fbo = self.ctx.screen or self.ctx.detect_framebuffer(0)
         self._fbos: list = []
         self.width = self.height = 0
         self.resize(width, height)
 
+    def make_current(self) -> None:
+        """Make this renderer's context current on this thread (and leave it current).
+
+        Every method here does so first, so renders stay correct when other contexts were
+        created or released in between; call it before using :attr:`renderer` directly
+        after such a switch."""
+        self.ctx.__enter__()
+
     # ------------------------------------------------------------------ framebuffers
     def _release_fbos(self) -> None:
+        if self._fbos:
+            self._default_fbo.use()
         for o in self._fbos:
             o.release()
         self._fbos = []
@@ -69,6 +82,7 @@ class OffscreenRenderer:
         width, height = max(int(width), 0), max(int(height), 0)
         if (width, height) == (self.width, self.height) and self._fbos:
             return
+        self.make_current()
         self._release_fbos()
         self.width, self.height = width, height
         if width == 0 or height == 0:
@@ -90,6 +104,7 @@ class OffscreenRenderer:
     def load(self, tree: Tree, scene: Scene | None = None, **kw) -> Renderer:
         """Make (and keep) a :class:`Renderer` for ``tree`` on this context, releasing the
         previous one. Extra keywords go to :class:`Renderer`."""
+        self.make_current()
         if self.renderer is not None:
             self.renderer.release()
         self.renderer = Renderer(self.ctx, tree, scene=scene, **kw)
@@ -115,6 +130,7 @@ class OffscreenRenderer:
             raise RuntimeError("OffscreenRenderer.render: no tree loaded (call load(tree) first)")
         if self.width == 0 or self.height == 0:
             return np.zeros((self.height, self.width, 3), np.uint8)
+        self.make_current()
         r.draw(camera, self.width, self.height, season=season, overlays=overlays, framebuffer=self.fbo)
         if self.fbo is not self.resolve_fbo:
             self.ctx.copy_framebuffer(self.resolve_fbo, self.fbo)
@@ -124,6 +140,9 @@ class OffscreenRenderer:
 
     def release(self) -> None:
         """Free the renderer, framebuffers and (if owned) the context."""
+        if self.ctx is None:
+            return
+        self.make_current()
         if self.renderer is not None:
             self.renderer.release()
             self.renderer = None
