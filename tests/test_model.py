@@ -197,7 +197,7 @@ def test_generator_invariants(trunk, levels, leaves, seed):
     n_levels = 1 + len(levels)
     spec = TreeSpec(
         name="random", seed=seed, levels=(trunk, *levels),
-        leaves=dataclasses.replace(base.leaves, count=leaves, winter_count=leaves // 3, levels=(n_levels,)),
+        leaves=dataclasses.replace(base.leaves, count=leaves, winter_count=leaves // 3, levels=tuple(range(1, n_levels + 1))),
         lamina=base.lamina, physics=base.physics,
     )
     tree = generate(spec)
