@@ -3,8 +3,9 @@
 uniform vec3 u_sun_dir;        // unit, towards the sun
 uniform vec3 u_sun_color;      // linear
 uniform vec3 u_sky_zenith;     // linear
-uniform vec3 u_sky_horizon;    // linear
+uniform vec3 u_sky_horizon;    // linear (also the haze colour)
 uniform vec3 u_ground_bounce;  // linear, light from below
+uniform float u_ambient;       // strength of the sky/ground hemisphere light
 uniform vec3 u_camera_pos;
 uniform float u_haze_distance; // metres at which haze reaches 63 %
 uniform float u_exposure;
@@ -13,7 +14,7 @@ vec3 srgb_to_linear(vec3 c) { return pow(c, vec3(2.2)); }
 
 vec3 hemisphere(vec3 n) {
     vec3 sky = mix(u_sky_horizon, u_sky_zenith, 0.5);
-    return mix(u_ground_bounce, sky, 0.5 + 0.5 * n.y);
+    return u_ambient * mix(u_ground_bounce, sky, 0.5 + 0.5 * n.y);
 }
 
 vec3 apply_haze(vec3 c, vec3 world) {

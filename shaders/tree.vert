@@ -69,7 +69,7 @@ void main() {
     float jitter = in_extra.y;
     float key = in_extra.w;
     if (v_material == BARK) {
-        v_albedo = lin(vec3(0.36, 0.28, 0.22)) * (0.8 + 0.4 * jitter);
+        v_albedo = lin(vec3(0.34, 0.29, 0.25)) * (0.8 + 0.4 * jitter);
     } else if (v_material == PETIOLE) {
         v_albedo = mix(leaf_color(jitter, key), lin(vec3(0.55, 0.28, 0.14)), 0.4);
     } else if (v_material == LAMINA) {

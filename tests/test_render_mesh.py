@@ -182,8 +182,11 @@ def test_camera_frame_orbit_pan_zoom():
     cam = OrbitCamera(azimuth=-30, elevation=15)
     lo, hi = np.array([-1.0, 0.0, -0.5]), np.array([1.5, 3.0, 0.8])
     cam.frame((lo, hi), aspect=4 / 3)
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    xy = cam.project(corners, 400, 300)[:, :2]
+    mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    a = np.linspace(0, 2 * np.pi, 7)
+    ring = mid + np.stack([half[0] * np.cos(a), 0 * a, half[2] * np.sin(a)], 1)
+    rim = np.concatenate([ring - [0, half[1], 0], ring + [0, half[1], 0]])  # on the inscribed cylinder
+    xy = cam.project(rim, 400, 300)[:, :2]
     assert np.all((xy >= -1e-6) & (xy <= [400 + 1e-6, 300 + 1e-6]))
     assert (xy[:, 0].max() - xy[:, 0].min() > 0.8 * 400) or (xy[:, 1].max() - xy[:, 1].min() > 0.8 * 300)
     eye = cam.eye

@@ -117,12 +117,15 @@ class OrbitCamera:
 
     def frame(self, bounds: Bounds, aspect: float = 16 / 9, margin: float = 1.08) -> None:
         """Aim at the centre of axis-aligned ``bounds`` ((x0, y0, z0), (x1, y1, z1)) and step back
-        until the box, seen from the current direction, fits the view of ``aspect`` (w / h)
-        with ``margin`` to spare."""
+        until the upright elliptic cylinder inscribed in them (a crown is round, not boxy),
+        seen from the current direction, fits the view of ``aspect`` (w / h) with ``margin``
+        to spare."""
         lo, hi = np.asarray(bounds[0], float), np.asarray(bounds[1], float)
         self.target = 0.5 * (lo + hi)
-        corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-        rel = corners - self.target
+        half = 0.5 * (hi - lo)
+        a = np.linspace(0.0, 2.0 * np.pi, 32, endpoint=False)
+        ring = np.stack([half[0] * np.cos(a), np.zeros_like(a), half[2] * np.sin(a)], 1)
+        rel = np.concatenate([ring - [0.0, half[1], 0.0], ring + [0.0, half[1], 0.0]])
         across = np.abs(rel @ self.right)
         upward = np.abs(rel @ self.up)
         depth = rel @ self.forward  # towards the far side is positive

@@ -99,8 +99,7 @@ class Renderer:
         self._released = False
 
         self.tree_prog = load_program(ctx, "tree.vert", "tree.frag")
-        self.sky_prog = load_program(ctx, "sky.vert", "sky.frag")
-        self.ground_prog = load_program(ctx, "ground.vert", "ground.frag")
+        self.bg_prog = load_program(ctx, "background.vert", "background.frag")
         self.line_prog = load_program(ctx, "line.vert", "line.frag", "line_geom.glsl")
 
         # --- static mesh
@@ -128,10 +127,8 @@ class Renderer:
             self._uniform(prog, "u_nodes", 0)
         self._uniform(self.tree_prog, "u_objects", 1)
 
-        # --- sky and ground
-        self.sky_vao = ctx.vertex_array(self.sky_prog, [])
-        self.ground_vbo = ctx.buffer(np.array([-1, -1, 1, -1, -1, 1, 1, 1], np.float32).tobytes())
-        self.ground_vao = ctx.vertex_array(self.ground_prog, [(self.ground_vbo, "2f", "in_xz")])
+        # --- sky and ground: one full-screen triangle
+        self.bg_vao = ctx.vertex_array(self.bg_prog, [])
         self._place_ground()
 
         self._lines: dict[int, _Lines] = {}
@@ -171,14 +168,13 @@ class Renderer:
         branch = tree.kind == "branch"
         trunk_foot = P[roots[0]] if len(roots) and branch.any() else 0.5 * (lo + hi)
         self.ground_centre = np.array([trunk_foot[0], 0.0, trunk_foot[2]])
-        self.ground_half = max(60.0, 25.0 * size)
         self.earth_radius = float(7.0 * tree.node_diameter[roots[branch[tree.parent < 0]]].max()) \
             if branch.any() else 0.0
         leafy = tree.kind != "branch"
         pts = P[np.isin(tree.node_object, np.flatnonzero(leafy))] if leafy.any() else P
         self.crown_centre = pts.mean(axis=0)
-        spread = np.sqrt(np.mean(np.sum((pts[:, [0, 2]] - self.crown_centre[[0, 2]]) ** 2, axis=1)))
-        self.shadow_radius = float(max(1.2 * spread, 0.15 * size))
+        spread = np.percentile(np.linalg.norm(pts[:, [0, 2]] - self.crown_centre[[0, 2]], axis=1), 85)
+        self.shadow_radius = float(max(1.1 * spread, 0.1 * size))
 
     def _apply_scene(self) -> None:
         s = self.scene
@@ -191,20 +187,20 @@ class Renderer:
         lit = {
             "u_sun_dir": sun,
             "u_sun_color": tuple(c * s.sun_intensity for c in _lin(s.sun_color)),
-            "u_sky_zenith": tuple(c * s.ambient for c in _lin(s.sky_zenith)),
+            "u_sky_zenith": _lin(s.sky_zenith),
             "u_sky_horizon": _lin(s.sky_horizon),
-            "u_ground_bounce": tuple(c * s.ambient for c in _lin(s.ground_bounce)),
+            "u_ground_bounce": _lin(s.ground_bounce),
+            "u_ambient": float(s.ambient),
             "u_haze_distance": float(s.haze_distance or max(40.0 * self.size, 60.0)),
             "u_exposure": float(s.exposure),
         }
-        for prog in (self.tree_prog, self.sky_prog, self.ground_prog):
+        for prog in (self.tree_prog, self.bg_prog):
             for k, v in lit.items():
                 self._uniform(prog, k, v)
-        # The sky's horizon colour is used unscaled (it is also the haze colour).
-        self._uniform(self.sky_prog, "u_sky_zenith", _lin(s.sky_zenith))
-        g = self.ground_prog
+        g = self.bg_prog
+        self._uniform(g, "u_show_sky", int(s.show_sky))
+        self._uniform(g, "u_show_ground", int(s.show_ground))
         self._uniform(g, "u_ground_centre", tuple(self.ground_centre))
-        self._uniform(g, "u_ground_half", float(self.ground_half))
         self._uniform(g, "u_earth_radius", float(self.earth_radius))
         c = self.crown_centre
         shadow_at = c - np.asarray(sun) * (c[1] / max(sun[1], 0.2))
@@ -295,8 +291,8 @@ class Renderer:
         vp = camera.view_projection(width, height)
         vp_bytes = vp.tobytes()
         eye = tuple(float(x) for x in camera.eye)
-        self._write((self.tree_prog, self.ground_prog, self.line_prog), "u_view_proj", vp_bytes)
-        for prog in (self.tree_prog, self.sky_prog, self.ground_prog):
+        self._write((self.tree_prog, self.line_prog), "u_view_proj", vp_bytes)
+        for prog in (self.tree_prog, self.bg_prog):
             self._uniform(prog, "u_camera_pos", eye)
         self._uniform(self.tree_prog, "u_season", season)
 
@@ -304,17 +300,17 @@ class Renderer:
         hz = _lin(s.sky_horizon)
         ctx.clear(hz[0] ** (1 / 2.2), hz[1] ** (1 / 2.2), hz[2] ** (1 / 2.2), 1.0, depth=1.0)
         ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
-        if s.show_sky:
-            ctx.disable(moderngl.DEPTH_TEST)
-            self.sky_prog["u_inv_view_proj"].write(np.linalg.inv(vp.astype(np.float64)).astype(np.float32).tobytes())
-            self.sky_vao.render(moderngl.TRIANGLES, vertices=3)
         ctx.enable(moderngl.DEPTH_TEST)
-        if s.show_ground:
-            self.ground_vao.render(moderngl.TRIANGLE_STRIP)
+        ctx.depth_func = "<"
         self.node_texture.use(0)
         self.object_texture.use(1)
         if self.vao is not None:
             self.vao.render(moderngl.TRIANGLES, vertices=self._n_indices)
+        # Background last, at the far plane: only pixels the tree left uncovered are shaded.
+        ctx.depth_func = "<="
+        self.bg_prog["u_inv_view_proj"].write(np.linalg.inv(vp.astype(np.float64)).astype(np.float32).tobytes())
+        self.bg_vao.render(moderngl.TRIANGLES, vertices=3)
+        ctx.depth_func = "<"
         overlays = [o for o in overlays if o is not None]
         if overlays:
             self._draw_overlays(overlays, width, height)
@@ -367,8 +363,7 @@ class Renderer:
         for b in self._lines.values():
             b.release()
         self._lines.clear()
-        for o in (self.vao, self.vbo, self.ibo, self.sky_vao, self.ground_vao, self.ground_vbo,
-                  self.node_texture, self.object_texture, self.tree_prog, self.sky_prog,
-                  self.ground_prog, self.line_prog):
+        for o in (self.vao, self.vbo, self.ibo, self.bg_vao, self.node_texture, self.object_texture,
+                  self.tree_prog, self.bg_prog, self.line_prog):
             if o is not None:
                 o.release()
