@@ -39,6 +39,127 @@ def _season(text: str) -> float:
     return value
 
 
+def _positive(kind):
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a positive {kind.__name__}, got {text!r}") from None
+        if not (value > 0 and value < float("inf")):
+            raise argparse.ArgumentTypeError(f"expected a positive {kind.__name__}, got {text!r}")
+        return value
+
+    return parse
+
+
+def _non_negative(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 <= value < float("inf"):
+        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}")
+    return value
+
+
+def _vector(text: str):
+    from treeanim.scripted import parse_vector
+
+    try:
+        return parse_vector(text, "direction")
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+
+
+def _pull(text: str):
+    from treeanim.scripted import parse_pull
+
+    try:
+        return parse_pull(text)
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+
+
+def add_scene_options(p: argparse.ArgumentParser, seconds: float = 5.0, fps: float = 30.0) -> None:
+    """Options shared by the offline commands: the preset, timing, wind, season and pulls."""
+    p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
+    p.add_argument("--seconds", type=_positive(float), default=seconds, help=f"duration in seconds (default {seconds:g})")
+    p.add_argument("--fps", type=_positive(float), default=fps, help=f"frames per second (default {fps:g})")
+    p.add_argument("--wind", type=_non_negative, default=5.0, metavar="SPEED",
+                   help="wind speed at the tree top, m/s (default 5; 0 = calm)")
+    p.add_argument("--wind-dir", type=_vector, default=(1.0, 0.0, 0.0), metavar="X,Y,Z",
+                   help="wind direction; needs a horizontal part (default 1,0,0)")
+    p.add_argument("--turbulence", type=float, default=1.5, metavar="LAMBDA", help="λ of Eq. 17, in [1, 2] (default 1.5)")
+    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the wind and the modal noise (default 0)")
+    p.add_argument("--pull", type=_pull, action="append", default=[], metavar="OBJECT:FX,FY,FZ@T0-T1",
+                   help="pull OBJECT's tip with a world force in newtons from T0 to T1 s, then let go; repeatable")
+
+
+def make_simulation(args):
+    """The tree and a Simulation set up from :func:`add_scene_options`."""
+    import treeanim as ta
+    from treeanim.scripted import check_pulls
+
+    tree = load_any(args.preset)
+    try:
+        check_pulls(args.pull, tree.n_objects)
+        wind = None
+        if args.wind > 0:
+            wind = ta.WindField(direction=args.wind_dir, speed=args.wind, turbulence=args.turbulence, seed=args.seed)
+        sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed)
+    except ValueError as e:
+        raise UsageError(str(e)) from None
+    return tree, sim
+
+
+def output_path(text: str, suffixes: tuple[str, ...]):
+    """Check an output path: a known extension and a writable folder."""
+    import os
+    from pathlib import Path
+
+    path = Path(text)
+    if path.suffix.lower() not in suffixes:
+        raise UsageError(f"--out {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise UsageError(f"--out {text}: folder {folder} does not exist")
+    if not os.access(folder, os.W_OK):
+        raise UsageError(f"--out {text}: folder {folder} is not writable")
+    return path
+
+
+def cmd_export(args) -> int:
+    """Bake the simulated motion into a glTF 2.0 file."""
+    import numpy as np
+    from tqdm import tqdm
+
+    from treeanim import export, scripted
+
+    out = output_path(args.out, (".glb", ".gltf"))
+    tree, sim = make_simulation(args)
+    skel = export.skeleton(tree)
+    fade = int(round(args.loop * args.fps))
+    n = int(round(args.seconds * args.fps))
+    if n < 2:
+        raise UsageError(f"--seconds {args.seconds:g} at --fps {args.fps:g} gives fewer than 2 frames")
+    if fade >= n:
+        raise UsageError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
+    keys = np.empty((n + fade, skel.count, 4), np.float32)
+    bar = tqdm(total=n + fade, desc=f"baking {tree.name}", unit="frame", disable=args.quiet, leave=False)
+    for k in scripted.frames(sim, (n + fade) / args.fps, args.fps, args.pull):
+        keys[k] = export.local_rotations(skel, sim.rotations)
+        bar.update()
+    bar.close()
+    doc, data = export.build_gltf(tree, export.crossfade_loop(keys, fade), args.fps, season=args.season,
+                                  present=sim.present)
+    files = export.write_gltf(out, doc, data)
+    size = sum(f.stat().st_size for f in files)
+    print(f"wrote {', '.join(map(str, files))}: {skel.count} joints, {n} frames at {args.fps:g} fps "
+          f"({n / args.fps:.2f} s), {size / 1e6:.1f} MB")
+    return 0
+
+
 def load_any(name_or_path: str):
     """A preset by name, or a preset TOML file by path."""
     import treeanim as ta
@@ -95,6 +216,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
     p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
     p.set_defaults(func=cmd_info)
+
+    p = sub.add_parser("export", help="bake the animation into a glTF 2.0 file (.glb or .gltf)",
+                       description="Simulate and bake the motion into a glTF 2.0 file: the mesh, a skin with one "
+                       "joint per segment and rotation keys at --fps. Opens in Blender, three.js and game engines.")
+    add_scene_options(p)
+    p.add_argument("--out", required=True, help="output file: tree.glb, or tree.gltf (+ tree.bin)")
+    p.add_argument("--loop", type=_non_negative, default=0.0, metavar="SECONDS",
+                   help="make the clip loop by cross-fading this many seconds of its end into its start (default 0)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_export)
 
     p = sub.add_parser("list", help="list the shipped presets", description="List the shipped presets.")
     p.set_defaults(func=lambda args: print("\n".join(__import__("treeanim").list_presets())) or 0)

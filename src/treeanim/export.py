@@ -1,0 +1,309 @@
+"""Bake a simulation into a glTF 2.0 file (.glb or .gltf + .bin) for Blender, three.js, engines.
+
+The skeleton has one joint per segment: a joint sits on every node that starts a segment
+(an object's tip node moves rigidly with its last segment, so it shares that joint). A joint's
+parent is the previous segment's joint, or for an object's base the joint that carries the
+parent's attach node; every object root hangs under one root joint at the origin. Because the
+simulation keeps segment lengths exactly and children sit exactly on their parents' nodes,
+each joint's translation relative to its parent is constant: the animation holds rotations
+only, one float32 quaternion key per joint and frame, sharing one time accessor.
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pygltflib as gl
+
+from .model.tree import Tree
+from .render.mesh import MATERIAL_BARK, MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh, build_mesh
+
+# Base colours (linear RGB) by material; leaves turn through autumn with the season.
+_BARK = (0.23, 0.16, 0.11)
+_PETIOLE = (0.30, 0.42, 0.12)
+_LEAF_SUMMER = (0.13, 0.38, 0.07)
+_LEAF_AUTUMN = (0.75, 0.32, 0.05)
+_LEAF_WINTER = (0.45, 0.20, 0.06)
+_BLADE = (0.20, 0.45, 0.10)
+
+
+@dataclass(frozen=True)
+class Skeleton:
+    """Joints of a tree: one per segment-starting node, plus a root joint 0 at the origin.
+
+    Attributes
+    ----------
+    joint_node : (J,) int
+        Node of each joint (-1 for the root joint).
+    joint_parent : (J,) int
+        Parent joint (-1 for the root joint).
+    node_joint : (N,) int
+        The joint each node moves with (a tip node: its last segment's joint).
+    """
+
+    joint_node: np.ndarray
+    joint_parent: np.ndarray
+    node_joint: np.ndarray
+
+    @property
+    def count(self) -> int:
+        """Number of joints, the root included."""
+        return len(self.joint_node)
+
+
+def skeleton(tree: Tree) -> Skeleton:
+    """The joint hierarchy of ``tree`` (see the module docstring)."""
+    N = tree.n_nodes
+    tip = np.zeros(N, bool)
+    tip[tree.object_start + tree.object_count - 1] = True
+    nodes = np.flatnonzero(~tip)
+    node_joint = np.zeros(N, np.int64)
+    node_joint[nodes] = np.arange(1, len(nodes) + 1)
+    node_joint[tip] = node_joint[np.flatnonzero(tip) - 1]
+    parent_node = nodes - 1  # the previous node of the same object...
+    is_base = tree.node_index[nodes] == 0
+    obj = tree.node_object[nodes[is_base]]
+    parent_node[is_base] = tree.attach_node[obj]  # ...or the parent's attach node (-1 for roots)
+    joint_parent = np.where(parent_node >= 0, node_joint[np.maximum(parent_node, 0)], 0)
+    return Skeleton(
+        joint_node=np.concatenate([[-1], nodes]),
+        joint_parent=np.concatenate([[-1], joint_parent]),
+        node_joint=node_joint,
+    )
+
+
+# ---------------------------------------------------------------------------- rotations
+def quaternions(R: np.ndarray) -> np.ndarray:
+    """Unit quaternions (x, y, z, w) of rotation matrices (..., 3, 3), w >= 0."""
+    R = np.asarray(R, float)
+    m00, m11, m22 = R[..., 0, 0], R[..., 1, 1], R[..., 2, 2]
+    q = np.stack(
+        [
+            np.sqrt(np.maximum(0.0, 1 + m00 - m11 - m22)) / 2,
+            np.sqrt(np.maximum(0.0, 1 - m00 + m11 - m22)) / 2,
+            np.sqrt(np.maximum(0.0, 1 - m00 - m11 + m22)) / 2,
+            np.sqrt(np.maximum(0.0, 1 + m00 + m11 + m22)) / 2,
+        ],
+        axis=-1,
+    )
+    # Signs of x, y, z from the antisymmetric part (w taken >= 0).
+    q[..., 0] = np.copysign(q[..., 0], R[..., 2, 1] - R[..., 1, 2])
+    q[..., 1] = np.copysign(q[..., 1], R[..., 0, 2] - R[..., 2, 0])
+    q[..., 2] = np.copysign(q[..., 2], R[..., 1, 0] - R[..., 0, 1])
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
+def local_rotations(skel: Skeleton, rotations: np.ndarray) -> np.ndarray:
+    """(J, 4) quaternions of each joint's rotation relative to its parent joint.
+
+    ``rotations`` (N, 3, 3) are world rotations relative to rest; at rest every joint's frame
+    is axis-aligned, so a joint's local rotation is R_parent^T R_joint.
+    """
+    world = np.concatenate([np.eye(3)[None], rotations[skel.joint_node[1:]]])
+    parent = world[np.maximum(skel.joint_parent, 0)]
+    local = np.einsum("jki,jkl->jil", parent, world)
+    local[0] = np.eye(3)
+    return quaternions(local)
+
+
+def crossfade_loop(keys: np.ndarray, fade: int) -> np.ndarray:
+    """Make keys (F + fade, J, 4) loop: the first ``fade`` frames blend from the frames after
+    the end into the start, so the last frame runs smoothly on into the first. Returns (F, J, 4)."""
+    if fade <= 0:
+        return keys
+    out = keys[:-fade].copy()
+    tail = keys[-fade:]
+    a = (np.arange(fade) / fade)[:, None, None]
+    head = out[:fade]
+    tail = np.where(np.sum(tail * head, axis=-1, keepdims=True) < 0, -tail, tail)
+    mix = (1 - a) * tail + a * head  # normalised lerp between matching hemispheres
+    out[:fade] = mix / np.linalg.norm(mix, axis=-1, keepdims=True)
+    return out
+
+
+# ---------------------------------------------------------------------------- mesh
+def vertex_colours(tree: Tree, mesh: TreeMesh, season: float) -> np.ndarray:
+    """(V, 4) float linear RGBA per vertex: bark, petiole, lamina (season-tinted), blade."""
+    mat = mesh.material
+    jitter = mesh.vertices["extra"][:, 1].astype(float)
+    key = mesh.vertices["extra"][:, 3].astype(float)
+    col = np.empty((len(mat), 3))
+    col[:] = _BARK
+    col[mat == MATERIAL_PETIOLE] = _PETIOLE
+    col[mat == MATERIAL_BLADE] = _BLADE
+    leaf = mat == MATERIAL_LAMINA
+    # Leaves turn in their drop order: the ones that fall first turn first.
+    turn = np.clip(season * 2.0 - key[leaf] * 0.8, 0.0, 1.0)[:, None]
+    late = np.clip(season * 2.0 - 1.0, 0.0, 1.0)
+    autumn = np.asarray(_LEAF_AUTUMN) * (1 - late) + np.asarray(_LEAF_WINTER) * late
+    col[leaf] = np.asarray(_LEAF_SUMMER) * (1 - turn) + autumn * turn
+    col *= (0.85 + 0.3 * jitter)[:, None]
+    return np.column_stack([np.clip(col, 0, 1), np.ones(len(col))])
+
+
+# ---------------------------------------------------------------------------- container
+class _Blob:
+    """The binary buffer, built as aligned buffer views and accessors."""
+
+    def __init__(self, doc: gl.GLTF2) -> None:
+        self.doc, self.parts, self.size = doc, [], 0
+
+    def view(self, data: bytes, target: int | None = None) -> int:
+        pad = (-self.size) % 4
+        if pad:
+            self.parts.append(b"\0" * pad)
+            self.size += pad
+        self.doc.bufferViews.append(gl.BufferView(buffer=0, byteOffset=self.size, byteLength=len(data), target=target))
+        self.parts.append(data)
+        self.size += len(data)
+        return len(self.doc.bufferViews) - 1
+
+    def accessor(self, array: np.ndarray, kind: str, component: int, target=None, normalized=None,
+                 minmax=False, view=None, offset=0, count=None) -> int:
+        if view is None:
+            view = self.view(np.ascontiguousarray(array).tobytes(), target)
+        acc = gl.Accessor(bufferView=view, byteOffset=offset or None, componentType=component,
+                          count=int(count if count is not None else len(array)), type=kind, normalized=normalized)
+        if minmax:
+            flat = np.asarray(array).reshape(len(array), -1)
+            acc.min = flat.min(axis=0).tolist()
+            acc.max = flat.max(axis=0).tolist()
+        self.doc.accessors.append(acc)
+        return len(self.doc.accessors) - 1
+
+    def bytes(self) -> bytes:
+        pad = (-self.size) % 4
+        return b"".join(self.parts) + b"\0" * pad
+
+
+def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, mesh: TreeMesh | None = None,
+               present: np.ndarray | None = None) -> tuple[gl.GLTF2, bytes]:
+    """The glTF document and its binary buffer.
+
+    Parameters
+    ----------
+    tree : Tree
+    keys : (F, J, 4) float
+        Local joint rotations per frame (from :func:`local_rotations`).
+    fps : float
+        Frames per second of ``keys``.
+    season : float
+        Leaf colour; leaves not ``present`` are left out of the mesh.
+    """
+    mesh = mesh if mesh is not None else build_mesh(tree)
+    skel = skeleton(tree)
+    doc = gl.GLTF2(asset=gl.Asset(version="2.0", generator="treeanim"))
+    blob = _Blob(doc)
+
+    # --- mesh: rest positions, normals, colours, joints and weights
+    keep_tris = np.ones(len(mesh.indices), bool)
+    if present is not None:
+        tri_obj = np.repeat(np.arange(tree.n_objects), mesh.object_triangles)
+        keep_tris = present[tri_obj]
+    used = np.zeros(mesh.vertex_count, bool)
+    used[mesh.indices[keep_tris].ravel()] = True
+    remap = np.cumsum(used) - 1
+    v = mesh.vertices[used]
+    ids = v["ids"]
+    pos = (tree.rest_positions[ids[:, 0]] + v["offset"]).astype(np.float32)
+    nrm = v["normal"].astype(np.float64)
+    nrm = (nrm / np.linalg.norm(nrm, axis=1, keepdims=True)).astype(np.float32)
+    col = np.round(vertex_colours(tree, mesh, season)[used] * 255).astype(np.uint8)
+    w2 = v["extra"][:, 0].astype(np.float64)
+    j1 = skel.node_joint[ids[:, 0]]
+    j2 = skel.node_joint[ids[:, 1]]
+    single = (w2 <= 0) | (j1 == j2)
+    joints = np.zeros((len(v), 4), np.uint16)
+    weights = np.zeros((len(v), 4), np.uint8)  # normalised: each vertex's weights sum to 255
+    joints[:, 0] = j1
+    joints[:, 1] = np.where(single, 0, j2)
+    weights[:, 1] = np.where(single, 0, np.round(w2 * 255)).astype(np.uint8)
+    weights[:, 0] = 255 - weights[:, 1]
+    index = remap[mesh.indices[keep_tris]].astype(np.uint32)
+
+    attrs = gl.Attributes(
+        POSITION=blob.accessor(pos, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER, minmax=True),
+        NORMAL=blob.accessor(nrm, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
+        COLOR_0=blob.accessor(col, gl.VEC4, gl.UNSIGNED_BYTE, gl.ARRAY_BUFFER, normalized=True),
+        JOINTS_0=blob.accessor(joints, gl.VEC4, gl.UNSIGNED_SHORT, gl.ARRAY_BUFFER),
+        WEIGHTS_0=blob.accessor(weights, gl.VEC4, gl.UNSIGNED_BYTE, gl.ARRAY_BUFFER, normalized=True),
+    )
+    indices = blob.accessor(index.ravel(), gl.SCALAR, gl.UNSIGNED_INT, gl.ELEMENT_ARRAY_BUFFER, minmax=True)
+    doc.materials.append(gl.Material(
+        name="tree", doubleSided=True,
+        pbrMetallicRoughness=gl.PbrMetallicRoughness(baseColorFactor=[1, 1, 1, 1], metallicFactor=0.0, roughnessFactor=0.8),
+    ))
+    doc.meshes.append(gl.Mesh(name=tree.name, primitives=[gl.Primitive(attributes=attrs, indices=indices, material=0)]))
+
+    # --- joints: constant local translations, rotations animated
+    J = skel.count
+    rest = np.concatenate([np.zeros((1, 3)), tree.rest_positions[skel.joint_node[1:]]])
+    local_t = rest - np.where(skel.joint_parent[:, None] >= 0, rest[np.maximum(skel.joint_parent, 0)], 0.0)
+    first = len(doc.nodes)
+    children: list[list[int]] = [[] for _ in range(J)]
+    for j, p in enumerate(skel.joint_parent[1:].tolist(), start=1):
+        children[p].append(first + j)
+    for j in range(J):
+        t = local_t[j].tolist()
+        doc.nodes.append(gl.Node(name=f"joint{j}", translation=t if any(t) else None, children=children[j] or None))
+    ibm = np.zeros((J, 4, 4), np.float32)
+    ibm[:] = np.eye(4, dtype=np.float32)
+    ibm[:, 3, :3] = -rest  # column-major: the translation column is stored last
+    doc.skins.append(gl.Skin(name="skeleton", joints=list(range(first, first + J)), skeleton=first,
+                             inverseBindMatrices=blob.accessor(ibm.reshape(J, 16), gl.MAT4, gl.FLOAT)))
+    doc.nodes.append(gl.Node(name=tree.name, mesh=0, skin=0))
+    doc.scenes.append(gl.Scene(name=tree.name, nodes=[first, len(doc.nodes) - 1]))
+    doc.scene = 0
+
+    # --- animation: one shared time accessor, one rotation accessor per joint in one view
+    F = len(keys)
+    times = (np.arange(F) / fps).astype(np.float32)
+    t_acc = blob.accessor(times, gl.SCALAR, gl.FLOAT, minmax=True)
+    per_joint = np.ascontiguousarray(np.transpose(keys.astype(np.float32), (1, 0, 2)))  # (J, F, 4)
+    view = blob.view(per_joint.tobytes())
+    anim = gl.Animation(name="wind")
+    for j in range(1, J):
+        out = blob.accessor(per_joint[j], gl.VEC4, gl.FLOAT, view=view, offset=j * F * 16, count=F)
+        anim.samplers.append(gl.AnimationSampler(input=t_acc, output=out, interpolation="LINEAR"))
+        anim.channels.append(gl.AnimationChannel(sampler=j - 1, target=gl.AnimationChannelTarget(node=first + j, path="rotation")))
+    doc.animations.append(anim)
+    data = blob.bytes()
+    doc.buffers.append(gl.Buffer(byteLength=len(data)))
+    return doc, data
+
+
+def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
+    """Write ``.glb`` (one file) or ``.gltf`` + ``.bin`` atomically; returns the files written."""
+    path = Path(path)
+    if path.suffix.lower() == ".glb":
+        doc.buffers[0].uri = None
+        doc.set_binary_blob(data)
+        payloads = [(path, b"".join(doc.save_to_bytes()))]
+    else:
+        bin_path = path.with_suffix(".bin")
+        doc.buffers[0].uri = bin_path.name
+        payloads = [(bin_path, data), (path, doc.to_json(separators=(",", ":")).encode())]
+    for target, payload in payloads:
+        fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".part")
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(payload)
+            os.replace(tmp, target)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+    return [p for p, _ in payloads]
+
+
+def read_glb_header(path: str | Path) -> tuple[int, int]:
+    """(version, length) from a .glb header, for quick checks."""
+    with open(path, "rb") as f:
+        magic, version, length = struct.unpack("<4sII", f.read(12))
+    if magic != b"glTF":
+        raise ValueError(f"{path}: not a binary glTF file")
+    return version, length

@@ -1,0 +1,94 @@
+"""Scripted runs for the offline commands: scheduled pulls and fixed-rate frames.
+
+``--pull OBJECT:FX,FY,FZ@T0-T1`` pulls object OBJECT's tip with a world force (newtons) from
+time T0 and lets go at T1; several pulls may be given.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+from typing import Iterator
+
+import numpy as np
+
+_PULL = re.compile(r"^\s*(\d+)\s*:\s*([^@]+?)\s*@\s*([^-]+?)\s*-\s*(.+?)\s*$")
+
+
+@dataclass(frozen=True)
+class Pull:
+    """A pull on ``obj``'s tip with world ``force`` (N) from ``start`` to ``end`` seconds."""
+
+    obj: int
+    force: tuple[float, float, float]
+    start: float
+    end: float
+
+
+def parse_vector(text: str, what: str) -> tuple[float, float, float]:
+    """``'FX,FY,FZ'`` as three finite floats; ValueError naming ``what`` otherwise."""
+    parts = text.split(",")
+    try:
+        values = tuple(float(p) for p in parts)
+    except ValueError:
+        values = ()
+    if len(values) != 3 or not all(math.isfinite(v) for v in values):
+        raise ValueError(f"{what}: expected three finite numbers X,Y,Z, got {text!r}")
+    return values  # type: ignore[return-value]
+
+
+def parse_pull(text: str) -> Pull:
+    """Parse ``OBJECT:FX,FY,FZ@T0-T1``.
+
+    Raises
+    ------
+    ValueError
+        With a message that repeats the expected form.
+    """
+    form = "expected OBJECT:FX,FY,FZ@T0-T1, e.g. 0:300,0,0@0.5-2"
+    m = _PULL.match(text)
+    if not m:
+        raise ValueError(f"--pull {text!r}: {form}")
+    force = parse_vector(m.group(2), f"--pull {text!r}")
+    try:
+        t0, t1 = float(m.group(3)), float(m.group(4))
+    except ValueError:
+        raise ValueError(f"--pull {text!r}: {form}") from None
+    if not (math.isfinite(t0) and math.isfinite(t1) and 0 <= t0 < t1):
+        raise ValueError(f"--pull {text!r}: expected times 0 <= T0 < T1")
+    return Pull(int(m.group(1)), force, t0, t1)
+
+
+def check_pulls(pulls: list[Pull], n_objects: int) -> None:
+    """Refuse a pull on an object the tree does not have."""
+    for p in pulls:
+        if not 0 <= p.obj < n_objects:
+            raise ValueError(f"--pull on object {p.obj}: the tree has objects 0 to {n_objects - 1}")
+
+
+def frames(sim, seconds: float, fps: float, pulls: list[Pull] = (), max_step: float = 1 / 60) -> Iterator[int]:
+    """Advance ``sim`` to each frame time k / fps for k = 0 .. round(seconds * fps) - 1.
+
+    Yields the frame index after the simulation reached that frame's time. Steps are at most
+    ``max_step`` long; pulls start and end on the step that reaches their times.
+    """
+    n = int(round(seconds * fps))
+    active: Pull | None = None
+    t = 0.0
+    for k in range(n):
+        target = k / fps
+        while t < target - 1e-12:
+            dt = min(max_step, target - t)
+            want = next((p for p in pulls if p.start <= t < p.end), None)
+            if want is not active:
+                if want is None:
+                    sim.release()
+                else:
+                    sim.pull(want.obj, np.asarray(want.force, float))
+                active = want
+            sim.step(dt)
+            t += dt
+        yield k
+    if active is not None:
+        sim.release()

@@ -1,0 +1,77 @@
+"""Read a baked glTF back, independently of the exporter: accessors, hierarchy, joint poses."""
+
+from pathlib import Path
+
+import numpy as np
+import pygltflib as gl
+
+_COMPONENTS = {gl.FLOAT: np.float32, gl.UNSIGNED_SHORT: np.uint16, gl.UNSIGNED_BYTE: np.uint8,
+               gl.UNSIGNED_INT: np.uint32, gl.SHORT: np.int16, gl.BYTE: np.int8}
+_WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
+
+
+def load(path):
+    path = Path(path)
+    doc = gl.GLTF2().load(str(path))
+    if path.suffix == ".glb":
+        blob = doc.binary_blob()
+    else:
+        blob = (path.parent / doc.buffers[0].uri).read_bytes()
+    return doc, blob
+
+
+def accessor(doc, blob, index):
+    acc = doc.accessors[index]
+    view = doc.bufferViews[acc.bufferView]
+    dtype = np.dtype(_COMPONENTS[acc.componentType])
+    width = _WIDTH[acc.type]
+    start = (view.byteOffset or 0) + (acc.byteOffset or 0)
+    a = np.frombuffer(blob, dtype, count=acc.count * width, offset=start).reshape(acc.count, width)
+    if acc.normalized:
+        a = a.astype(np.float64) / np.iinfo(dtype).max
+    return a
+
+
+def quat_to_matrix(q):
+    x, y, z, w = np.moveaxis(np.asarray(q, float), -1, 0)
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)], -1),
+        np.stack([2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)], -1),
+        np.stack([2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)], -1),
+    ], -2)
+
+
+def joint_world_positions(doc, blob, frame):
+    """World position of every skin joint at key ``frame``, composed down the node hierarchy."""
+    skin = doc.skins[0]
+    anim = doc.animations[0]
+    rot = {}
+    for ch in anim.channels:
+        assert ch.target.path == "rotation"
+        rot[ch.target.node] = accessor(doc, blob, anim.samplers[ch.sampler].output)[frame]
+    parent = {}
+    for i, node in enumerate(doc.nodes):
+        for c in node.children or []:
+            parent[c] = i
+    world_R, world_t = {}, {}
+
+    def pose(i):
+        if i in world_t:
+            return
+        t = np.asarray(doc.nodes[i].translation or [0.0, 0.0, 0.0], float)
+        q = rot.get(i, doc.nodes[i].rotation or [0.0, 0.0, 0.0, 1.0])
+        R = quat_to_matrix(np.asarray(q, float) / np.linalg.norm(q))
+        if i in parent:
+            pose(parent[i])
+            p = parent[i]
+            world_t[i] = world_t[p] + world_R[p] @ t
+            world_R[i] = world_R[p] @ R
+        else:
+            world_t[i], world_R[i] = t, R
+
+    import sys
+
+    sys.setrecursionlimit(100000)
+    for j in skin.joints:
+        pose(j)
+    return np.array([world_t[j] for j in skin.joints])

@@ -1,0 +1,136 @@
+"""glTF export: the Khronos validator accepts the files, and they play back the simulation."""
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import treeanim as ta
+from gltf_readback import accessor, joint_world_positions, load
+from treeanim import scripted
+from treeanim.export import skeleton
+
+ROOT = Path(__file__).resolve().parents[1]
+NODE_MODULES = Path(os.environ.get("TREEANIM_NODE_MODULES", ROOT / ".venv" / "node" / "node_modules"))
+
+
+def validate(path):
+    """Issues reported by the Khronos glTF Validator (installed by scripts/test with npm)."""
+    assert (NODE_MODULES / "gltf-validator").is_dir(), f"gltf-validator is not installed in {NODE_MODULES}: run scripts/test"
+    res = subprocess.run(["node", str(ROOT / "tests" / "gltf_validate.js"), str(path)], capture_output=True, text=True,
+                         env=dict(os.environ, NODE_PATH=str(NODE_MODULES)), timeout=600)
+    assert res.returncode == 0, res.stderr
+    return json.loads(res.stdout)
+
+
+def export(*args):
+    res = subprocess.run([sys.executable, "-m", "treeanim", "export", *args, "--quiet"], capture_output=True, text=True,
+                         timeout=900)
+    return res
+
+
+def simulate(preset, seconds, fps, wind, pulls=(), season=0.0):
+    """The node positions the exporter should have baked, frame by frame."""
+    tree = ta.load_preset(preset)
+    sim = ta.Simulation(tree, wind=ta.WindField(speed=wind) if wind else None, season=season)
+    return tree, [sim.positions.copy() for _ in scripted.frames(sim, seconds, fps, [scripted.parse_pull(p) for p in pulls])]
+
+
+CASES = [
+    # preset, file, seconds, fps, wind, pulls
+    ("small_cherry", "small.glb", 2.0, 15, 8.0, ["3:0,0,150@0.2-0.8"]),
+    ("large_cherry", "large.gltf", 0.5, 10, 12.0, []),
+    ("grassland", "grass.glb", 1.0, 10, 10.0, []),
+]
+
+
+@pytest.mark.parametrize("preset,name,seconds,fps,wind,pulls", CASES, ids=[c[0] for c in CASES])
+def test_export_validates_and_plays_back(tmp_path, preset, name, seconds, fps, wind, pulls):
+    out = tmp_path / name
+    pull_args = [a for p in pulls for a in ("--pull", p)]
+    res = export(preset, "--seconds", str(seconds), "--fps", str(fps), "--wind", str(wind), *pull_args, "--out", str(out))
+    assert res.returncode == 0, res.stderr
+    report = validate(out)
+    assert report["numErrors"] == 0, report["messages"][:5]
+
+    doc, blob = load(out)
+    tree, frames = simulate(preset, seconds, fps, wind, pulls)
+    skel = skeleton(tree)
+    n = int(round(seconds * fps))
+    assert len(doc.skins[0].joints) == skel.count
+    times = accessor(doc, blob, doc.animations[0].samplers[0].input)[:, 0]
+    assert len(times) == n == len(frames)
+    assert times[-1] == pytest.approx((n - 1) / fps)
+    assert len(doc.animations[0].channels) == skel.count - 1
+    for k in (n // 2, n - 1):
+        baked = joint_world_positions(doc, blob, k)[1:]
+        truth = frames[k][skel.joint_node[1:]]
+        assert np.max(np.linalg.norm(baked - truth, axis=1)) < 1e-3, f"frame {k} joints off by more than 1 mm"
+    # The tree really moves in the file: the wind displaced joints by centimetres at least.
+    assert np.max(np.linalg.norm(frames[-1] - tree.rest_positions, axis=1)) > 0.01
+
+
+def test_export_mesh_matches_tree(tmp_path):
+    out = tmp_path / "cherry.glb"
+    assert export("small_cherry", "--seconds", "0.2", "--fps", "10", "--out", str(out)).returncode == 0
+    doc, blob = load(out)
+    tree = ta.load_preset("small_cherry")
+    prim = doc.meshes[0].primitives[0]
+    assert doc.accessors[prim.indices].count == 3 * tree.stats()["triangles"]
+    pos = accessor(doc, blob, prim.attributes.POSITION)
+    lo, hi = tree.rest_positions.min(axis=0), tree.rest_positions.max(axis=0)
+    assert np.all(pos.min(axis=0) > lo - 0.2) and np.all(pos.max(axis=0) < hi + 0.2)
+    w = accessor(doc, blob, prim.attributes.WEIGHTS_0)
+    assert np.allclose(w.sum(axis=1), 1.0, atol=1e-6)
+
+
+def test_winter_export_drops_leaves(tmp_path):
+    summer, winter = tmp_path / "s.glb", tmp_path / "w.glb"
+    for path, season in ((summer, "0"), (winter, "1")):
+        assert export("large_cherry", "--seconds", "0.2", "--fps", "5", "--season", season, "--out", str(path)).returncode == 0
+    tris = []
+    for path in (summer, winter):
+        doc, _ = load(path)
+        tris.append(doc.accessors[doc.meshes[0].primitives[0].indices].count // 3)
+    tree = ta.load_preset("large_cherry")
+    assert tris == [tree.stats(0.0)["triangles"], tree.stats(1.0)["triangles"]]
+    assert validate(winter)["numErrors"] == 0
+
+
+def test_loop_cross_fades_end_into_start(tmp_path):
+    looped, plain = tmp_path / "loop.glb", tmp_path / "plain.glb"
+    common = ["small_cherry", "--seconds", "3", "--fps", "20", "--wind", "12"]
+    assert export(*common, "--loop", "1", "--out", str(looped)).returncode == 0
+    assert export(*common, "--out", str(plain)).returncode == 0
+
+    def wrap_jump(path):
+        doc, blob = load(path)
+        first, last = joint_world_positions(doc, blob, 0), joint_world_positions(doc, blob, 59)
+        before = joint_world_positions(doc, blob, 58)
+        return np.abs(first - last).max(), np.abs(last - before).max()
+
+    loop_jump, loop_step = wrap_jump(looped)
+    plain_jump, _ = wrap_jump(plain)
+    assert loop_jump < 2.5 * loop_step, "the looped clip's end runs on into its start like one more frame"
+    assert plain_jump > 2 * loop_jump
+    assert validate(looped)["numErrors"] == 0
+
+
+@pytest.mark.parametrize("args,words", [
+    (["--out", "tree.obj"], "unknown extension"),
+    (["--out", "/nonexistent/dir/tree.glb"], "does not exist"),
+    (["--out", "x.glb", "--pull", "99999:1,0,0@0-1"], "objects 0 to"),
+    (["--out", "x.glb", "--seconds", "-1"], "positive"),
+    (["--out", "x.glb", "--fps", "0"], "positive"),
+    (["--out", "x.glb", "--loop", "9"], "shorter"),
+])
+def test_export_bad_input(tmp_path, args, words):
+    res = subprocess.run([sys.executable, "-m", "treeanim", "export", "small_cherry", *args], capture_output=True,
+                         text=True, cwd=tmp_path, timeout=120)
+    assert res.returncode == 2
+    assert "Traceback" not in res.stderr and words in res.stderr
+    assert not list(tmp_path.iterdir()), "no file is left behind"
