@@ -47,9 +47,9 @@ def scene(offscreen, tree):
 
 
 def background(off, r, cam, season=0.0):
-    r.update(*rest(r.tree), present=np.zeros(r.tree.n_objects, bool))
+    off.update(*rest(r.tree), present=np.zeros(r.tree.n_objects, bool))
     img = off.render(cam, season=season)
-    r.update(*rest(r.tree))
+    off.update(*rest(r.tree))
     return img
 
 
@@ -94,7 +94,7 @@ def test_pose_moves_pixels_and_matches_a_rotated_tree(offscreen):
     bg = background(offscreen, r, cam)
     R = rot((0, 0, 1), -0.35)  # lean towards +x (to the right on screen)
     P, I = rest(tree)
-    r.update(P @ R.T, np.broadcast_to(R, I.shape))
+    offscreen.update(P @ R.T, np.broadcast_to(R, I.shape))
     bent = offscreen.render(cam)
     m_rest, m_bent = changed(rest_img, bg), changed(bent, bg)
     assert (m_rest ^ m_bent).sum() > 0.2 * m_rest.sum()
@@ -102,15 +102,17 @@ def test_pose_moves_pixels_and_matches_a_rotated_tree(offscreen):
 
     # The same tree built rotated, drawn at rest: same silhouette.
     rotated = dataclasses.replace(tree, rest_positions=P @ R.T, rest_w=tree.rest_w @ R.T)
-    r2 = Renderer(offscreen.ctx, rotated)
+    with offscreen.ctx:
+        r2 = Renderer(offscreen.ctx, rotated)
     ref = offscreen.render(cam, renderer=r2)
-    r2.release()
+    with offscreen.ctx:
+        r2.release()
     m_ref = changed(ref, bg)
     iou = (m_ref & m_bent).sum() / (m_ref | m_bent).sum()
     assert iou > 0.9, iou
 
     # A pure displacement moves pixels too.
-    r.update(P + [0.0, 0.4, 0.0], I)
+    offscreen.update(P + [0.0, 0.4, 0.0], I)
     up = offscreen.render(cam)
     assert np.nonzero(changed(up, bg))[0].mean() < np.nonzero(m_rest)[0].mean() - 3
 
@@ -130,7 +132,7 @@ def test_inner_joint_bend_keeps_the_tube_closed(offscreen):
     pos[j + 1:] = P[j] + (P[j + 1:] - P[j]) @ R.T
     rots = np.array(I)
     rots[j:] = R
-    r.update(pos, rots)
+    offscreen.update(pos, rots)
     img = offscreen.render(cam)
     bg = background(offscreen, r, cam)
     mask = changed(img, bg)
@@ -144,9 +146,9 @@ def test_inner_joint_bend_keeps_the_tube_closed(offscreen):
 # ------------------------------------------------------------------------------ leaves, season
 def bare(off, r, cam, season=0.0):
     """The tree with every leaf hidden."""
-    r.update(*rest(r.tree), present=r.tree.kind != "leaf")
+    off.update(*rest(r.tree), present=r.tree.kind != "leaf")
     img = off.render(cam, season=season)
-    r.update(*rest(r.tree))
+    off.update(*rest(r.tree))
     return img
 
 
@@ -160,17 +162,17 @@ def test_hidden_leaves_show_far_fewer_leaf_pixels(scene):
     tree = r.tree
     bg = background(off, r, cam)
     no_leaves = bare(off, r, cam)
-    r.update(*rest(tree))  # present from the season
+    off.update(*rest(tree))  # present from the season
     summer = leaf_pixels(off.render(cam, season=0.0), no_leaves)
-    r.update(*rest(tree), present=tree.leaves_present(1.0))
+    off.update(*rest(tree), present=tree.leaves_present(1.0))
     winter_mask = leaf_pixels(off.render(cam, season=0.0), no_leaves)
-    r.update(*rest(tree))
+    off.update(*rest(tree))
     winter_season = leaf_pixels(off.render(cam, season=1.0), bare(off, r, cam, season=1.0))
     assert len(summer) > 200
     assert len(winter_mask) < 0.25 * len(summer), (len(winter_mask), len(summer))
     assert len(winter_season) < 0.25 * len(summer), (len(winter_season), len(summer))
     # Hiding everything leaves only the background.
-    r.update(*rest(tree), present=np.zeros(tree.n_objects, bool))
+    off.update(*rest(tree), present=np.zeros(tree.n_objects, bool))
     assert not changed(off.render(cam), bg).any()
 
 
@@ -181,7 +183,7 @@ def test_season_turns_leaves_from_green_to_autumn_colours(scene):
     ratios = []
     for season in (0.0, 0.35, 0.7):
         no_leaves = bare(off, r, cam, season)
-        r.update(*rest(tree), present=everything)
+        off.update(*rest(tree), present=everything)
         px = leaf_pixels(off.render(cam, season=season), no_leaves)
         assert len(px) > 200
         ratios.append(float(np.mean(px[:, 0] / np.maximum(px[:, 1], 1.0))))
@@ -203,9 +205,9 @@ def test_blades_render(offscreen):
 def test_highlight_tints_the_object(scene):
     off, r, cam = scene
     base = off.render(cam)
-    r.update(*rest(r.tree), highlight=0)  # the trunk
+    off.update(*rest(r.tree), highlight=0)  # the trunk
     lit = off.render(cam)
-    r.update(*rest(r.tree))
+    off.update(*rest(r.tree))
     diff = changed(lit, base)
     assert diff.sum() > 30
     px = lit[diff].astype(float)
@@ -247,9 +249,9 @@ def test_frames_overlay_follows_the_pose(scene):
     P, I = rest(r.tree)
     a = off.render(cam, overlays=[ov])
     R = rot((0, 0, 1), 0.4)
-    r.update(P @ R.T, np.broadcast_to(R, I.shape))
+    off.update(P @ R.T, np.broadcast_to(R, I.shape))
     b = off.render(cam, overlays=[ov])
-    r.update(P, I)
+    off.update(P, I)
     plain_b = off.render(cam)
     assert changed(a, b).sum() > 100
     assert changed(b, plain_b).sum() > 40
@@ -273,17 +275,19 @@ def test_zero_viewport_draw_is_a_no_op(offscreen, tree):
     r = offscreen.load(tree)
     cam = framed_camera(r)
     first = offscreen.render(cam)
-    offscreen.fbo.use()
-    r.draw(cam, 0, 0)
-    r.draw(cam, 0, 17)
-    offscreen.ctx.copy_framebuffer(offscreen.resolve_fbo, offscreen.fbo)
-    raw = np.frombuffer(offscreen.resolve_fbo.read(components=3, alignment=1), np.uint8)
+    with offscreen.ctx:
+        offscreen.fbo.use()
+        r.draw(cam, 0, 0)
+        r.draw(cam, 0, 17)
+        offscreen.ctx.copy_framebuffer(offscreen.resolve_fbo, offscreen.fbo)
+        raw = np.frombuffer(offscreen.resolve_fbo.read(components=3, alignment=1), np.uint8)
     assert np.array_equal(raw.reshape(H, W, 3)[::-1], first)
 
 
 def test_renderer_on_a_plain_context_and_release(tree):
     ctx = create_egl_context()
     try:
+        ctx.__enter__()
         r = Renderer(ctx, tree)
         fbo = ctx.simple_framebuffer((W, H))
         cam = framed_camera(r)
@@ -297,6 +301,7 @@ def test_renderer_on_a_plain_context_and_release(tree):
             r.draw(cam, W, H)
         assert ctx.error == "GL_NO_ERROR"
     finally:
+        ctx.__exit__(None, None, None)
         ctx.release()
 
 
@@ -322,4 +327,5 @@ def test_renderer_refuses_old_gl(tree):
 def test_no_gl_errors_after_a_frame(scene):
     off, r, cam = scene
     off.render(cam, overlays=list(_overlays(r.tree, r).values()))
-    assert off.ctx.error == "GL_NO_ERROR"
+    with off.ctx:
+        assert off.ctx.error == "GL_NO_ERROR"
