@@ -22,7 +22,7 @@ def write(tmp_path, text, name="bad.toml"):
 CASES = [
     ("not TOML", lambda s: s.replace("[trunk]", "[trunk"), None, "not valid TOML"),
     ("missing key", lambda s: s.replace('type = "tree"\n', ""), "type", "missing"),
-    ("missing trunk length", lambda s: s.replace("length = 1.0\n", "", 1), "trunk.length", "missing"),
+    ("missing trunk length", lambda s: s.replace("[trunk]\nlength = 0.8\n", "[trunk]\n"), "trunk.length", "missing"),
     ("wrong type", lambda s: s.replace("segments = 2", 'segments = "two"', 1), "trunk.segments", "integer"),
     ("negative count", lambda s: s.replace("count = 816", "count = -816"), "leaves.count", "[0,"),
     ("NaN", lambda s: s.replace("diameter = 0.14", "diameter = nan"), "trunk.diameter", "number"),
