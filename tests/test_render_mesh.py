@@ -42,9 +42,13 @@ def test_triangle_counts_equal_tree_counts(any_tree):
     assert np.array_equal(mesh.object_triangles, any_tree.triangles_per_object())
     assert mesh.triangle_count == int(any_tree.triangles_per_object().sum()) == len(mesh.indices)
     assert mesh.indices.dtype == np.uint32 and mesh.indices.max() < mesh.vertex_count
-    # Every triangle belongs to one object: its three vertices share the object index.
+    # Every triangle belongs to one object (its three vertices share the object index), and
+    # triangles come grouped by object, in object order.
     obj = mesh.object[mesh.indices]
     assert np.all(obj == obj[:, :1])
+    expect = np.repeat(np.arange(any_tree.n_objects), mesh.object_triangles)
+    assert np.array_equal(obj[:, 0], expect)
+    assert np.array_equal(mesh.object_triangle_start[1:], np.cumsum(mesh.object_triangles)[:-1])
 
 
 def test_per_kind_triangles_follow_the_papers_rule():

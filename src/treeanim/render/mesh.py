@@ -71,7 +71,9 @@ class TreeMesh:
     ----------
     vertices : (V,) structured array of :data:`VERTEX_DTYPE`
     indices : (T, 3) uint32
-        Triangles, counter-clockwise seen from the side the rest normal points to.
+        Triangles, counter-clockwise seen from the side the rest normal points to, grouped by
+        object in object order: object i's are rows ``object_triangle_start[i]`` to
+        ``object_triangle_start[i] + object_triangles[i]``.
     object_triangles : (M,) int
         Triangles of each object (equals ``tree.triangles_per_object()``).
     """
@@ -84,6 +86,11 @@ class TreeMesh:
     def triangle_count(self) -> int:
         """Total number of triangles."""
         return len(self.indices)
+
+    @property
+    def object_triangle_start(self) -> np.ndarray:
+        """(M,) int: first row of each object's triangles in :attr:`indices`."""
+        return np.concatenate([[0], np.cumsum(self.object_triangles)[:-1]]).astype(np.int64)
 
     @property
     def vertex_count(self) -> int:
@@ -381,4 +388,5 @@ def build_mesh(tree: Tree, seed: int | None = None) -> TreeMesh:
     tris = np.concatenate(parts.tris).astype(np.uint32) if parts.tris else np.zeros((0, 3), np.uint32)
     tri_obj = np.concatenate(parts.tri_obj) if parts.tri_obj else np.zeros(0, np.int64)
     verts["extra"][:, 2] = _ambient_occlusion(tree, verts)
-    return TreeMesh(verts, np.ascontiguousarray(tris), np.bincount(tri_obj, minlength=M))
+    order = np.argsort(tri_obj, kind="stable")  # group triangles by object
+    return TreeMesh(verts, np.ascontiguousarray(tris[order]), np.bincount(tri_obj, minlength=M))
