@@ -256,3 +256,26 @@ def test_pick_lamina_follows_pose_and_present_mask():
     shift = np.array([0.0, 0.0, 3.0])
     assert getattr(pick(tree, P + shift, R, o, d), "object", None) != leaf
     assert pick(tree, P + shift, R, o + shift, d).object == leaf
+
+
+# ------------------------------------------------------------------------------ small pieces
+def test_pull_trace_ring_buffer_keeps_the_newest_in_order():
+    from treeanim.render.overlays import PullTrace
+
+    tr = PullTrace(capacity=5)
+    assert tr.lines(small_tree()) is None
+    tr.push((0.0, 0.0, 0.0))
+    tr.extend(np.arange(1, 8)[:, None] * np.ones(3))
+    assert len(tr) == 5
+    assert np.array_equal(tr.points[:, 0], [3, 4, 5, 6, 7])
+    ls = tr.lines(small_tree())
+    assert len(ls.points) == 8 and np.all(np.diff(ls.colors[:, 3]) >= 0)  # fading with age
+    tr.clear()
+    assert len(tr) == 0
+
+
+def test_render_package_exports_lazily():
+    import treeanim.render as render
+
+    for name in render.__all__:
+        assert getattr(render, name) is not None

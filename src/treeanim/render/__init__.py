@@ -1,0 +1,41 @@
+"""Rendering core: skinned tree meshes, the moderngl renderer, camera, picking, overlays and
+headless (EGL) rendering. Shared by the viewer, the offline renderer and the glTF exporter.
+
+Names are imported lazily (``from treeanim.render import Renderer``), so importing one
+GL-free module (e.g. ``treeanim.render.mesh``) does not pull in the others.
+"""
+
+from importlib import import_module
+
+_EXPORTS = {
+    "TreeMesh": "mesh",
+    "build_mesh": "mesh",
+    "Renderer": "renderer",
+    "Scene": "renderer",
+    "OffscreenRenderer": "offscreen",
+    "create_egl_context": "offscreen",
+    "OrbitCamera": "camera",
+    "Picker": "picking",
+    "PickHit": "picking",
+    "pick": "picking",
+    "Overlay": "overlays",
+    "LineSet": "overlays",
+    "PullTrace": "overlays",
+    "LocalFrames": "overlays",
+    "WindSlices": "overlays",
+    "WindArrow": "overlays",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name):
+    if name in _EXPORTS:
+        value = getattr(import_module(f"{__name__}.{_EXPORTS[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(list(globals()) + __all__)

@@ -91,14 +91,15 @@ class PullTrace(Overlay):
 
     def push(self, point) -> None:
         """Append one point (3,)."""
-        self._buf[self._next] = point
-        self._next = (self._next + 1) % self.capacity
-        self._size = min(self._size + 1, self.capacity)
+        self.extend(np.reshape(point, (1, 3)))
 
     def extend(self, points) -> None:
         """Append points (K, 3) in order."""
-        for p in np.asarray(points, float).reshape(-1, 3)[-self.capacity:]:
-            self.push(p)
+        pts = np.asarray(points, float).reshape(-1, 3)[-self.capacity:]
+        k = len(pts)
+        self._buf[(self._next + np.arange(k)) % self.capacity] = pts
+        self._next = (self._next + k) % self.capacity
+        self._size = min(self._size + k, self.capacity)
 
     def clear(self) -> None:
         self._next = 0
