@@ -168,7 +168,7 @@ class Renderer:
         branch = tree.kind == "branch"
         trunk_foot = P[roots[0]] if len(roots) and branch.any() else 0.5 * (lo + hi)
         self.ground_centre = np.array([trunk_foot[0], 0.0, trunk_foot[2]])
-        self.earth_radius = float(7.0 * tree.node_diameter[roots[branch[tree.parent < 0]]].max()) \
+        self.earth_radius = float(5.0 * tree.node_diameter[roots[branch[tree.parent < 0]]].max()) \
             if branch.any() else 0.0
         leafy = tree.kind != "branch"
         pts = P[np.isin(tree.node_object, np.flatnonzero(leafy))] if leafy.any() else P
