@@ -168,8 +168,8 @@ class Renderer:
         branch = tree.kind == "branch"
         trunk_foot = P[roots[0]] if len(roots) and branch.any() else 0.5 * (lo + hi)
         self.ground_centre = np.array([trunk_foot[0], 0.0, trunk_foot[2]])
-        self.earth_radius = float(5.0 * tree.node_diameter[roots[branch[tree.parent < 0]]].max()) \
-            if branch.any() else 0.0
+        trunks = tree.object_start[(tree.parent < 0) & branch]
+        self.earth_radius = float(5.0 * tree.node_diameter[trunks].max()) if len(trunks) else 0.0
         leafy = tree.kind != "branch"
         pts = P[np.isin(tree.node_object, np.flatnonzero(leafy))] if leafy.any() else P
         self.crown_centre = pts.mean(axis=0)
@@ -222,7 +222,7 @@ class Renderer:
         present : (M,) bool or None
             Objects shown (``Simulation.present``); None shows the leaves present at the
             ``season`` passed to :meth:`draw` (``Tree.leaves_present``).
-        highlight : None, int, sequence of int or (M,) bool
+        highlight : None, int, sequence of int, or bool (scalar or (M,))
             Objects drawn highlighted (e.g. the grabbed one).
         """
         rows = self._node_rows
@@ -242,8 +242,8 @@ class Renderer:
         hl = np.zeros(M, bool)
         if highlight is not None:
             h = np.asarray(highlight)
-            if h.dtype == bool and h.shape == (M,):
-                hl = h
+            if h.dtype == bool:
+                hl = np.broadcast_to(h, (M,))
             elif h.size:
                 hl[h.astype(int).reshape(-1)] = True
         if not np.array_equal(hl, self._highlight):
