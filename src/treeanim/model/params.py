@@ -58,6 +58,12 @@ class PhysicsParams:
         Drag gain per kind (N·s/m³): load = gain × exposed area × wind velocity.
     wood_density, leaf_density : float
         kg/m³, for the base-excitation inertia (DESIGN §6 step 3).
+    lamina_thickness : float
+        Thickness of a leaf lamina (and of a grass blade) in metres, for its mass.
+    leaf_twist_c0 : float
+        c0 of Eq. 11 for leaves (1/(N·m)); ``twist_c0`` applies to branches and blades. A
+        leaf's twisting moment is some 10⁴ times smaller than a branch's, so one constant
+        cannot serve both.
     """
 
     summer: SeasonModes = field(default_factory=_default_season)
@@ -72,6 +78,8 @@ class PhysicsParams:
     wind_gain_blade: float = 1.0
     wood_density: float = 700.0
     leaf_density: float = 500.0
+    lamina_thickness: float = 3.0e-4
+    leaf_twist_c0: float = 200.0
 
     def modes(self, kind: str, season: float) -> ModeRange | None:
         """f and ζ ranges for ``kind``, linearly interpolated at ``season`` in [0, 1]."""

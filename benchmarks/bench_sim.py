@@ -1,0 +1,138 @@
+"""Simulation speed per preset: median milliseconds per step, wind on, one thread.
+
+A script, not a test::
+
+    python benchmarks/bench_sim.py [--steps 600] [--presets small_cherry large_cherry ...]
+
+For each preset it runs ``--warmup`` steps, then times ``--steps`` steps of 1/60 s with a
+5 m/s turbulent wind (``WindField``) and reports the median and 90th percentile of
+
+* ``step``: :meth:`Simulation.step` alone (wind sampling, loads, oscillators, bending, the
+  hierarchy's structural nodes);
+* ``step+pose``: the step plus reading ``positions`` and ``rotations`` (the full per-node pose
+  a renderer uploads every frame; built lazily on first access).
+
+Targets (issue #4): large_cherry <= 3 ms, grassland <= 2 ms, small_cherry <= 1 ms per step.
+Where a preset cannot be loaded (presets not installed) a synthetic tree of the same size is
+timed instead, and the row says so.
+"""
+
+from __future__ import annotations
+
+import os
+
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = "1"
+
+import argparse  # noqa: E402
+import platform  # noqa: E402
+import time  # noqa: E402
+
+import numpy as np  # noqa: E402
+
+PRESETS = ("small_cherry", "large_cherry", "tulip_poplar", "grassland")
+TARGETS_MS = {"small_cherry": 1.0, "large_cherry": 3.0, "grassland": 2.0}
+
+
+def synthetic(name: str):
+    """A tree of roughly the preset's size (Table 1), for when presets are unavailable."""
+    from treeanim.model.build import ObjectSpec, assemble
+
+    rng = np.random.default_rng(0)
+    sizes = {  # (levels of branching, children per branch, leaves per terminal branch)
+        "small_cherry": (5, 2, 14),
+        "large_cherry": (7, 3, 10),
+        "tulip_poplar": (3, 13, 6),
+    }
+    specs: list[ObjectSpec] = []
+    if name == "grassland":
+        for _ in range(5000):
+            base = np.array([rng.uniform(-5, 5), 0.0, rng.uniform(-5, 5)])
+            pts = base + np.outer(np.linspace(0, 0.4, 4), [0.05, 1.0, 0.02])
+            specs.append(ObjectSpec(pts, np.array([0.01, 0.008, 0.006, 0.002]), "blade", 1))
+        return assemble(specs, name="synthetic_grassland")
+    depth, children, leaves = sizes[name]
+
+    def branch(base, d, length, diam, level, parent, attach):
+        pts = base + np.outer(np.linspace(0, length, 3), d)
+        specs.append(ObjectSpec(pts, np.linspace(diam, diam * 0.7, 3), "branch", level, parent, attach))
+        me = len(specs) - 1
+        if level < depth:
+            for _ in range(children):
+                nd = d + rng.normal(scale=0.6, size=3)
+                nd /= np.linalg.norm(nd)
+                branch(pts[-1], nd, length * 0.7, diam * 0.6, level + 1, me, 2)
+        else:
+            for _ in range(leaves):
+                nd = rng.normal(size=3)
+                nd /= np.linalg.norm(nd)
+                pet = pts[1] + np.outer(np.linspace(0, 0.03, 4), nd)
+                specs.append(ObjectSpec(pet, np.full(4, 0.002), "leaf", level + 1, me, 1,
+                                        w=np.cross(nd, rng.normal(size=3)), lamina_length=0.1))
+
+    branch(np.zeros(3), np.array([0.0, 1.0, 0.0]), 1.5, 0.3, 1, -1, 0)
+    return assemble(specs, name=f"synthetic_{name}")
+
+
+def load(name: str):
+    try:
+        import treeanim
+
+        return treeanim.load_preset(name), False
+    except Exception:  # noqa: BLE001 - presets missing: time a synthetic tree instead
+        return synthetic(name), True
+
+
+def bench(tree, steps: int, warmup: int, speed: float, dt: float) -> dict:
+    from treeanim.physics.simulation import Simulation
+    from treeanim.physics.wind import WindField
+
+    sim = Simulation(tree, wind=WindField(speed=speed, seed=1))
+    for _ in range(warmup):
+        sim.step(dt)
+    t_step = np.empty(steps)
+    for k in range(steps):
+        t0 = time.perf_counter()
+        sim.step(dt)
+        t_step[k] = time.perf_counter() - t0
+    t_pose = np.empty(steps)
+    for k in range(steps):
+        t0 = time.perf_counter()
+        sim.step(dt)
+        sim.positions
+        sim.rotations
+        t_pose[k] = time.perf_counter() - t0
+    return {
+        "step": 1e3 * np.median(t_step),
+        "step_p90": 1e3 * np.percentile(t_step, 90),
+        "pose": 1e3 * np.median(t_pose),
+        "pose_p90": 1e3 * np.percentile(t_pose, 90),
+        "finite": bool(np.all(np.isfinite(sim.positions))),
+    }
+
+
+def main(argv=None) -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--presets", nargs="+", default=list(PRESETS))
+    ap.add_argument("--steps", type=int, default=600)
+    ap.add_argument("--warmup", type=int, default=60)
+    ap.add_argument("--speed", type=float, default=5.0, help="wind speed at the tree top (m/s)")
+    ap.add_argument("--dt", type=float, default=1 / 60)
+    args = ap.parse_args(argv)
+    print(f"# {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
+          f"numpy {np.__version__}, one thread, wind {args.speed} m/s, dt {args.dt:.4g} s, "
+          f"{args.steps} steps")
+    print(f"{'preset':<24}{'objects':>8}{'nodes':>8}{'step ms':>10}{'p90':>8}"
+          f"{'step+pose ms':>14}{'p90':>8}{'target':>8}")
+    for name in args.presets:
+        tree, synth = load(name)
+        r = bench(tree, args.steps, args.warmup, args.speed, args.dt)
+        label = name + (" (synthetic)" if synth else "")
+        target = TARGETS_MS.get(name)
+        print(f"{label:<24}{tree.n_objects:>8}{tree.n_nodes:>8}{r['step']:>10.2f}{r['step_p90']:>8.2f}"
+              f"{r['pose']:>14.2f}{r['pose_p90']:>8.2f}"
+              f"{(f'{target:.1f}' if target else '-'):>8}" + ("" if r["finite"] else "  NON-FINITE!"))
+
+
+if __name__ == "__main__":
+    main()

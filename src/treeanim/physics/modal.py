@@ -1,0 +1,173 @@
+"""Modal parameters of every object (Eqs. 20–22, DESIGN §4).
+
+Each object gets three modes (u, v, w) with a natural frequency f (Hz) and a damping ratio ζ:
+
+* f′ⱼ = dⱼ / hⱼ² (mean diameter over length squared) mapped linearly onto the kind's
+  [fmin, fmax] at the current season (Eq. 20), separately per kind;
+* ζⱼ from rⱼ = (descendant sub-branches) + (descendant leaves)/6 mapped linearly onto
+  [ζmin, ζmax] (Eq. 21);
+* f_u = f, f_v = f(1 + 0.1·noise), f_w = f(1 + 0.1·noise), likewise ζ (Eq. 22), noise uniform
+  in [−0.5, 0.5]; leaves scale ζ_w and ζ_v by the preset's ``leaf_zeta_w_scale`` and
+  ``leaf_zeta_v_scale``.
+
+A degenerate range (all f′ or all r of a kind equal, e.g. every leaf has r = 0) draws uniformly
+in [min, max]. All random numbers are drawn once per seed (:class:`ModalDraws`), so changing the
+season or the ranges re-maps the same draws smoothly.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.params import PhysicsParams
+from ..model.tree import KINDS, Tree
+
+#: Columns of the (M, 3) mode arrays.
+MODE_AXES = ("u", "v", "w")
+
+
+@dataclass
+class ModalParameters:
+    """Natural frequencies and damping ratios of every object's three modes.
+
+    Attributes
+    ----------
+    f : (M, 3) float
+        Natural frequencies in Hz, columns (u, v, w). Writable: the simulation reads the array
+        at every step (and checks it: finite and > 0).
+    zeta : (M, 3) float
+        Damping ratios, columns (u, v, w). Writable (finite and >= 0).
+
+    Notes
+    -----
+    Mode u is driven by the load along w and moves the object along w; mode w is driven by the
+    load along u and moves it along u; mode v (driven by the lever-arm moment r·L_w) twists it
+    about v (Eqs. 2–6).
+    """
+
+    f: np.ndarray
+    zeta: np.ndarray
+
+
+@dataclass(frozen=True)
+class ModalDraws:
+    """The random numbers of Eqs. 20–22, drawn once per seed.
+
+    Attributes
+    ----------
+    f_uniform, zeta_uniform : (M,) float in [0, 1)
+        Positions inside [fmin, fmax] / [ζmin, ζmax] used where a kind's range is degenerate.
+    noise : (M, 4) float in [−0.5, 0.5)
+        Eq. 22's noise() for f_v, f_w, ζ_v, ζ_w.
+    """
+
+    f_uniform: np.ndarray
+    zeta_uniform: np.ndarray
+    noise: np.ndarray
+
+    @classmethod
+    def draw(cls, n_objects: int, seed: int) -> "ModalDraws":
+        """Draw the numbers for ``n_objects`` objects from ``seed`` (deterministic)."""
+        rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, 0x6D6F646573])  # stream "modes"
+        return cls(
+            f_uniform=rng.random(n_objects),
+            zeta_uniform=rng.random(n_objects),
+            noise=rng.random((n_objects, 4)) - 0.5,
+        )
+
+
+def object_lengths(tree: Tree) -> np.ndarray:
+    """(M,) float: rest length of each object (sum of its segment lengths), metres."""
+    seg = np.linalg.norm(np.diff(tree.rest_positions, axis=0), axis=1)
+    seg = np.append(seg, 0.0)
+    tips = tree.object_start + tree.object_count - 1
+    seg[tips] = 0.0  # differences across object boundaries are not segments
+    return np.add.reduceat(seg, tree.object_start)
+
+
+def mean_diameters(tree: Tree) -> np.ndarray:
+    """(M,) float: mean of each object's node diameters, metres."""
+    return np.add.reduceat(tree.node_diameter, tree.object_start) / tree.object_count
+
+
+def descendant_counts(tree: Tree) -> tuple[np.ndarray, np.ndarray]:
+    """Descendant sub-branches and descendant leaves of every object (all generations).
+
+    Returns
+    -------
+    branches, leaves : (M,) int
+        Number of objects of kind 'branch' (resp. 'leaf') below each object in the hierarchy.
+    """
+    M = tree.n_objects
+    nb = np.zeros(M, np.int64)
+    nl = np.zeros(M, np.int64)
+    is_b = (tree.kind == "branch").astype(np.int64)
+    is_l = (tree.kind == "leaf").astype(np.int64)
+    # Children come after parents and levels are sorted: accumulate deepest level first.
+    for sl in reversed(tree.level_slices()):
+        idx = np.arange(sl.start, sl.stop)
+        idx = idx[tree.parent[idx] >= 0]
+        if len(idx) == 0:
+            continue
+        np.add.at(nb, tree.parent[idx], nb[idx] + is_b[idx])
+        np.add.at(nl, tree.parent[idx], nl[idx] + is_l[idx])
+    return nb, nl
+
+
+def _map_linear(x: np.ndarray, lo: float, hi: float, uniform: np.ndarray) -> np.ndarray:
+    """Map x linearly from [min x, max x] onto [lo, hi]; a degenerate x range uses ``uniform``."""
+    xmin, xmax = float(np.min(x)), float(np.max(x))
+    span = xmax - xmin
+    if not np.isfinite(span) or span <= 1e-12 * max(abs(xmax), abs(xmin), 1e-300):
+        return lo + uniform * (hi - lo)
+    return lo + (x - xmin) * ((hi - lo) / span)
+
+
+def derive_modes(tree: Tree, params: PhysicsParams, season: float, draws: ModalDraws) -> ModalParameters:
+    """Modal parameters of every object at ``season`` (Eqs. 20–22).
+
+    Parameters
+    ----------
+    tree : Tree
+        The tree.
+    params : PhysicsParams
+        Ranges per kind (summer and winter) and the leaf ζ scales.
+    season : float
+        0 (summer) .. 1 (winter); interpolates the ranges.
+    draws : ModalDraws
+        The seeded random numbers.
+
+    Returns
+    -------
+    ModalParameters
+        New (M, 3) arrays.
+
+    Raises
+    ------
+    ValueError
+        If a kind present in the tree has no range in ``params``.
+    """
+    M = tree.n_objects
+    fprime = mean_diameters(tree) / object_lengths(tree) ** 2  # Eq. 20
+    nb, nl = descendant_counts(tree)
+    r = nb + nl / 6.0  # Eq. 21
+    f = np.empty(M)
+    zeta = np.empty(M)
+    for kind in KINDS:
+        sel = np.flatnonzero(tree.kind == kind)
+        if len(sel) == 0:
+            continue
+        rng_ = params.modes(kind, season)
+        if rng_ is None:
+            raise ValueError(f"physics: no f/zeta range for kind {kind!r}, which the tree has")
+        f[sel] = _map_linear(fprime[sel], rng_.f[0], rng_.f[1], draws.f_uniform[sel])
+        zeta[sel] = _map_linear(r[sel], rng_.zeta[0], rng_.zeta[1], draws.zeta_uniform[sel])
+    n = draws.noise
+    F = np.stack([f, f * (1 + 0.1 * n[:, 0]), f * (1 + 0.1 * n[:, 1])], axis=1)  # Eq. 22
+    Z = np.stack([zeta, zeta * (1 + 0.1 * n[:, 2]), zeta * (1 + 0.1 * n[:, 3])], axis=1)
+    leaf = tree.kind == "leaf"
+    Z[leaf, 1] *= params.leaf_zeta_v_scale
+    Z[leaf, 2] *= params.leaf_zeta_w_scale
+    return ModalParameters(F, Z)

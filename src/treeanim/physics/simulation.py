@@ -1,0 +1,717 @@
+"""The whole-tree simulation (DESIGN §6): wind → loads → oscillators → bending → hierarchy."""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Iterable
+
+import numpy as np
+
+from ..model.params import PhysicsParams
+from ..model.tree import KINDS, Tree
+from .bending import BendingPlan
+from .hierarchy import CompositionPlan
+from .modal import ModalDraws, ModalParameters, derive_modes, mean_diameters, object_lengths
+from .oscillator import euler_step, exact_coefficients, exact_step
+from .rotation import Workspace, qrot
+
+__all__ = ["Simulation", "trace_tips", "INTEGRATORS"]
+
+#: Oscillator integrators (see :mod:`treeanim.physics.oscillator`).
+INTEGRATORS = ("exact", "euler")
+
+#: Time constant (s) of the low-pass filter on base accelerations (base excitation). It keeps
+#: the finite-difference acceleration finite and smooth at any dt and delays it by ~10 ms.
+ACCEL_TAU = 0.01
+
+#: The wind's default bounds; a wind still on them has "no bounds of its own" and is fitted.
+_WIND_DEFAULT_BOUNDS = ((-5.0, 0.0, -5.0), (5.0, 10.0, 5.0))
+
+
+def _finite_float(name: str, value) -> float:
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a real number, got {value!r}") from None
+    if not math.isfinite(x):
+        raise ValueError(f"{name} must be finite, got {value!r}")
+    return x
+
+
+def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
+    """Raise ValueError naming the field if ``p`` cannot drive a simulation of these kinds."""
+    if not isinstance(p, PhysicsParams):
+        raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
+    positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness")
+    for name in positive:
+        x = _finite_float(f"physics.{name}", getattr(p, name))
+        if x <= 0:
+            raise ValueError(f"physics.{name} must be > 0, got {x!r}")
+    for name in ("stiffness_exponent", "twist_c0", "leaf_twist_c0", "leaf_zeta_w_scale",
+                 "leaf_zeta_v_scale", "wind_gain_branch", "wind_gain_leaf", "wind_gain_blade"):
+        x = _finite_float(f"physics.{name}", getattr(p, name))
+        if x < 0:
+            raise ValueError(f"physics.{name} must be >= 0, got {x!r}")
+    for season in ("summer", "winter"):
+        sm = getattr(p, season)
+        for kind in kinds:
+            r = sm.of(kind)
+            if r is None:
+                if getattr(p, "winter" if season == "summer" else "summer").of(kind) is None:
+                    raise ValueError(f"physics: no f/zeta range for kind {kind!r}, which the tree has")
+                continue
+            for i in (0, 1):
+                f = _finite_float(f"physics.{season}.{kind}.f", r.f[i])
+                z = _finite_float(f"physics.{season}.{kind}.zeta", r.zeta[i])
+                if f <= 0:
+                    raise ValueError(f"physics.{season}.{kind}.f must be > 0, got {r.f!r}")
+                if z < 0:
+                    raise ValueError(f"physics.{season}.{kind}.zeta must be >= 0, got {r.zeta!r}")
+
+
+class Simulation:
+    """A tree animated by wind and by pulls (Hu, Chiba & He 2012; DESIGN §5–§8).
+
+    Parameters
+    ----------
+    tree : Tree
+        The tree (any preset, or a Tree built with :func:`treeanim.model.build.assemble`).
+    wind : WindField or None
+        Anything with ``sample(points (K, 3), t) -> (K, 3)`` m/s. If it still has the default
+        bounds, they are fitted to the tree's rest bounding box (``wind.fit``). None: calm.
+    season : float
+        0 (summer) … 1 (winter): interpolates the modal ranges and drops leaves.
+    seed : int
+        Seed of the random numbers of Eqs. 20–22 (degenerate ranges, mode noise).
+    integrator : {'exact', 'euler'}
+        Oscillator integrator (:mod:`treeanim.physics.oscillator`).
+    coupling : bool
+        Base excitation: every object also feels −(acceleration of its base node) × its mass,
+        so a swinging trunk shakes its twigs. False restores the paper's independent objects.
+
+    Attributes
+    ----------
+    positions : (N, 3) float, read-only
+        Deformed world node positions.
+    rotations : (N, 3, 3) float, read-only
+        World rotation *relative to rest* of the segment leaving node j; an object's tip node
+        carries its last segment's rotation. A rest point x rigidly attached to node j is drawn
+        at ``positions[j] + rotations[j] @ (x − rest_positions[j])``. A leaf's lamina is
+        attached to its petiole's tip node (it follows the petiole's bend and twist); a
+        child's base follows its parent's attach node. At rest, ``positions ==
+        rest_positions`` and ``rotations`` are identities (to ~1e-12).
+    modes : ModalParameters
+        ``modes.f`` and ``modes.zeta``, (M, 3) arrays, columns (u, v, w), writable; read at
+        every step. Setting ``season`` or ``physics`` re-derives them (Eqs. 20–22).
+    present : (M,) bool, read-only
+        Objects shown at the current season (fallen leaves are False); ``present_nodes`` is the
+        same per node. Fallen leaves are still simulated (cheap), just not shown.
+    season : float
+        Settable, in [0, 1].
+    physics : PhysicsParams
+        Settable (e.g. ``dataclasses.replace(sim.physics, ei_max=...)``); re-derives the
+        modes, stiffnesses, gains and masses.
+    time : float
+        Simulated time (s).
+
+    Notes
+    -----
+    One :meth:`step` (DESIGN §6):
+
+    1. wind U at each object's middle node (previous-step pose);
+    2. local load L = (U·u, U·v, U·w) in the object's previous-step world frame (the rest
+       frame carried by its parent, Eq. 12) × exposed area × the kind's gain (Eq. 19), plus
+       any pull, plus −mass × base acceleration (``coupling``);
+    3. oscillators (Eqs. 2–5): q̈ + 4πζf q̇ + 4π²f² q = g, g_u = L_w, g_v = r·L_w, g_w = L_u,
+       L′ = 4π²f² q (unit static gain: L′ settles at the load);
+    4. force in the rest frame F = L′_w·u + L′_u·w (Eq. 6) — net effect: a static load along w
+       bends the object along w, a load along u bends it along u — and twist from L′_v
+       (Eq. 11);
+    5. bending of every object in its rest frame (Eqs. 7–10);
+    6. composition down the hierarchy (Eq. 12).
+
+    The lever arm r is u·P0Pn for branches and blades (Eq. 3); for a leaf it is the distance
+    from the petiole's base to the lamina's centroid, so the wind on the lamina twists the
+    petiole. Exposed area: length × mean diameter; a leaf adds its lamina
+    (``tree.lamina.area × lamina_length²``). Mass: density × volume (a lamina is
+    ``lamina_thickness`` thick).
+    """
+
+    def __init__(self, tree: Tree, wind=None, season: float = 0.0, seed: int = 0,
+                 integrator: str = "exact", coupling: bool = True):
+        if not isinstance(tree, Tree):
+            raise ValueError(f"tree must be a treeanim Tree, got {type(tree).__name__}")
+        if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
+            raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
+        self._tree = tree
+        self._seed = int(seed)
+        self._integrator = self._check_integrator(integrator)
+        self._coupling = bool(coupling)
+        season = self._check_season(season)
+        kinds = [k for k in KINDS if np.any(tree.kind == k)]
+        self._kinds = kinds
+        _check_params(tree.physics, kinds)
+
+        M, N = tree.n_objects, tree.n_nodes
+        self._M, self._N = M, N
+        self._draws = ModalDraws.draw(M, self._seed)
+        self._bplan = BendingPlan(tree)
+        self._cplan = CompositionPlan(tree, self._bplan)
+        self._geometry()
+
+        self._physics = tree.physics
+        self._season = season
+        self._derive_physics()
+        self._derive_modes()
+        self._present = tree.leaves_present(season)
+        self._present.setflags(write=False)
+
+        self._pulls: dict[int, np.ndarray] = {}
+        self._coef_cache: dict[float, tuple] = {}
+        self._wind = None
+        self.wind = wind
+        self.reset()
+
+    # ------------------------------------------------------------------ set-up
+    def _geometry(self) -> None:
+        """Per-object rest frames, lever arms, areas and volumes (fixed for the tree)."""
+        tree = self._tree
+        X = np.asarray(tree.rest_positions, float)
+        start = np.asarray(tree.object_start)
+        count = np.asarray(tree.object_count)
+        tip = start + count - 1
+        M = self._M
+        v = X[start + 1] - X[start]
+        v /= np.linalg.norm(v, axis=1, keepdims=True)
+        w = np.asarray(tree.rest_w, float).reshape(M, 3).copy()
+        w -= np.einsum("ij,ij->i", w, v)[:, None] * v  # make w exactly ⟂ v
+        wn = np.linalg.norm(w, axis=1)
+        bad = wn < 1e-9
+        if np.any(bad):  # rest_w parallel to v: any perpendicular
+            from ..model.build import perpendicular
+
+            w[bad] = perpendicular(v[bad])
+            wn[bad] = 1.0
+        w /= wn[:, None]
+        u = np.cross(v, w)  # Eq. 1: u = v × w
+        self._u, self._v, self._w = u.T.copy(), v.T.copy(), w.T.copy()
+
+        kind = tree.kind
+        leaf = kind == "leaf"
+        length = object_lengths(tree)
+        dmean = mean_diameters(tree)
+        p0pn = X[tip] - X[start]
+        r = np.einsum("ij,ij->i", u, p0pn)  # Eq. 3: r = u · P0Pn
+        lam_area = np.zeros(M)
+        if tree.lamina is not None and np.any(leaf):
+            unit_area = float(tree.lamina.area)
+            cx, cy = _polygon_centroid(np.asarray(tree.lamina.outline, float))
+            L = np.asarray(tree.lamina_length, float)
+            lam_area[leaf] = unit_area * L[leaf] ** 2
+            centroid = X[tip] + L[:, None] * (cx * u + cy * v)
+            r[leaf] = np.linalg.norm(centroid[leaf] - X[start[leaf]], axis=1)
+        self._lever = r
+        self._area = length * dmean + lam_area
+        # Volumes: tapered segments (frusta ≈ cylinders of the mean diameter).
+        seg = np.linalg.norm(np.diff(X, axis=0), axis=1)
+        dseg = 0.5 * (tree.node_diameter[1:] + tree.node_diameter[:-1])
+        seg = np.append(seg, 0.0)
+        dseg = np.append(dseg, 0.0)
+        seg[tip] = 0.0
+        self._round_volume = np.add.reduceat(0.25 * np.pi * dseg**2 * seg, start)
+        self._flat_area = np.add.reduceat(dseg * seg, start)  # blades: width × length
+        self._lam_area = lam_area
+        self._nseg = (count - 1).astype(float)
+        self._sample_node = start + count // 2  # the middle node
+        self._sample_ofs = self._bplan.ofs_of_node[self._sample_node]
+        self._tip_node = tip
+        self._rest_P = X.T.copy()
+        # Base excitation: unique attach nodes of the non-root objects.
+        self._nonroot = np.flatnonzero(tree.parent >= 0)
+        att = np.asarray(tree.attach_node)[self._nonroot]
+        self._att_nodes, att_inv = np.unique(att, return_inverse=True)
+        # Per object, its base's column in the acceleration array (roots: the zero column).
+        self._att_col = np.full(M, len(self._att_nodes), np.int64)
+        self._att_col[self._nonroot] = att_inv
+        self._ws = Workspace()
+        # Ordered copies for the bending pass.
+        o = self._bplan.order
+        self._v_ord = self._v[:, o].copy()
+        self._u_ord = self._u[:, o].copy()
+        self._w_ord = self._w[:, o].copy()
+        self._neg_half_pi_over_n_ord = -0.5 * np.pi / self._nseg[o]
+        mins, maxs = X.min(axis=0), X.max(axis=0)
+        self._rest_bounds = (mins, maxs)
+
+    def _derive_physics(self) -> None:
+        """Stiffness, gains, masses and twist constants from ``self._physics``."""
+        p = self._physics
+        kind = self._tree.kind
+        gain = np.select([kind == "branch", kind == "leaf"], [p.wind_gain_branch, p.wind_gain_leaf],
+                         p.wind_gain_blade)
+        self._gain_area = gain * self._area
+        mass = np.where(kind == "branch", p.wood_density * self._round_volume, 0.0)
+        mass = np.where(kind == "leaf", p.leaf_density * (self._round_volume + self._lam_area * p.lamina_thickness),
+                        mass)
+        mass = np.where(kind == "blade", p.leaf_density * self._flat_area * p.lamina_thickness, mass)
+        self._mass = mass
+        self._k = self._bplan.stiffness(p.ei_max, p.stiffness_exponent)
+        # Eq. 11's c0, per unit of the object's root stiffness k₀ (see the class notes).
+        c0 = np.where(kind == "leaf", p.leaf_twist_c0, p.twist_c0)
+        k_root = np.empty(self._M)
+        k_root[self._bplan.order] = self._k[0]
+        self._c0k = c0 / np.maximum(k_root, 1e-300)
+        self._c0k_ord = self._c0k[self._bplan.order]
+
+    def _derive_modes(self) -> None:
+        m = derive_modes(self._tree, self._physics, self._season, self._draws)
+        if hasattr(self, "_modes"):
+            # Keep the user's references valid: overwrite in place when possible.
+            cur = self._modes
+            if isinstance(cur.f, np.ndarray) and cur.f.shape == m.f.shape and cur.f.flags.writeable:
+                cur.f[...] = m.f
+            else:
+                cur.f = m.f
+            if isinstance(cur.zeta, np.ndarray) and cur.zeta.shape == m.zeta.shape and cur.zeta.flags.writeable:
+                cur.zeta[...] = m.zeta
+            else:
+                cur.zeta = m.zeta
+        else:
+            self._modes = m
+        self._mode_snap = None  # force re-validation and new coefficients
+
+    # ------------------------------------------------------------------ validation
+    @staticmethod
+    def _check_integrator(name) -> str:
+        if name not in INTEGRATORS:
+            raise ValueError(f"integrator must be one of {INTEGRATORS}, got {name!r}")
+        return str(name)
+
+    @staticmethod
+    def _check_season(season) -> float:
+        s = _finite_float("season", season)
+        if not 0.0 <= s <= 1.0:
+            raise ValueError(f"season must be in [0, 1], got {season!r}")
+        return s
+
+    def _check_object(self, i) -> int:
+        if isinstance(i, bool) or not isinstance(i, numbers.Integral):
+            raise ValueError(f"object index i must be an integer, got {i!r}")
+        if not 0 <= int(i) < self._M:
+            raise ValueError(f"object index i={i} is out of range: the tree has {self._M} objects")
+        return int(i)
+
+    def _modes_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        """Validated (3, M) copies of modes.f and modes.zeta (cached while unchanged)."""
+        f, z = self._modes.f, self._modes.zeta
+        snap = self._mode_snap
+        if snap is not None and f is snap[0] and z is snap[1] and np.array_equal(f, snap[2]) \
+                and np.array_equal(z, snap[3]):
+            return snap[4], snap[5]
+        shape = (self._M, 3)
+        fa = np.asarray(f, dtype=float) if not isinstance(f, np.ndarray) else f
+        za = np.asarray(z, dtype=float) if not isinstance(z, np.ndarray) else z
+        if fa.shape != shape:
+            raise ValueError(f"modes.f must have shape {shape}, got {fa.shape}")
+        if za.shape != shape:
+            raise ValueError(f"modes.zeta must have shape {shape}, got {za.shape}")
+        fa = fa.astype(float)
+        za = za.astype(float)
+        badf = ~(np.isfinite(fa) & (fa > 0))
+        if badf.any():
+            j, c = np.argwhere(badf)[0]
+            raise ValueError(f"modes.f must be finite and > 0: object {j} mode {'uvw'[c]} is {fa[j, c]!r}")
+        badz = ~(np.isfinite(za) & (za >= 0))
+        if badz.any():
+            j, c = np.argwhere(badz)[0]
+            raise ValueError(f"modes.zeta must be finite and >= 0: object {j} mode {'uvw'[c]} is {za[j, c]!r}")
+        f3, z3 = fa.T.copy(), za.T.copy()
+        self._mode_snap = (f, z, fa.copy(), za.copy(), f3, z3)
+        self._coef_cache.clear()
+        return f3, z3
+
+    # ------------------------------------------------------------------ properties
+    @property
+    def tree(self) -> Tree:
+        """The simulated tree."""
+        return self._tree
+
+    @property
+    def seed(self) -> int:
+        """Seed of the modal random numbers."""
+        return self._seed
+
+    @property
+    def time(self) -> float:
+        """Simulated time in seconds."""
+        return self._time
+
+    @property
+    def modes(self) -> ModalParameters:
+        """(M, 3) natural frequencies ``f`` and damping ratios ``zeta`` (columns u, v, w)."""
+        return self._modes
+
+    @property
+    def season(self) -> float:
+        """0 (summer) … 1 (winter). Setting it re-derives the modes and the present leaves."""
+        return self._season
+
+    @season.setter
+    def season(self, value) -> None:
+        s = self._check_season(value)
+        self._season = s
+        self._derive_modes()
+        present = self._tree.leaves_present(s)
+        present.setflags(write=False)
+        self._present = present
+
+    @property
+    def present(self) -> np.ndarray:
+        """(M,) bool: objects shown at the current season (fallen leaves False)."""
+        return self._present
+
+    @property
+    def present_nodes(self) -> np.ndarray:
+        """(N,) bool: nodes of the present objects."""
+        return np.repeat(self._present, self._tree.object_count)
+
+    @property
+    def physics(self) -> PhysicsParams:
+        """The physical parameters. Setting new ones re-derives the modes, stiffness and gains."""
+        return self._physics
+
+    @physics.setter
+    def physics(self, params: PhysicsParams) -> None:
+        _check_params(params, self._kinds)
+        old = self._physics
+        self._physics = params
+        try:
+            self._derive_physics()
+            self._derive_modes()
+        except Exception:
+            self._physics = old
+            self._derive_physics()
+            raise
+
+    @property
+    def integrator(self) -> str:
+        """'exact' or 'euler' (settable)."""
+        return self._integrator
+
+    @integrator.setter
+    def integrator(self, name: str) -> None:
+        self._integrator = self._check_integrator(name)
+
+    @property
+    def coupling(self) -> bool:
+        """Whether base excitation is on (settable)."""
+        return self._coupling
+
+    @coupling.setter
+    def coupling(self, on: bool) -> None:
+        self._coupling = bool(on)
+
+    @property
+    def wind(self):
+        """The wind field or None (settable; a wind on its default bounds is fitted to the tree)."""
+        return self._wind
+
+    @wind.setter
+    def wind(self, wind) -> None:
+        if wind is not None:
+            if not callable(getattr(wind, "sample", None)):
+                raise ValueError(f"wind must have a sample(points, t) method, got {type(wind).__name__}")
+            self._fit_wind(wind)
+        self._wind = wind
+
+    def _fit_wind(self, wind) -> None:
+        b = getattr(wind, "bounds", None)
+        if b is None or np.allclose(np.asarray(b, float), _WIND_DEFAULT_BOUNDS):
+            lo, hi = self._rest_bounds
+            if hasattr(wind, "fit"):
+                wind.fit((tuple(lo), tuple(hi)))
+            elif hasattr(type(wind), "bounds") or b is None:
+                try:
+                    wind.bounds = (tuple(lo), tuple(hi))
+                except AttributeError:
+                    pass
+
+    @property
+    def rest_positions(self) -> np.ndarray:
+        """(N, 3) rest node positions (the tree's)."""
+        return self._tree.rest_positions
+
+    @property
+    def positions(self) -> np.ndarray:
+        """(N, 3) deformed world node positions (read-only; built on first access after a step)."""
+        if self._pos_out is None:
+            pos, _ = self._cplan.full_pose(self._bplan.q, self._bplan.o, self._qpar, self._base,
+                                           want_rotations=False)
+            pos.setflags(write=False)
+            self._pos_out = pos
+        return self._pos_out
+
+    @property
+    def rotations(self) -> np.ndarray:
+        """(N, 3, 3) world rotations relative to rest of the segment leaving each node.
+
+        See the class notes for the convention. Read-only; built on first access after a step.
+        """
+        if self._rot_out is None:
+            _, rot = self._cplan.full_pose(self._bplan.q, self._bplan.o, self._qpar, self._base,
+                                           want_positions=False)
+            rot.setflags(write=False)
+            self._rot_out = rot
+        return self._rot_out
+
+    @property
+    def loads(self) -> np.ndarray:
+        """(M, 3) the local loads L = (L_u, L_v, L_w) of the last step (N), a copy."""
+        return self._L.T.copy()
+
+    @property
+    def modal_loads(self) -> np.ndarray:
+        """(M, 3) the oscillator outputs L′ = (L′_u, L′_v, L′_w) (N; N·m for v), a copy."""
+        return self._p.T.copy()
+
+    @property
+    def pulls(self) -> dict[int, np.ndarray]:
+        """Held objects and their world forces (a copy)."""
+        return {i: f.copy() for i, f in self._pulls.items()}
+
+    def tip_position(self, i: int) -> np.ndarray:
+        """Deformed world position of object ``i``'s tip node, (3,)."""
+        i = self._check_object(i)
+        return self._tip_positions(np.array([i]))[0]
+
+    def _tip_positions(self, objs: np.ndarray) -> np.ndarray:
+        """(K, 3) deformed tip positions of objects ``objs`` (no validation)."""
+        o = self._bplan.o[:, self._bplan.ofs_of_node[self._tip_node[objs]]]
+        return (self._base[:, objs] + qrot(self._qpar[:, objs], o)).T
+
+    # ------------------------------------------------------------------ interaction
+    def pull(self, i: int, force_xyz) -> None:
+        """Hold object ``i`` with a constant world force (N) at its tip (DESIGN §8).
+
+        While held, the object follows the static deflection of its current load (no
+        oscillation of its own modes); :meth:`release` lets it swing freely from there. Pulling
+        an object again replaces its force; several objects may be held at once.
+
+        Parameters
+        ----------
+        i : int
+            Object index.
+        force_xyz : array_like of 3 floats
+            World force in newtons (finite).
+
+        Raises
+        ------
+        ValueError
+            Unknown object index or a non-finite / malformed force (state unchanged).
+        """
+        i = self._check_object(i)
+        try:
+            f = np.array(force_xyz, dtype=float).reshape(-1)
+        except (TypeError, ValueError):
+            raise ValueError(f"force_xyz must be 3 finite numbers, got {force_xyz!r}") from None
+        if f.shape != (3,):
+            raise ValueError(f"force_xyz must be 3 finite numbers, got shape {np.shape(force_xyz)}")
+        if not np.all(np.isfinite(f)):
+            raise ValueError(f"force_xyz must be finite, got {f.tolist()}")
+        self._pulls[i] = f
+
+    def release(self, i: int | None = None) -> None:
+        """Let go of object ``i`` (or of every held object when None)."""
+        if i is None:
+            self._pulls.clear()
+            return
+        i = self._check_object(i)
+        self._pulls.pop(i, None)
+
+    # ------------------------------------------------------------------ state
+    def reset(self) -> None:
+        """Back to rest at time 0: oscillators at zero, the rest pose, no pulls."""
+        M, N = self._M, self._N
+        self._time = 0.0
+        self._p = np.zeros((3, M))  # L′ (Eq. 5), rows u, v, w
+        self._pd = np.zeros((3, M))  # its rate
+        self._L = np.zeros((3, M))  # last local loads
+        self._bplan.reset()
+        self._P = self._rest_P.copy()  # valid at structural nodes and roots' bases
+        Qw = np.zeros((4, N + 1))
+        Qw[0] = 1.0
+        self._Qw = Qw
+        self._qpar, self._base = self._cplan.parent_frames(Qw, self._P)
+        self._sample_pos = self._rest_P[:, self._sample_node].copy()
+        U = len(self._att_nodes)
+        self._att_x = self._rest_P[:, self._att_nodes].copy()
+        self._att_v = np.zeros((3, U))
+        self._att_a = np.zeros((3, U + 1))  # column U: zero, for roots
+        self._dt_prev = None
+        self._pulls.clear()
+        self._pos_out = None
+        self._rot_out = None
+
+    def step(self, dt: float) -> None:
+        """Advance the simulation by ``dt`` seconds (DESIGN §6).
+
+        Parameters
+        ----------
+        dt : float
+            Step length in seconds, finite and > 0. Any length is stable: the exact integrator
+            has no step limit; Euler sub-steps (and clamps very long steps, see
+            :mod:`treeanim.physics.oscillator`).
+
+        Raises
+        ------
+        ValueError
+            Non-finite or non-positive ``dt``, or invalid ``modes`` (f <= 0 or non-finite,
+            ζ < 0 or non-finite, wrong shape). The state is left unchanged.
+        """
+        dt = _finite_float("dt", dt)
+        if not dt > 0:
+            raise ValueError(f"dt must be > 0, got {dt!r}")
+        f3, z3 = self._modes_arrays()
+        M = self._M
+        t = self._time
+        u, v, w = self._u, self._v, self._w
+
+        # 1–2. World force on each object: wind (Eq. 19 × area × gain), pulls, base excitation.
+        ws = self._ws
+        mul = np.multiply
+        Fw = ws.get("Fw", (3, M))
+        if self._wind is not None:
+            pts = np.ascontiguousarray(self._sample_pos.T)
+            U = np.asarray(self._wind.sample(pts, t), dtype=float)
+            if U.shape != (M, 3):
+                raise ValueError(f"wind.sample returned shape {U.shape}, expected {(M, 3)}")
+            mul(U.T, self._gain_area, out=Fw)
+        else:
+            Fw.fill(0.0)
+        for i, f in self._pulls.items():
+            Fw[:, i] += f
+        if self._coupling and len(self._nonroot):
+            inertia = np.take(self._att_a, self._att_col, axis=1, out=ws.get("inertia", (3, M)))
+            inertia *= self._mass
+            Fw -= inertia
+        # Into the previous-step frame: the rest frame carried by the parent (Eq. 12).
+        G = qrot(self._qpar, Fw, conj=True, out=ws.get("G", (3, M)), ws=ws)
+        L = self._L
+        tmp = ws.get("tmpM", (M,))
+        for row, axis in ((0, u), (1, v), (2, w)):  # L = (U·u, U·v, U·w), Eq. 19
+            r = L[row]
+            mul(axis[0], G[0], out=r)
+            r += mul(axis[1], G[1], out=tmp)
+            r += mul(axis[2], G[2], out=tmp)
+
+        # 3. Oscillators (Eqs. 2–5), signed loads, unit static gain.
+        g = ws.get("g", (3, M))
+        g[0] = L[2]  # g_u = L_w
+        mul(self._lever, L[2], out=g[1])  # g_v = r·L_w
+        g[2] = L[0]  # g_w = L_u
+        if self._integrator == "exact":
+            coef = self._coef_cache.get(dt)
+            if coef is None:
+                if len(self._coef_cache) > 8:
+                    self._coef_cache.clear()
+                coef = self._coef_cache[dt] = exact_coefficients(f3, z3, dt)
+            exact_step(self._p, self._pd, g, coef)
+        else:
+            euler_step(self._p, self._pd, g, f3, z3, dt)
+        if self._pulls:  # held objects sit at the static deflection of their load (§8)
+            held = np.fromiter(self._pulls, dtype=np.int64)
+            self._p[:, held] = g[:, held]
+            self._pd[:, held] = 0.0
+
+        # 4. Force in the rest frame (Eq. 6) and twist (Eq. 11), in bending order.
+        po = np.take(self._p, self._bplan.order, axis=1, out=ws.get("po", (3, M)))
+        F = mul(self._u_ord, po[2], out=ws.get("F", (3, M)))  # L′_w along u
+        F += mul(self._w_ord, po[0], out=ws.get("F2", (3, M)))  # L′_u along w
+        lv = po[1]
+        gamma = np.abs(lv)
+        gamma *= self._c0k_ord
+        gamma *= -1.0
+        np.expm1(gamma, out=gamma)
+        gamma *= np.sign(lv)
+        gamma *= self._neg_half_pi_over_n_ord
+
+        # 5. Bend every object in its rest frame (Eqs. 7–10).
+        bp = self._bplan
+        ratio = 0.0 if self._dt_prev is None else min(dt / self._dt_prev, 2.0)
+        bp.bend(F, gamma, self._v_ord, self._k, predict=ratio)
+
+        # 6. Compose the hierarchy (Eq. 12): structural nodes, then per-object frames.
+        P = self._P
+        self._cplan.compose_structural(bp.q, bp.o, self._Qw, P)
+        self._cplan.parent_frames(self._Qw, P, out=(self._qpar, self._base))
+        so = np.take(bp.o, self._sample_ofs, axis=1, out=ws.get("so", (3, M)))
+        qrot(self._qpar, so, out=self._sample_pos, ws=ws)
+        self._sample_pos += self._base
+
+        # Base accelerations for the next step's excitation, low-passed (finite at any dt).
+        if len(self._att_nodes):
+            x = P[:, self._att_nodes]
+            vel = (x - self._att_x) / dt
+            h = dt if self._dt_prev is None else 0.5 * (dt + self._dt_prev)
+            a_raw = (vel - self._att_v) / h
+            alpha = -math.expm1(-dt / ACCEL_TAU)
+            acc = self._att_a[:, :-1]
+            acc += alpha * (a_raw - acc)
+            self._att_x = x
+            self._att_v = vel
+        self._dt_prev = dt
+        self._time = t + dt
+        self._pos_out = None
+        self._rot_out = None
+
+
+def _polygon_centroid(xy: np.ndarray) -> tuple[float, float]:
+    """Centroid of a simple polygon (K, 2); the vertex mean if its area is ~0."""
+    x, y = xy[:, 0], xy[:, 1]
+    xn, yn = np.roll(x, -1), np.roll(y, -1)
+    cr = x * yn - xn * y
+    a = 0.5 * cr.sum()
+    if abs(a) < 1e-15:
+        return float(x.mean()), float(y.mean())
+    return float(((x + xn) * cr).sum() / (6 * a)), float(((y + yn) * cr).sum() / (6 * a))
+
+
+def trace_tips(sim: Simulation, objects, duration: float, dt: float) -> tuple[np.ndarray, np.ndarray]:
+    """Step ``sim`` for ``duration`` seconds and record the tip positions of ``objects``.
+
+    Parameters
+    ----------
+    sim : Simulation
+    objects : int or sequence of int
+        Object indices.
+    duration : float
+        Seconds to simulate (> 0).
+    dt : float
+        Step (> 0).
+
+    Returns
+    -------
+    times : (T + 1,) float
+        Sample times, starting at the current time.
+    tips : (T + 1, K, 3) float
+        Tip positions (the first row before any step).
+    """
+    objs = np.atleast_1d(np.asarray(objects))
+    for o in objs:
+        sim._check_object(int(o))
+    duration = _finite_float("duration", duration)
+    dt = _finite_float("dt", dt)
+    if duration <= 0 or dt <= 0:
+        raise ValueError("duration and dt must be > 0")
+    n = int(round(duration / dt))
+    objs = objs.astype(np.int64)
+    out = np.empty((n + 1, len(objs), 3))
+    times = np.empty(n + 1)
+    out[0] = sim._tip_positions(objs)
+    times[0] = sim.time
+    for k in range(n):
+        sim.step(dt)
+        out[k + 1] = sim._tip_positions(objs)
+        times[k + 1] = sim.time
+    return times, out
