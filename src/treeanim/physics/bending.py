@@ -36,6 +36,10 @@ import numpy as np
 
 from .rotation import Workspace, qmul, qrot
 
+# Rot(v, −γ) ⊗ C = cos·C + sin·(−C_y, C_z, C_w, −C_x): rows and signs of the second term.
+_SWAP = np.array([2, 3, 0, 1])
+_SWAP_SIGN = np.array([-1.0, 1.0, 1.0, -1.0])[:, None]
+
 #: Newton stops when |Δφ| is below this (radians).
 NEWTON_TOL = 1e-7
 #: Halley iterations run on every segment; from the previous step's angle (a warm start) two
@@ -46,23 +50,26 @@ NEWTON_FIXED = 3
 NEWTON_EXTRA = 12
 
 
-def _residual(phi, nn, dot, k):
-    """h(φ) = nn·cos φ − dot·sin φ − kφ, hp = −h′(φ), m = h + kφ = −h″(φ), t = tan(φ/2)."""
-    t = np.tan(0.5 * phi)
-    t2 = t * t
-    r = 1.0 + t2
-    np.divide(1.0, r, out=r)
-    omt = 1.0 - t2
-    m = nn * omt
-    m -= (dot + dot) * t
-    m *= r  # nn cos φ − dot sin φ = a sin(θ₀ − φ) >= 0
-    hp = (nn + nn) * t
-    hp += dot * omt
+def _residual(phi, a, theta0, k):
+    """h(φ) = a sin(θ₀ − φ) − kφ, hp = −h′ = a cos(θ₀ − φ) + k, m = −h″ = a sin(θ₀ − φ).
+
+    sin and cos come from τ = tan((θ₀ − φ)/2) (one fast tan). Returns (h, hp, m).
+    """
+    tau = np.subtract(theta0, phi)
+    tau *= 0.5
+    np.tan(tau, out=tau)
+    t2 = tau * tau
+    r = t2 + 1.0
+    np.divide(a, r, out=r)  # a/(1 + τ²)
+    m = tau * r
+    m += m  # a sin ψ = 2τ a/(1+τ²)
+    hp = t2
     hp *= r
-    hp += k  # a cos(θ₀ − φ) + k
+    np.subtract(r, hp, out=hp)  # a cos ψ = (1 − τ²) a/(1+τ²)
+    hp += k
     h = k * phi
     np.subtract(m, h, out=h)
-    return h, hp, m, t
+    return h, hp, m
 
 
 def solve_bend_angle(nn: np.ndarray, dot: np.ndarray, k: np.ndarray, theta0: np.ndarray,
@@ -70,13 +77,14 @@ def solve_bend_angle(nn: np.ndarray, dot: np.ndarray, k: np.ndarray, theta0: np.
                      fixed: int = NEWTON_FIXED) -> tuple[np.ndarray, np.ndarray]:
     """Solve |F||s| sin(θ₀ − φ) = k φ for φ ∈ [0, θ₀] (Eqs. 8–9), vectorised.
 
-    With a = |F||s|, ``a·sin θ₀ = |s × F|`` (``nn``) and ``a·cos θ₀ = s·F`` (``dot``), the
-    residual is h(φ) = nn·cos φ − dot·sin φ − k φ: concave on [0, θ₀] with h(0) >= 0 >=
-    h(θ₀), so the root is unique. ``fixed`` safeguarded iterations of Halley's method (Newton
-    with the curvature term, cubically convergent; iterates clipped to [0, θ₀]) run on every
-    entry; entries whose last correction is still >= ``tol`` continue alone with plain Newton
-    (monotone from the right of the root) and finally bisection on [0, θ₀], so the tolerance
-    always holds.
+    With a = |F||s| (``a·sin θ₀ = |s × F|`` = ``nn``, ``a·cos θ₀ = s·F`` = ``dot``) the
+    residual h(φ) = a sin(θ₀ − φ) − k φ is concave on [0, θ₀] with h(0) >= 0 >= h(θ₀), so the
+    root is unique. ``fixed`` safeguarded iterations of Halley's method (Newton with the
+    curvature term, cubically convergent; iterates clipped to [0, θ₀]) run on every entry;
+    entries whose last correction is still >= ``tol``, or that sit left of the apex of h (where
+    the step points away from the root), continue alone with plain Newton started on the right
+    of the root (monotone there) and finally bisection on [0, θ₀], so the tolerance always
+    holds.
 
     Parameters
     ----------
@@ -87,7 +95,7 @@ def solve_bend_angle(nn: np.ndarray, dot: np.ndarray, k: np.ndarray, theta0: np.
     theta0 : (K,) float
         ∠(F, s) in [0, π].
     phi0 : (K,) float, optional
-        Start (e.g. the previous step's angles); default: the Newton step from 0.
+        Start (e.g. from the previous step); default: the Newton step from 0.
     tol : float
         Convergence: the last correction is below ``tol``.
     fixed : int
@@ -101,55 +109,58 @@ def solve_bend_angle(nn: np.ndarray, dot: np.ndarray, k: np.ndarray, theta0: np.
         tan(φ/2).
     """
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        a = np.hypot(nn, dot)
         if phi0 is None:
             den = k + dot
             phi = nn / den
-            phi[~((den > 0) & (phi < theta0))] = 0.0
-            phi = np.minimum(phi, theta0)
+            phi = np.where((den > 0) & (phi < theta0), phi, theta0)
         else:
-            phi = np.minimum(np.maximum(phi0, 0.0), theta0)
-        for it in range(max(int(fixed), 1)):
-            h, hp, m, t = _residual(phi, nn, dot, k)
-            # Halley: φ + 2 h hp / (2 hp² + h m)   (h′ = −hp, h″ = −m)
-            den = hp * hp
-            den += den
+            phi = np.clip(phi0, 0.0, theta0)
+        fixed = max(int(fixed), 1)
+        for it in range(fixed):
+            h, hp, m = _residual(phi, a, theta0, k)
+            if it + 1 == fixed:
+                # h′ >= 0: left of the apex of h, where the step points the wrong way (and a
+                # clipped step can look converged at φ = 0); such entries start again on the
+                # right of the root below.
+                stuck = hp <= 0
+            # Halley: φ + h·hp / (hp² + h·m/2)   (h′ = −hp, h″ = −m)
             m *= h
-            den += m
+            m *= 0.5
             new = h * hp
-            new += new
-            new /= den
+            hp *= hp
+            hp += m
+            new /= hp
             new += phi
-            np.maximum(new, 0.0, out=new)
-            np.minimum(new, theta0, out=new)  # NaN stays NaN and is caught below
+            np.clip(new, 0.0, theta0, out=new)  # NaN stays NaN and is caught below
             if it + 1 < fixed:
                 phi = new
         new -= phi
         np.abs(new, out=new)
         bad = ~(new < tol)
+        bad |= stuck
         if bad.any():
             idx = np.flatnonzero(bad)
-            p, tt = _stragglers(phi[idx], nn[idx], dot[idx], k[idx], theta0[idx], tol)
             phi = phi.copy()
-            phi[idx] = p
-            t = t.copy()
-            t[idx] = tt
+            phi[idx] = _stragglers(phi[idx], a[idx], k[idx], theta0[idx], tol)
+        t = np.multiply(phi, 0.5)
+        np.tan(t, out=t)
     return phi, t
 
 
-def _stragglers(phi, nn, dot, k, theta0, tol):
+def _stragglers(phi, a, k, theta0, tol):
     """Newton then bisection for the few entries the fixed iterations did not converge."""
-    done = np.zeros(len(phi), bool)
-    t = np.tan(0.5 * phi)
-    # Newton from the right end of the bracket converges monotonically (h concave); start
-    # from the current iterate where it lies right of the root, else from θ₀.
-    h, _, _, _ = _residual(phi, nn, dot, k)
+    # Newton from the right of the root converges monotonically (h concave): start from the
+    # current iterate where it lies there, else from θ₀.
+    h, _, _ = _residual(phi, a, theta0, k)
     phi = np.where(h <= 0, phi, theta0)
+    done = np.zeros(len(phi), bool)
     for _ in range(NEWTON_EXTRA):
-        h, hp, _, t = _residual(phi, nn, dot, k)
+        h, hp, _ = _residual(phi, a, theta0, k)
         new = np.clip(phi + h / hp, 0.0, theta0)
         done |= np.abs(new - phi) < tol
         if done.all():
-            return phi, t
+            return phi
         phi = np.where(done, phi, new)
         phi = np.where(np.isfinite(phi), phi, 0.5 * theta0)
     # Bisection on [0, θ₀] (h(0) >= 0 >= h(θ₀)) for the rest: always converges.
@@ -158,14 +169,47 @@ def _stragglers(phi, nn, dot, k, theta0, tol):
     todo = ~done
     for _ in range(64):
         mid = 0.5 * (lo + hi)
-        h, _, _, _ = _residual(mid, nn, dot, k)
+        h, _, _ = _residual(mid, a, theta0, k)
         pos = h > 0
         lo = np.where(todo & pos, mid, lo)
         hi = np.where(todo & ~pos, mid, hi)
         if np.all(hi - lo < tol):
             break
-    phi = np.where(todo, 0.5 * (lo + hi), phi)
-    return phi, np.tan(0.5 * phi)
+    return np.where(todo, 0.5 * (lo + hi), phi)
+
+
+def rest_frames(tree) -> np.ndarray:
+    """(M, 3, 3) rest frames: columns (u, v, w) of every object (Eq. 1; leaves: Fig. 6).
+
+    v = P0P1/|P0P1|; w = the tree's ``rest_w`` made exactly perpendicular to v (Eq. 1's
+    P0Pn × v for branches and blades, the lamina normal for leaves; any perpendicular if it is
+    parallel to v); u = v × w.
+    """
+    from ..model.build import perpendicular
+
+    X = np.asarray(tree.rest_positions, float)
+    start = np.asarray(tree.object_start)
+    M = len(start)
+    v = X[start + 1] - X[start]
+    v /= np.linalg.norm(v, axis=1, keepdims=True)
+    w = np.asarray(tree.rest_w, float).reshape(M, 3).copy()
+    w -= np.einsum("ij,ij->i", w, v)[:, None] * v
+    wn = np.linalg.norm(w, axis=1)
+    bad = ~(wn > 1e-9)
+    if np.any(bad):
+        w[bad] = perpendicular(v[bad])
+        wn[bad] = 1.0
+    w /= wn[:, None]
+    u = np.cross(v, w)  # Eq. 1: u = v × w
+    return np.stack([u, v, w], axis=2)
+
+
+def matrix_to_quat(R: np.ndarray) -> np.ndarray:
+    """(4, K) unit quaternions (w, x, y, z) of (K, 3, 3) rotation matrices."""
+    from scipy.spatial.transform import Rotation
+
+    xyzw = Rotation.from_matrix(R).as_quat()
+    return np.ascontiguousarray(np.roll(xyzw, 1, axis=1).T)
 
 
 class BendingPlan:
@@ -192,10 +236,12 @@ class BendingPlan:
     o : (3, S + 1) float
         Bent offsets from the object's base, in world rest coordinates; column S is zero.
     phi : (S,) float
-        Bend angles (the warm start of the next solve).
+        Bend angles.
+    rho : (S,) float
+        φ/θ₀, the warm start of the next solve.
     """
 
-    def __init__(self, tree):
+    def __init__(self, tree, frames: np.ndarray):
         X = np.asarray(tree.rest_positions, float)
         start = np.asarray(tree.object_start)
         nseg = np.asarray(tree.object_count) - 1
@@ -206,10 +252,11 @@ class BendingPlan:
         self.counts = [int(np.count_nonzero(nseg > i)) for i in range(max_n)]
         self.offsets = [int(x) for x in np.concatenate([[0], np.cumsum(self.counts)])]
         self.n_flat = S = self.offsets[-1]
+        R0 = np.asarray(frames, float)[self.order]  # (M, 3, 3) local → world rest, in order
 
         flat_of_node = np.empty(self.N, np.int64)
         ofs_of_node = np.full(self.N, S, np.int64)
-        self.seg = []  # (3, K_i) rest segment vectors
+        self.seg = []  # (3, K_i) rest segment vectors in each object's local frame
         self.seg_len2 = []  # (K_i,) |sᵢ|²
         self.frac = []  # (K_i,) (n − i)/n of Eq. 7
         self.taper = []  # (K_i,) D_i of Eq. 10
@@ -224,7 +271,11 @@ class BendingPlan:
             ofs_of_node[nodes + 1] = flat
             last = nseg[objs] == i + 1
             flat_of_node[nodes[last] + 1] = flat[last]  # tip nodes: their last segment
-            s = (X[nodes + 1] - X[nodes]).T.copy()
+            sw = X[nodes + 1] - X[nodes]
+            s = np.einsum("kji,kj->ik", R0[:K], sw)  # Rᵀ s: local (u, v, w) components
+            if i == 0:  # the first segment lies on v by definition (Eq. 1)
+                s = np.stack([np.zeros(K), np.linalg.norm(sw, axis=1), np.zeros(K)])
+            s = np.ascontiguousarray(s)
             self.seg.append(s)
             self.seg_len2.append(np.einsum("ik,ik->k", s, s))
             n = nseg[objs].astype(float)
@@ -235,7 +286,7 @@ class BendingPlan:
         self.ofs_of_node = ofs_of_node
         self.ws = Workspace()
         self.d_max = float(diam.max()) if self.N else 1.0
-        # Rest offsets of every node from its object's base, accumulated like the bent ones.
+        # Rest offsets of every node from its object's base (local), accumulated like the bent.
         self.rest_o = np.zeros((3, S + 1))
         for i, s in enumerate(self.seg):
             a, b = self.offsets[i], self.offsets[i + 1]
@@ -249,127 +300,150 @@ class BendingPlan:
         self.q[0] = 1.0
         self.o = self.rest_o.copy()
         self.phi = np.zeros(S)
-        self.phi_old = np.zeros(S)
-        self.phi_start = np.zeros(S)
+        self.rho = np.zeros(S)
+        self.rho_old = np.zeros(S)
+        self.rho_start = np.zeros(S)
 
     def stiffness(self, ei_max: float, exponent: float) -> list[np.ndarray]:
         """kᵢ = EI_max (Dᵢ/D_max)^m per block (Eq. 10)."""
         return [ei_max * np.maximum(d / self.d_max, 0.0) ** exponent for d in self.taper]
 
-    def bend(self, F: np.ndarray, gamma: np.ndarray, v: np.ndarray, k: list[np.ndarray],
+    def bend(self, Fu: np.ndarray, Fw: np.ndarray, gamma: np.ndarray, k: list[np.ndarray],
              predict: float = 0.0) -> None:
-        """Bend every object; update ``q``, ``o`` and ``phi``.
+        """Bend every object in its local rest frame; update ``q``, ``o`` and ``phi``.
+
+        In the local frame (u, v, w) the force of Eq. 6 is (L′_w, 0, L′_u), the twist is a
+        rotation about the v axis (0, 1, 0), and the first segment lies on v.
 
         Parameters
         ----------
-        F : (3, M) float
-            Force on each object in world rest coordinates, in ``order``.
+        Fu, Fw : (M,) float
+            u and w components of the force on each object (L′_w and L′_u), in ``order``.
         gamma : (M,) float
             Twist per segment about v (Eq. 11), in ``order``; applied as Rot(v, −γ).
-        v : (3, M) float
-            Rest v axes, in ``order``.
         k : list of (K_i,) float
             Stiffness per block, from :meth:`stiffness`.
         predict : float
-            The solver starts from φ + predict·(φ − φ_previous): 0 restarts from the last
-            angles, dt/dt_prev extrapolates linearly in time (a better start, fewer iterations).
+            The solver starts from ρ·θ₀ with ρ = φ/θ₀ extrapolated as ρ + predict·(ρ −
+            ρ_previous): 0 restarts from the last fractions, dt/dt_prev extrapolates linearly
+            in time (a better start, fewer iterations).
         """
         M = len(gamma)
-        # Start of the angle solve: linear extrapolation of the last two solutions.
-        phi_start = self.phi_start
-        np.subtract(self.phi, self.phi_old, out=phi_start)
-        phi_start *= predict
-        phi_start += self.phi
-        self.phi_old, self.phi = self.phi, self.phi_old
+        # Start of the angle solve: the bend as a fraction ρ = φ/θ₀ of the angle to the force
+        # (nearly constant from step to step even where θ₀ moves), extrapolated linearly.
+        rho_start = self.rho_start
+        np.subtract(self.rho, self.rho_old, out=rho_start)
+        rho_start *= predict
+        rho_start += self.rho
+        np.clip(rho_start, 0.0, 1.0, out=rho_start)
+        self.rho_old, self.rho = self.rho, self.rho_old
         ws = self.ws
         mul = np.multiply
-        twist = bool(np.any(gamma))
-        if twist:  # Rot(v, −γ) as a quaternion: (cos γ/2, −sin γ/2 · v)
-            th = np.tan(0.25 * gamma)
-            ch = 1.0 / np.sqrt(1.0 + th * th)
-            qv = ws.get("qv", (4, M))
-            qv[0] = ch
-            mul(v, -(th * ch), out=qv[1:])
+        # Rot(v, −γ) = (cos γ/2, 0, −sin γ/2, 0)
+        th = np.tan(0.25 * gamma)
+        cv = th * th
+        cv += 1.0
+        np.sqrt(cv, out=cv)
+        np.divide(1.0, cv, out=cv)
+        sv = th
+        sv *= cv
+        np.negative(sv, out=sv)
         prev = None
         prev_o = None
         for i, K in enumerate(self.counts):
             a, b = self.offsets[i], self.offsets[i + 1]
             s = self.seg[i]
-            # T = Rot(v, −γ)·C_{i−1};  s′ = T sᵢ
-            sp = ws.get("sp", (3, K))
-            if i == 0:
-                if twist:
-                    T = qv
-                    qrot(T, s, out=sp, ws=ws)
-                else:
-                    T = None
-                    sp[...] = s
-            else:
-                if twist:
-                    T = qmul(qv[:, :K], prev[:, :K], out=ws.get("T", (4, K)), ws=ws)
-                else:
-                    T = prev[:, :K]
-                qrot(T, s, out=sp, ws=ws)
-            Fi = mul(F[:, :K], self.frac[i], out=ws.get("Fi", (3, K)))  # Eq. 7
-            # Bend axis N = s′ × F (turns s′ towards F); |N| = a sin θ₀, s′·F = a cos θ₀.
-            Nv = ws.get("N", (3, K))
+            fu = mul(Fu[:K], self.frac[i], out=ws.get("fu", (K,)))  # Eq. 7
+            fw = mul(Fw[:K], self.frac[i], out=ws.get("fw", (K,)))
             tmp = ws.get("tmp", (K,))
-            n0, n1, n2 = Nv
-            mul(sp[1], Fi[2], out=n0)
-            n0 -= mul(sp[2], Fi[1], out=tmp)
-            mul(sp[2], Fi[0], out=n1)
-            n1 -= mul(sp[0], Fi[2], out=tmp)
-            mul(sp[0], Fi[1], out=n2)
-            n2 -= mul(sp[1], Fi[0], out=tmp)
-            nn = mul(n0, n0)
-            nn += mul(n1, n1, out=tmp)
-            nn += mul(n2, n2, out=tmp)
-            np.sqrt(nn, out=nn)
-            dot = mul(sp[0], Fi[0])
-            dot += mul(sp[1], Fi[1], out=tmp)
-            dot += mul(sp[2], Fi[2], out=tmp)
-            theta0 = np.arctan2(nn, dot)
-            phi, t = solve_bend_angle(nn, dot, k[i], theta0, phi_start[a:b])  # Eqs. 8–9
+            if i == 0:
+                # s′ = Rot(v, −γ) s₀ = s₀ = (0, l, 0):  N = s′ × F = (l·F_w, 0, −l·F_u), s′·F = 0
+                sp = s
+                l = s[1]
+                n0 = mul(l, fw)
+                n2 = mul(l, fu)
+                np.negative(n2, out=n2)
+                n1 = None
+                nn = mul(n0, n0)
+                nn += mul(n2, n2, out=tmp)
+                np.sqrt(nn, out=nn)
+                dot = np.zeros(K)
+                theta0 = np.full(K, 0.5 * np.pi)
+            else:
+                # T = Rot(v, −γ) ⊗ C_{i−1}:  cv·C + sv·(−C_y, C_z, C_w, −C_x)
+                C = prev[:, :K]
+                T = ws.get("T", (4, K))
+                np.take(C, _SWAP, axis=0, out=T)
+                T *= _SWAP_SIGN
+                T *= sv[:K]
+                T += mul(C, cv[:K], out=ws.get("T2", (4, K)))
+                sp = qrot(T, s, out=ws.get("sp", (3, K)), ws=ws)
+                sx, sy, sz = sp
+                n0 = mul(sy, fw)
+                n1 = mul(sz, fu)
+                n1 -= mul(sx, fw, out=tmp)
+                n2 = mul(sy, fu)
+                np.negative(n2, out=n2)
+                nn = mul(n0, n0)
+                nn += mul(n1, n1, out=tmp)
+                nn += mul(n2, n2, out=tmp)
+                np.sqrt(nn, out=nn)
+                dot = mul(sx, fu)
+                dot += mul(sz, fw, out=tmp)
+                theta0 = np.arctan2(nn, dot)
+            phi, t = solve_bend_angle(nn, dot, k[i], theta0, mul(rho_start[a:b], theta0))  # Eqs. 8–9
             # No bend where the force is zero or (anti)parallel to the segment.
-            f2 = mul(Fi[0], Fi[0])
-            f2 += mul(Fi[1], Fi[1], out=tmp)
-            f2 += mul(Fi[2], Fi[2], out=tmp)
-            f2 *= self.seg_len2[i]
-            f2 *= 1e-24
-            ok = mul(nn, nn, out=tmp) > f2
+            a2 = mul(dot, dot, out=tmp)
+            a2 += mul(nn, nn)
+            a2 *= 1e-24
+            ok = mul(nn, nn) > a2
             phi *= ok
             t *= ok
             inv = np.divide(1.0, nn, out=np.zeros_like(nn), where=ok)
             self.phi[a:b] = phi
-            # Bend quaternion (cos φ/2, sin φ/2 · N/|N|);  Cᵢ = q_bend ⊗ T
+            np.divide(phi, np.maximum(theta0, 1e-300), out=self.rho[a:b])
+            # Bend quaternion (cos φ/2, sin φ/2 · N/|N|)
             t2 = t * t
             ch2 = 1.0 + t2
             np.divide(1.0, ch2, out=ch2)  # cos²(φ/2)
             ch = np.sqrt(ch2)
             sh = mul(t, ch)
             sh *= inv  # sin(φ/2) / |N|
+            b0 = ch
+            b1 = mul(n0, sh)
+            b3 = mul(n2, sh)
             dst = self.q[:, a:b]
-            if T is None:
-                dst[0] = ch
-                mul(Nv, sh, out=dst[1:])
+            if i == 0:
+                # C₀ = q_bend ⊗ Rot(v, −γ), with q_bend = (b0, b1, 0, b3), Rot = (cv, 0, sv, 0)
+                c_, s_ = cv[:K], sv[:K]
+                mul(b0, c_, out=dst[0])
+                mul(b1, c_, out=dst[1])
+                dst[1] -= mul(b3, s_, out=tmp)
+                mul(b0, s_, out=dst[2])
+                mul(b1, s_, out=dst[3])
+                dst[3] += mul(b3, c_, out=tmp)
             else:
                 qb = ws.get("qb", (4, K))
-                qb[0] = ch
-                mul(Nv, sh, out=qb[1:])
-                qmul(qb, T, out=dst, ws=ws)
+                qb[0] = b0
+                qb[1] = b1
+                mul(n1, sh, out=qb[2])
+                qb[3] = b3
+                qmul(qb, T, out=dst, ws=ws)  # Cᵢ = q_bend ⊗ T
             # Bent segment Cᵢsᵢ = cos φ·s′ + sin φ·(N̂ × s′), N̂ × s′ = (F|s|² − s′(s′·F))/|N|
             c_phi = 1.0 - t2
             c_phi *= ch2
             s_phi = mul(t, ch2)
             s_phi *= inv
             s_phi += s_phi
+            s_phi *= self.seg_len2[i]  # sin φ · |s|² / |N|
             oo = self.o[:, a:b]
-            v3 = ws.get("v3", (3, K))
-            mul(Fi, self.seg_len2[i], out=oo)
-            oo -= mul(sp, dot, out=v3)
-            oo *= s_phi
-            oo += mul(sp, c_phi, out=v3)
-            if prev_o is not None:
+            mul(sp, c_phi, out=oo)
+            oo[0] += mul(fu, s_phi, out=tmp)
+            oo[2] += mul(fw, s_phi, out=tmp)
+            if i > 0:
+                s_phi /= self.seg_len2[i]
+                s_phi *= dot
+                oo -= mul(sp, s_phi, out=ws.get("v3", (3, K)))
                 oo += prev_o[:, :K]  # accumulate along the object
             prev = dst
             prev_o = oo

@@ -1,13 +1,15 @@
 """Carrying each object's local bend up the hierarchy (Eq. 12, DESIGN §6).
 
-An object's segment j has world rotation ``R_parent(attach node) · C_j`` (both relative to
-rest) and its node j sits at the parent's deformed attach node plus the parent-rotated bent
-offset Σ_{i<j} Cᵢ sᵢ (accumulated per object by the bending pass).
+Every object bends in its local rest frame (u, v, w), whose orientation at rest is the
+quaternion q₀. Carried by its parent, that frame has the world orientation
+``f = R_parent(attach node) ⊗ q₀`` (Eq. 12); segment j of the object then has the world
+rotation relative to rest ``R_j = f ⊗ C_j ⊗ q₀*`` and node j sits at the parent's deformed
+attach node plus ``f`` applied to the local bent offset Σ_{i<j} Cᵢ sᵢ.
 
 Within a step only the *structural* objects — those that carry children — are composed node
 by node, level by level (each level one vectorised pass); every other object (leaves, outer
-twigs, grass blades: the bulk of the nodes) needs only its parent's rotation and base, per
-object. The full per-node pose is assembled on demand by :meth:`CompositionPlan.full_pose`.
+twigs, grass blades: the bulk of the nodes) needs only its frame f and base, per object. The
+full per-node pose is assembled on demand by :meth:`CompositionPlan.full_pose`.
 """
 
 from __future__ import annotations
@@ -17,14 +19,32 @@ import numpy as np
 from .rotation import Workspace, qmat, qmul, qrot
 
 
+def qconj(q: np.ndarray) -> np.ndarray:
+    """Conjugate (inverse) of (4, K) unit quaternions."""
+    c = q.copy()
+    c[1:] *= -1.0
+    return c
+
+
 class CompositionPlan:
     """Index arrays for composing the hierarchy, precomputed once.
 
-    World quaternions ``Qw`` (4, N + 1) and positions ``P`` (3, N) are kept for the structural
-    nodes; column N of ``Qw`` is the identity, the "parent rotation" of roots.
+    Parameters
+    ----------
+    tree : Tree
+    bplan : BendingPlan
+    q0 : (4, M) float
+        Rest frame quaternion of every object.
+
+    Notes
+    -----
+    ``Fw`` (4, N + 1) holds, at the structural nodes, the world orientation ``f ⊗ C_j`` of the
+    bent segment's frame; column N is the identity. A child's frame is
+    ``Fw[attach] ⊗ q_rel`` with the constant ``q_rel = q₀(parent)* ⊗ q₀(child)`` (roots:
+    ``q_rel = q₀``), since R(attach) = Fw[attach] ⊗ q₀(parent)*.
     """
 
-    def __init__(self, tree, bplan):
+    def __init__(self, tree, bplan, q0: np.ndarray):
         N, M = tree.n_nodes, tree.n_objects
         start = np.asarray(tree.object_start)
         count = np.asarray(tree.object_count)
@@ -33,13 +53,19 @@ class CompositionPlan:
         node_obj = tree.node_object
         self.N, self.M = N, M
         self.node_obj = node_obj
+        self.ws = Workspace()
         is_root = parent < 0
-        # Per object: where its parent rotation and its base position come from.
+        self.q0 = np.ascontiguousarray(q0)
+        self.q0_conj = qconj(self.q0)
+        self.q_rel = self.q0.copy()
+        nr = np.flatnonzero(~is_root)
+        if len(nr):
+            self.q_rel[:, nr] = qmul(self.q0_conj[:, parent[nr]], self.q0[:, nr])
+        # Per object: where its parent frame and its base position come from.
         self.rot_src = np.where(is_root, N, attach)
         self.base_src = np.where(is_root, start, attach)  # a root's base never moves
         self.flat_of_node = bplan.flat_of_node
         self.ofs_of_node = bplan.ofs_of_node
-        self.ws = Workspace()
         structural = np.zeros(M, bool)
         structural[parent[parent >= 0]] = True
         self.structural = structural
@@ -56,45 +82,49 @@ class CompositionPlan:
                 self.ofs_of_node[nodes],
                 self.rot_src[node_obj[nodes]],
                 self.base_src[node_obj[nodes]],
+                self.q_rel[:, node_obj[nodes]].copy(),
             ))
 
-    def compose_structural(self, q_flat: np.ndarray, o_flat: np.ndarray, Qw: np.ndarray, P: np.ndarray) -> None:
-        """World rotations and positions of the structural nodes (level by level, Eq. 12).
+    def compose_structural(self, q_flat: np.ndarray, o_flat: np.ndarray, Fw: np.ndarray, P: np.ndarray) -> None:
+        """Segment frames and positions of the structural nodes (level by level, Eq. 12).
 
         Parameters
         ----------
         q_flat : (4, S + 1) float
             Local cumulative rotations (quaternions), from the bending pass.
         o_flat : (3, S + 1) float
-            Bent node offsets from each object's base, rest coordinates (column S zero).
-        Qw : (4, N + 1) float
-            World quaternions, written at the structural nodes.
+            Local bent offsets of the nodes from their object's base (column S zero).
+        Fw : (4, N + 1) float
+            World segment frames, written at the structural nodes.
         P : (3, N) float
             World positions, written at the structural nodes.
         """
-        for nodes, flat, ofs, rot_src, base_src in self.levels:
-            qp = np.take(Qw, rot_src, axis=1)
-            Qw[:, nodes] = qmul(qp, np.take(q_flat, flat, axis=1))  # Eq. 12
-            P[:, nodes] = np.take(P, base_src, axis=1) + qrot(qp, np.take(o_flat, ofs, axis=1))
+        for nodes, flat, ofs, rot_src, base_src, q_rel in self.levels:
+            f = qmul(np.take(Fw, rot_src, axis=1), q_rel)  # the objects' frames, per node
+            Fw[:, nodes] = qmul(f, np.take(q_flat, flat, axis=1))
+            P[:, nodes] = np.take(P, base_src, axis=1) + qrot(f, np.take(o_flat, ofs, axis=1))
 
-    def parent_frames(self, Qw: np.ndarray, P: np.ndarray, out=None) -> tuple[np.ndarray, np.ndarray]:
-        """Per object: the parent's world quaternion at the attach node and the base position.
+    def object_frames(self, Fw: np.ndarray, P: np.ndarray, out=None) -> tuple[np.ndarray, np.ndarray]:
+        """Per object: its carried frame f (4, M) and its deformed base position (3, M).
 
         ``out``: optional ((4, M), (3, M)) arrays to fill.
         """
         qo, bo = out if out is not None else (None, None)
-        return (np.take(Qw, self.rot_src, axis=1, out=qo), np.take(P, self.base_src, axis=1, out=bo))
+        ws = self.ws
+        fp = np.take(Fw, self.rot_src, axis=1, out=ws.get("fp", (4, self.M)))
+        f = qmul(fp, self.q_rel, out=qo, ws=ws)
+        return f, np.take(P, self.base_src, axis=1, out=bo)
 
-    def full_pose(self, q_flat: np.ndarray, o_flat: np.ndarray, q_par: np.ndarray, base: np.ndarray,
+    def full_pose(self, q_flat: np.ndarray, o_flat: np.ndarray, f: np.ndarray, base: np.ndarray,
                   want_positions: bool = True, want_rotations: bool = True):
-        """World positions (N, 3) and rotations (N, 3, 3) of every node.
+        """World positions (N, 3) and rotations relative to rest (N, 3, 3) of every node.
 
         Parameters
         ----------
         q_flat, o_flat : arrays
             The bending pass's local rotations and bent offsets.
-        q_par : (4, M) float
-            Each object's parent world quaternion at its attach node (identity for roots).
+        f : (4, M) float
+            Each object's carried frame.
         base : (3, M) float
             Each object's deformed base position.
         want_positions, want_rotations : bool
@@ -102,14 +132,16 @@ class CompositionPlan:
         """
         ws = self.ws
         N = self.N
-        qpn = np.take(q_par, self.node_obj, axis=1, out=ws.get("qpn", (4, N)))
+        fn = np.take(f, self.node_obj, axis=1, out=ws.get("fn", (4, N)))
         positions = rotations = None
         if want_positions:
             on = np.take(o_flat, self.ofs_of_node, axis=1, out=ws.get("on", (3, N)))
-            pos = qrot(qpn, on, out=ws.get("pos", (3, N)), ws=ws)
+            pos = qrot(fn, on, out=ws.get("pos", (3, N)), ws=ws)
             pos += np.take(base, self.node_obj, axis=1, out=ws.get("bn", (3, N)))
             positions = np.ascontiguousarray(pos.T)
         if want_rotations:
             qn = np.take(q_flat, self.flat_of_node, axis=1, out=ws.get("qn", (4, N)))
-            rotations = qmat(qmul(qpn, qn, out=ws.get("qw", (4, N)), ws=ws), ws=ws)
+            g = qmul(fn, qn, out=ws.get("g", (4, N)), ws=ws)
+            q0c = np.take(self.q0_conj, self.node_obj, axis=1, out=ws.get("q0c", (4, N)))
+            rotations = qmat(qmul(g, q0c, out=ws.get("r", (4, N)), ws=ws), ws=ws)
         return positions, rotations

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..model.params import PhysicsParams
 from ..model.tree import KINDS, Tree
-from .bending import BendingPlan
+from .bending import BendingPlan, matrix_to_quat, rest_frames
 from .hierarchy import CompositionPlan
 from .modal import ModalDraws, ModalParameters, derive_modes, mean_diameters, object_lengths
 from .oscillator import euler_step, exact_coefficients, exact_step
@@ -156,8 +156,6 @@ class Simulation:
         M, N = tree.n_objects, tree.n_nodes
         self._M, self._N = M, N
         self._draws = ModalDraws.draw(M, self._seed)
-        self._bplan = BendingPlan(tree)
-        self._cplan = CompositionPlan(tree, self._bplan)
         self._geometry()
 
         self._physics = tree.physics
@@ -182,20 +180,11 @@ class Simulation:
         count = np.asarray(tree.object_count)
         tip = start + count - 1
         M = self._M
-        v = X[start + 1] - X[start]
-        v /= np.linalg.norm(v, axis=1, keepdims=True)
-        w = np.asarray(tree.rest_w, float).reshape(M, 3).copy()
-        w -= np.einsum("ij,ij->i", w, v)[:, None] * v  # make w exactly ⟂ v
-        wn = np.linalg.norm(w, axis=1)
-        bad = wn < 1e-9
-        if np.any(bad):  # rest_w parallel to v: any perpendicular
-            from ..model.build import perpendicular
-
-            w[bad] = perpendicular(v[bad])
-            wn[bad] = 1.0
-        w /= wn[:, None]
-        u = np.cross(v, w)  # Eq. 1: u = v × w
+        frames = rest_frames(tree)  # (M, 3, 3): columns u, v, w
+        u, v, w = frames[:, :, 0], frames[:, :, 1], frames[:, :, 2]
         self._u, self._v, self._w = u.T.copy(), v.T.copy(), w.T.copy()
+        self._bplan = BendingPlan(tree, frames)
+        self._cplan = CompositionPlan(tree, self._bplan, matrix_to_quat(frames))
 
         kind = tree.kind
         leaf = kind == "leaf"
@@ -235,11 +224,7 @@ class Simulation:
         self._att_col = np.full(M, len(self._att_nodes), np.int64)
         self._att_col[self._nonroot] = att_inv
         self._ws = Workspace()
-        # Ordered copies for the bending pass.
         o = self._bplan.order
-        self._v_ord = self._v[:, o].copy()
-        self._u_ord = self._u[:, o].copy()
-        self._w_ord = self._w[:, o].copy()
         self._neg_half_pi_over_n_ord = -0.5 * np.pi / self._nseg[o]
         mins, maxs = X.min(axis=0), X.max(axis=0)
         self._rest_bounds = (mins, maxs)
@@ -446,7 +431,7 @@ class Simulation:
     def positions(self) -> np.ndarray:
         """(N, 3) deformed world node positions (read-only; built on first access after a step)."""
         if self._pos_out is None:
-            pos, _ = self._cplan.full_pose(self._bplan.q, self._bplan.o, self._qpar, self._base,
+            pos, _ = self._cplan.full_pose(self._bplan.q, self._bplan.o, self._frame, self._base,
                                            want_rotations=False)
             pos.setflags(write=False)
             self._pos_out = pos
@@ -459,7 +444,7 @@ class Simulation:
         See the class notes for the convention. Read-only; built on first access after a step.
         """
         if self._rot_out is None:
-            _, rot = self._cplan.full_pose(self._bplan.q, self._bplan.o, self._qpar, self._base,
+            _, rot = self._cplan.full_pose(self._bplan.q, self._bplan.o, self._frame, self._base,
                                            want_positions=False)
             rot.setflags(write=False)
             self._rot_out = rot
@@ -488,7 +473,7 @@ class Simulation:
     def _tip_positions(self, objs: np.ndarray) -> np.ndarray:
         """(K, 3) deformed tip positions of objects ``objs`` (no validation)."""
         o = self._bplan.o[:, self._bplan.ofs_of_node[self._tip_node[objs]]]
-        return (self._base[:, objs] + qrot(self._qpar[:, objs], o)).T
+        return (self._base[:, objs] + qrot(self._frame[:, objs], o)).T
 
     # ------------------------------------------------------------------ interaction
     def pull(self, i: int, force_xyz) -> None:
@@ -539,13 +524,18 @@ class Simulation:
         self._L = np.zeros((3, M))  # last local loads
         self._bplan.reset()
         self._P = self._rest_P.copy()  # valid at structural nodes and roots' bases
-        Qw = np.zeros((4, N + 1))
-        Qw[0] = 1.0
-        self._Qw = Qw
-        self._qpar, self._base = self._cplan.parent_frames(Qw, self._P)
-        self._sample_pos = self._rest_P[:, self._sample_node].copy()
+        Fw = np.zeros((4, N + 1))  # world segment frames (structural nodes); column N: identity
+        Fw[0, N] = 1.0
+        Fw[:, :N] = self._cplan.q0[:, self._tree.node_object]
+        self._Fw = Fw
+        # The rest pose as the composition computes it (equal to the rest positions up to
+        # round-off), so that a tree at rest sees exactly zero base velocity.
+        bp = self._bplan
+        self._cplan.compose_structural(bp.q, bp.o, Fw, self._P)
+        self._frame, self._base = self._cplan.object_frames(Fw, self._P)
+        self._sample_pos = self._base + qrot(self._frame, bp.o[:, self._sample_ofs])
         U = len(self._att_nodes)
-        self._att_x = self._rest_P[:, self._att_nodes].copy()
+        self._att_x = self._P[:, self._att_nodes].copy()
         self._att_v = np.zeros((3, U))
         self._att_a = np.zeros((3, U + 1))  # column U: zero, for roots
         self._dt_prev = None
@@ -595,15 +585,9 @@ class Simulation:
             inertia = np.take(self._att_a, self._att_col, axis=1, out=ws.get("inertia", (3, M)))
             inertia *= self._mass
             Fw -= inertia
-        # Into the previous-step frame: the rest frame carried by the parent (Eq. 12).
-        G = qrot(self._qpar, Fw, conj=True, out=ws.get("G", (3, M)), ws=ws)
-        L = self._L
-        tmp = ws.get("tmpM", (M,))
-        for row, axis in ((0, u), (1, v), (2, w)):  # L = (U·u, U·v, U·w), Eq. 19
-            r = L[row]
-            mul(axis[0], G[0], out=r)
-            r += mul(axis[1], G[1], out=tmp)
-            r += mul(axis[2], G[2], out=tmp)
+        # Local loads L = (U·u, U·v, U·w) in the previous-step frame, carried by the parent
+        # (Eqs. 12, 19): the inverse of the object's frame applied to the world force.
+        L = qrot(self._frame, Fw, conj=True, out=self._L, ws=ws)
 
         # 3. Oscillators (Eqs. 2–5), signed loads, unit static gain.
         g = ws.get("g", (3, M))
@@ -624,10 +608,8 @@ class Simulation:
             self._p[:, held] = g[:, held]
             self._pd[:, held] = 0.0
 
-        # 4. Force in the rest frame (Eq. 6) and twist (Eq. 11), in bending order.
+        # 4. Force in the local rest frame (Eq. 6): (L′_w, 0, L′_u); twist (Eq. 11).
         po = np.take(self._p, self._bplan.order, axis=1, out=ws.get("po", (3, M)))
-        F = mul(self._u_ord, po[2], out=ws.get("F", (3, M)))  # L′_w along u
-        F += mul(self._w_ord, po[0], out=ws.get("F2", (3, M)))  # L′_u along w
         lv = po[1]
         gamma = np.abs(lv)
         gamma *= self._c0k_ord
@@ -636,17 +618,17 @@ class Simulation:
         gamma *= np.sign(lv)
         gamma *= self._neg_half_pi_over_n_ord
 
-        # 5. Bend every object in its rest frame (Eqs. 7–10).
+        # 5. Bend every object in its local rest frame (Eqs. 7–10).
         bp = self._bplan
         ratio = 0.0 if self._dt_prev is None else min(dt / self._dt_prev, 2.0)
-        bp.bend(F, gamma, self._v_ord, self._k, predict=ratio)
+        bp.bend(po[2], po[0], gamma, self._k, predict=ratio)
 
         # 6. Compose the hierarchy (Eq. 12): structural nodes, then per-object frames.
         P = self._P
-        self._cplan.compose_structural(bp.q, bp.o, self._Qw, P)
-        self._cplan.parent_frames(self._Qw, P, out=(self._qpar, self._base))
+        self._cplan.compose_structural(bp.q, bp.o, self._Fw, P)  # Eq. 12
+        self._cplan.object_frames(self._Fw, P, out=(self._frame, self._base))
         so = np.take(bp.o, self._sample_ofs, axis=1, out=ws.get("so", (3, M)))
-        qrot(self._qpar, so, out=self._sample_pos, ws=ws)
+        qrot(self._frame, so, out=self._sample_pos, ws=ws)
         self._sample_pos += self._base
 
         # Base accelerations for the next step's excitation, low-passed (finite at any dt).
