@@ -131,6 +131,11 @@ class Simulation:
     5. bending of every object in its rest frame (Eqs. 7–10);
     6. composition down the hierarchy (Eq. 12).
 
+    Twist (Eq. 11): γ = 0.5π·sgn(L′_v)(1 − exp(−c0·|L′_v|/k₀))/n per segment, with c0 the
+    preset's ``twist_c0`` (``leaf_twist_c0`` for leaves) taken per unit of the object's root
+    stiffness k₀ = EI_max (D_r/D_max)^m, so that one constant serves trunks and twigs alike;
+    it turns each segment about v by −γ (see :mod:`treeanim.physics.bending` for the sign).
+
     The lever arm r is u·P0Pn for branches and blades (Eq. 3); for a leaf it is the distance
     from the petiole's base to the lamina's centroid, so the wind on the lamina twists the
     petiole. Exposed area: length × mean diameter; a leaf adds its lamina
