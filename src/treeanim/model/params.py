@@ -68,8 +68,9 @@ class PhysicsParams:
     Notes
     -----
     The defaults are tuned on the small cherry (m = 4): a 5 m/s wind at the tree top bends
-    it by about 2 % of its height at the top (≈ 8 cm) with leaves bent and twisted by ≈ 12°;
-    25 m/s gives ≈ 8 % (≈ 30 cm) with leaves at ≈ 50° and twigs at ≈ 30°. With k ∝ D⁴ the
+    it by about 2 % of its height at the top (≈ 8 cm), its leaves bent and twisted by ≈ 15°
+    (≈ 8° of twist); 25 m/s gives ≈ 8 % (≈ 30 cm), leaves at ≈ 55° (≈ 35° of twist) and
+    twigs at ≈ 30°. With k ∝ D⁴ the
     stiffness scales with the tree's thickest diameter, so a preset of another size sets its
     own ``ei_max``: (1 … 7)·10⁷ N/m³ × D_max⁴ gives the tree presets that response (the small
     cherry's 2.5·10⁴ is 6.5·10⁷ × 0.14⁴).
@@ -79,7 +80,7 @@ class PhysicsParams:
     winter: SeasonModes = field(default_factory=_default_season)
     ei_max: float = 2.5e4
     stiffness_exponent: float = 4.0
-    twist_c0: float = 0.5
+    twist_c0: float = 0.25
     leaf_zeta_w_scale: float = 1.5
     leaf_zeta_v_scale: float = 0.5
     wind_gain_branch: float = 3.0
@@ -88,7 +89,7 @@ class PhysicsParams:
     wood_density: float = 700.0
     leaf_density: float = 500.0
     lamina_thickness: float = 3.0e-4
-    leaf_twist_c0: float = 0.6
+    leaf_twist_c0: float = 0.5
 
     def modes(self, kind: str, season: float) -> ModeRange | None:
         """f and ζ ranges for ``kind``, linearly interpolated at ``season`` in [0, 1]."""

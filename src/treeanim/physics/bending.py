@@ -340,7 +340,7 @@ class BendingPlan:
         ws = self.ws
         mul = np.multiply
         # Rot(v, −γ) = (cos γ/2, 0, −sin γ/2, 0)
-        th = np.tan(0.25 * gamma)
+        th = np.tan(0.5 * gamma)  # tan(γ/2): cos(γ/2) = 1/√(1+th²), sin(γ/2) = th·cos(γ/2)
         cv = th * th
         cv += 1.0
         np.sqrt(cv, out=cv)
