@@ -1,0 +1,345 @@
+"""The Simulation as physics: traces of pulled and released beams and trees, measured."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from scipy.optimize import curve_fit
+
+import treeanim as ta
+from treeanim.model.build import ObjectSpec, assemble
+from treeanim.model.params import PhysicsParams
+from treeanim.physics.bending import rest_frames
+from treeanim.physics.simulation import Simulation, trace_tips
+
+
+def straight_beam(n=8, length=2.0):
+    pts = np.stack([np.zeros(n + 1), np.linspace(0, length, n + 1), np.zeros(n + 1)], 1)
+    return assemble([ObjectSpec(pts, np.linspace(0.08, 0.03, n + 1), "branch", 1, w=np.array([0.0, 0.0, 1.0]))],
+                    name="straight", physics=PhysicsParams(ei_max=200.0))
+
+
+class Uniform:
+    """A steady uniform wind (only ``sample`` is needed)."""
+
+    def __init__(self, U):
+        self.U = np.asarray(U, float)
+
+    def sample(self, points, t):
+        return np.tile(self.U, (len(points), 1))
+
+
+def fit_damped(t, x):
+    """Natural frequency and damping ratio of a damped cosine fitted to x(t)."""
+    def model(t, A, zeta, f, ph, c):
+        w = 2 * np.pi * f
+        return A * np.exp(-zeta * w * t) * np.cos(w * np.sqrt(1 - zeta**2) * t + ph) + c
+
+    spec = np.abs(np.fft.rfft(x - x.mean()))
+    f0 = np.fft.rfftfreq(len(x), t[1] - t[0])[np.argmax(spec[1:]) + 1]
+    p, _ = curve_fit(model, t, x, p0=[x[0], 0.05, f0, 0.0, 0.0], maxfev=40000)
+    return p[2], p[1]
+
+
+def release_trace(tree, f, zeta, direction, dt, seconds, integrator="exact", deflection=0.01):
+    """Hold the tip of object 0 deflected by ``deflection`` × its length along ``direction``
+    (world), release it, and return (times, tip displacement from rest)."""
+    sim = Simulation(tree, integrator=integrator)
+    sim.modes.f[0] = f
+    sim.modes.zeta[0] = zeta
+    tip_rest = tree.rest_positions[tree.object_start[0] + tree.object_count[0] - 1]
+    length = np.sum(np.linalg.norm(np.diff(tree.rest_positions[tree.object_nodes(0)], axis=0), axis=1))
+    force = 1.0
+    for _ in range(20):  # a held object sits at its static deflection: scale the force to it
+        sim.pull(0, force * np.asarray(direction))
+        sim.step(dt)
+        d = np.linalg.norm(sim.tip_position(0) - tip_rest)
+        if abs(d / (deflection * length) - 1) < 1e-4:
+            break
+        force *= deflection * length / d
+    sim.release()
+    t, tips = trace_tips(sim, 0, seconds, dt)
+    return t - t[0], tips[:, 0] - tip_rest, sim
+
+
+# ---------------------------------------------------------------------------- free decay
+@pytest.mark.parametrize("dt", [1 / 10, 1 / 60, 1 / 1000])
+def test_free_decay_of_a_beam_has_the_set_f_and_zeta(dt):
+    tree = straight_beam()
+    w = rest_frames(tree)[0][:, 2]
+    u = rest_frames(tree)[0][:, 0]
+    f, zeta = (0.75, 0.9, 1.25), (0.045, 0.05, 0.08)
+    seconds = 20.0 if dt < 0.01 else 40.0
+    # A pull along w moves the tip along w with mode u (Eq. 2) ...
+    t, d, _ = release_trace(tree, f, zeta, w, dt, seconds)
+    fm, zm = fit_damped(t, d @ w)
+    assert fm == pytest.approx(0.75, rel=2e-3)
+    assert zm == pytest.approx(0.045, rel=2e-2)
+    assert np.max(np.abs(d @ u)) < 1e-6 * np.max(np.abs(d @ w))  # ... and nothing else
+    # ... a pull along u moves it along u with mode w (Eq. 4).
+    t, d, _ = release_trace(tree, f, zeta, u, dt, seconds)
+    fm, zm = fit_damped(t, d @ u)
+    assert fm == pytest.approx(1.25, rel=2e-3)
+    assert zm == pytest.approx(0.08, rel=2e-2)
+
+
+def test_euler_agrees_with_exact_at_small_dt():
+    tree = straight_beam()
+    d_dir = rest_frames(tree)[0] @ np.array([1.0, 0.0, 1.0]) / np.sqrt(2)
+    f, zeta = (0.8, 0.8, 1.1), (0.05, 0.05, 0.04)
+    _, de, _ = release_trace(tree, f, zeta, d_dir, 1 / 200, 8.0, "exact")
+    t, du, _ = release_trace(tree, f, zeta, d_dir, 1 / 200, 8.0, "euler")
+    amp = np.max(np.linalg.norm(de, axis=1))
+    assert np.max(np.linalg.norm(de - du, axis=1)) < 0.02 * amp
+    assert fit_damped(t, du @ rest_frames(tree)[0][:, 0])[0] == pytest.approx(1.1, rel=5e-3)
+
+
+def test_release_in_the_u_w_plane_shows_both_frequencies():
+    tree = ta.load_preset("beam")
+    F = rest_frames(tree)[0]
+    u, w = F[:, 0], F[:, 2]
+    f_u, f_w = 0.6, 1.0
+    sim_dir = (u + w) / np.sqrt(2)
+    t, d, sim = release_trace(tree, (f_u, f_u, f_w), (0.02, 0.02, 0.02), sim_dir, 1 / 50, 60.0,
+                              deflection=0.02)
+    freqs = np.fft.rfftfreq(len(t), t[1] - t[0])
+    for axis, own in ((w, f_u), (u, f_w)):
+        spec = np.abs(np.fft.rfft((d @ axis) * np.hanning(len(t))))
+        assert abs(freqs[np.argmax(spec)] - own) < 0.03
+    # along the pull, the motion carries both modes: the two strongest separated peaks
+    spec = np.abs(np.fft.rfft((d @ sim_dir) * np.hanning(len(t))))
+    i1 = np.argmax(spec)
+    mask = np.abs(freqs - freqs[i1]) > 0.15
+    i2 = np.flatnonzero(mask)[np.argmax(spec[mask])]
+    assert sorted([freqs[i1], freqs[i2]]) == pytest.approx([f_u, f_w], abs=0.03)
+    assert spec[i2] > 0.2 * spec[i1]
+
+
+# ---------------------------------------------------------------------------- pulls
+@pytest.mark.parametrize("angle", [0.0, 40.0, 90.0, 155.0, 250.0])
+def test_static_deflection_points_along_the_pull(angle):
+    for tree, obj in ((ta.load_preset("beam"), 0), (ta.load_preset("small_cherry"), 5)):
+        F = rest_frames(tree)[obj]
+        a = np.radians(angle)
+        direction = np.cos(a) * F[:, 0] + np.sin(a) * F[:, 2]
+        sim = Simulation(tree, coupling=False)
+        tip = tree.object_start[obj] + tree.object_count[obj] - 1
+        sim.pull(obj, 2.0 * direction)
+        sim.step(1 / 60)
+        first = sim.tip_position(obj)
+        for _ in range(5):
+            sim.step(1 / 60)
+        np.testing.assert_allclose(sim.tip_position(obj), first, atol=1e-12)  # held: no oscillation
+        d = first - tree.rest_positions[tip]
+        assert np.linalg.norm(d) > 1e-4
+        assert d @ direction > 0.95 * np.linalg.norm(d)
+
+
+def test_modal_loads_settle_at_the_load_unit_static_gain():
+    tree = straight_beam()
+    sim = Simulation(tree)
+    force = np.array([0.3, 0.0, -0.2])
+    sim.pull(0, force)
+    sim.release()
+    sim.step(1 / 60)  # nothing held now
+    sim2 = Simulation(tree, wind=None)
+    sim2.modes.zeta[:] = 0.4
+    sim2._pulls[0] = force  # a constant force, not held (the oscillators respond freely)
+    for _ in range(3000):
+        sim2.step(1 / 60)
+    np.testing.assert_allclose(sim2.modal_loads[0], sim2.loads[0][[2, 1, 0]] * [1, sim2._lever[0], 1], rtol=1e-9,
+                               atol=1e-12)
+
+
+def test_trunk_release_shakes_leaves_only_with_coupling(tree):
+    weak = dataclasses.replace(tree, physics=dataclasses.replace(tree.physics, ei_max=2000.0))
+    motion = {}
+    for coupling in (True, False):
+        sim = Simulation(weak, coupling=coupling)
+        sim.pull(0, (60.0, 0.0, 30.0))
+        for _ in range(30):
+            sim.step(1 / 60)
+        sim.release()
+        leaves = np.flatnonzero(weak.kind == "leaf")
+        tips = weak.object_start[leaves] + weak.object_count[leaves] - 1
+        att = weak.attach_node[leaves]
+        worst = 0.0
+        for _ in range(180):
+            sim.step(1 / 60)
+            R = sim.rotations
+            local = np.einsum("kji,kjl->kil", R[att], R[tips])  # leaf bend relative to its twig
+            worst = max(worst, float(np.max(np.linalg.norm(local - np.eye(3), axis=(1, 2)))))
+        motion[coupling] = worst
+        trunk_tip = sim.tip_position(0)
+        assert np.all(np.isfinite(trunk_tip))
+    assert motion[False] < 1e-9  # the paper's independent objects: nothing moves the leaves
+    assert motion[True] > 1e-2  # base excitation: the swinging trunk shakes them
+
+
+# ---------------------------------------------------------------------------- robustness
+@pytest.mark.parametrize("integrator", ["exact", "euler"])
+def test_one_step_of_several_seconds_stays_finite(integrator, tree):
+    sim = Simulation(tree, wind=Uniform((60.0, 0.0, 10.0)), integrator=integrator)
+    sim.pull(3, (0.0, -50.0, 20.0))
+    X = tree.rest_positions
+    within = tree.node_object[1:] == tree.node_object[:-1]
+    rest_len = np.linalg.norm(np.diff(X, axis=0), axis=1)[within]
+    for dt in (5.0, 1e-3, 30.0, 1 / 60, 1e4):
+        sim.step(dt)
+        P = sim.positions
+        assert np.all(np.isfinite(P)) and np.all(np.isfinite(sim.rotations))
+        np.testing.assert_allclose(np.linalg.norm(np.diff(P, axis=0), axis=1)[within], rest_len, rtol=1e-9)
+    sim.release()
+    sim.step(7.0)
+    assert np.all(np.isfinite(sim.positions))
+
+
+def test_determinism_per_seed(tree):
+    def run(seed, wind_seed=1):
+        sim = Simulation(tree, wind=ta.WindField(speed=8.0, seed=wind_seed), seed=seed)
+        for _ in range(20):
+            sim.step(1 / 60)
+        return sim.positions.copy(), sim.modes.f.copy()
+
+    p1, f1 = run(3)
+    p2, f2 = run(3)
+    np.testing.assert_array_equal(p1, p2)
+    np.testing.assert_array_equal(f1, f2)
+    p3, f3 = run(4)
+    assert not np.array_equal(f1, f3) and not np.array_equal(p1, p3)
+
+
+def test_reset_returns_to_rest(tree):
+    sim = Simulation(tree, wind=Uniform((10.0, 0.0, 0.0)))
+    sim.pull(2, (1.0, 0.0, 0.0))
+    for _ in range(5):
+        sim.step(1 / 60)
+    sim.reset()
+    assert sim.time == 0.0 and sim.pulls == {}
+    np.testing.assert_allclose(sim.positions, tree.rest_positions, atol=1e-12)
+
+
+def test_wind_bounds_are_fitted_to_the_tree(tree):
+    wind = ta.WindField(speed=5.0)
+    Simulation(tree, wind=wind)
+    X = tree.rest_positions
+    b = np.asarray(wind.bounds)
+    assert b[1, 1] == pytest.approx(X[:, 1].max())
+    assert np.all(b[0] <= X.min(axis=0) + 1e-9) and np.all(b[1] >= X.max(axis=0) - 1e-9)
+    own = ta.WindField(speed=5.0, bounds=((-1, 0, -1), (1, 20, 1)))
+    Simulation(tree, wind=own)
+    np.testing.assert_allclose(own.bounds, [[-1, 0, -1], [1, 20, 1]])
+
+
+def test_wind_bends_the_tree_downwind_and_harder_in_a_gale():
+    tree = ta.load_preset("small_cherry")
+    X = tree.rest_positions
+    top = np.argsort(X[:, 1])[-30:]
+    disp = {}
+    for speed in (5.0, 25.0):
+        sim = Simulation(tree, wind=Uniform((0.0, 0.0, speed)), coupling=False)
+        for _ in range(4):
+            sim.step(5.0)  # long steps: the static response
+        d = sim.positions[top] - X[top]
+        assert np.mean(d[:, 2]) > 0  # downwind (+z)
+        disp[speed] = np.mean(np.linalg.norm(d, axis=1))
+    assert 0.01 < disp[5.0] < 0.4  # a gentle sway: centimetres to decimetres
+    assert disp[25.0] > 3 * disp[5.0]
+
+
+# ---------------------------------------------------------------------------- bad input
+def snapshot(sim):
+    return (sim.time, sim.positions.copy(), sim.modal_loads, sim._pd.copy(), sim.season, sim.integrator,
+            dict(sim.pulls), sim.modes.f.copy())
+
+
+def assert_same(a, b):
+    assert a[0] == b[0] and a[4] == b[4] and a[5] == b[5]
+    for x, y in zip(a[1:4], b[1:4]):
+        np.testing.assert_array_equal(x, y)
+    assert a[6].keys() == b[6].keys()
+
+
+@pytest.fixture
+def busy(tree):
+    sim = Simulation(tree, wind=Uniform((4.0, 0.0, 1.0)))
+    sim.pull(1, (0.0, 0.0, 3.0))
+    for _ in range(4):
+        sim.step(1 / 60)
+    return sim
+
+
+@pytest.mark.parametrize("dt", [0.0, -0.01, float("nan"), float("inf"), -float("inf"), "fast", None])
+def test_bad_dt(busy, dt):
+    before = snapshot(busy)
+    with pytest.raises(ValueError, match="dt"):
+        busy.step(dt)
+    assert_same(before, snapshot(busy))
+
+
+@pytest.mark.parametrize("name, value", [("f", 0.0), ("f", -1.0), ("f", float("nan")), ("f", float("inf")),
+                                         ("zeta", -0.01), ("zeta", float("nan")), ("zeta", float("inf"))])
+def test_bad_modes(busy, name, value):
+    before = snapshot(busy)
+    arr = getattr(busy.modes, name)
+    old = arr[2, 1]
+    arr[2, 1] = value
+    with pytest.raises(ValueError, match=f"modes.{name}"):
+        busy.step(1 / 60)
+    a, b = before, snapshot(busy)
+    assert_same(a, b)
+    arr[2, 1] = old
+    busy.step(1 / 60)  # fixed: steps again
+    assert busy.time > before[0]
+
+
+def test_bad_modes_shape(busy):
+    busy.modes.f = np.ones((3, 3))
+    with pytest.raises(ValueError, match="modes.f"):
+        busy.step(1 / 60)
+
+
+@pytest.mark.parametrize("obj", [-1, 10**6, 1.5, "3", True, None])
+def test_bad_object_index(busy, obj):
+    before = snapshot(busy)
+    with pytest.raises(ValueError, match="object"):
+        busy.pull(obj, (1.0, 0.0, 0.0))
+    with pytest.raises(ValueError, match="object"):
+        busy.release(obj) if obj is not None else busy.tip_position(obj)
+    assert_same(before, snapshot(busy))
+
+
+@pytest.mark.parametrize("force", [(float("nan"), 0, 0), (0, float("inf"), 0), (1, 2), (1, 2, 3, 4), "up", None])
+def test_bad_pull_force(busy, force):
+    before = snapshot(busy)
+    with pytest.raises(ValueError, match="force"):
+        busy.pull(0, force)
+    assert_same(before, snapshot(busy))
+
+
+@pytest.mark.parametrize("season", [-0.1, 1.5, float("nan"), "winter", None])
+def test_bad_season(busy, tree, season):
+    before = snapshot(busy)
+    with pytest.raises(ValueError, match="season"):
+        busy.season = season
+    assert_same(before, snapshot(busy))
+    with pytest.raises(ValueError, match="season"):
+        Simulation(tree, season=season)
+
+
+def test_bad_integrator(busy, tree):
+    before = snapshot(busy)
+    with pytest.raises(ValueError, match="integrator"):
+        busy.integrator = "rk4"
+    assert_same(before, snapshot(busy))
+    with pytest.raises(ValueError, match="integrator"):
+        Simulation(tree, integrator="verlet")
+
+
+def test_bad_constructor_arguments(tree):
+    with pytest.raises(ValueError, match="seed"):
+        Simulation(tree, seed=-1)
+    with pytest.raises(ValueError, match="tree"):
+        Simulation("small_cherry")
+    with pytest.raises(ValueError, match="wind"):
+        Simulation(tree, wind=42)
