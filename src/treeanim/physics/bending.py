@@ -47,7 +47,7 @@ NEWTON_TOL = 1e-7
 #: Halley iterations run on every segment; from the previous step's angle (a warm start) two
 #: usually converge. Segments not converged by then continue alone (Newton, then bisection), so
 #: the tolerance always holds.
-NEWTON_FIXED = 3
+NEWTON_FIXED = 2
 #: Further Newton iterations for the stragglers before bisection takes over.
 NEWTON_EXTRA = 12
 #: Blocks with at most this many segments (the tail of long objects: a tulip poplar's trunk
@@ -155,33 +155,34 @@ def solve_bend_angle(nn: np.ndarray, dot: np.ndarray, k: np.ndarray, theta0: np.
 
 
 def _stragglers(phi, a, k, theta0, tol):
-    """Newton then bisection for the few entries the fixed iterations did not converge."""
-    # Newton from the right of the root converges monotonically (h concave): start from the
-    # current iterate where it lies there, else from θ₀.
-    h, _, _ = _residual(phi, a, theta0, k)
-    phi = np.where(h <= 0, phi, theta0)
-    done = np.zeros(len(phi), bool)
+    """More safeguarded Halley iterations for the entries the fixed ones left unconverged,
+    each dropped once converged; bisection for any that still are not."""
+    out = phi.copy()
+    idx = np.arange(len(phi))
     for _ in range(NEWTON_EXTRA):
-        h, hp, _ = _residual(phi, a, theta0, k)
-        new = np.clip(phi + h / hp, 0.0, theta0)
-        done |= np.abs(new - phi) < tol
-        if done.all():
-            return phi
-        phi = np.where(done, phi, new)
+        h, hp, m = _residual(phi, a, theta0, k)
+        new = h * hp / (hp * hp + 0.5 * h * m)
+        new += phi
+        new = np.where(hp > 0, new, theta0)  # left of the apex: restart right of the root
+        np.clip(new, 0.0, theta0, out=new)
+        done = (np.abs(new - phi) < tol) & (hp > 0)
+        out[idx[done]] = phi[done]
+        keep = ~done
+        if not keep.any():
+            return out
+        idx, phi, a, k, theta0 = idx[keep], new[keep], a[keep], k[keep], theta0[keep]
         phi = np.where(np.isfinite(phi), phi, 0.5 * theta0)
     # Bisection on [0, θ₀] (h(0) >= 0 >= h(θ₀)) for the rest: always converges.
     lo = np.zeros_like(phi)
     hi = theta0.copy()
-    todo = ~done
-    for _ in range(64):
+    while np.any(hi - lo >= tol):
         mid = 0.5 * (lo + hi)
         h, _, _ = _residual(mid, a, theta0, k)
         pos = h > 0
-        lo = np.where(todo & pos, mid, lo)
-        hi = np.where(todo & ~pos, mid, hi)
-        if np.all(hi - lo < tol):
-            break
-    return np.where(todo, 0.5 * (lo + hi), phi)
+        lo = np.where(pos, mid, lo)
+        hi = np.where(pos, hi, mid)
+    out[idx] = 0.5 * (lo + hi)
+    return out
 
 
 def rest_frames(tree) -> np.ndarray:
