@@ -32,34 +32,6 @@ class Workspace:
 
 _DEFAULT_WS = Workspace()
 
-#: Below this many columns the helpers use a few einsum calls instead of many scalar-row passes
-#: (numpy's per-call overhead dominates small arrays).
-SMALL = 256
-
-# a ⊗ b = L(a) b with L(a)[i, j] = SIGN[i, j] · a[IDX[i, j]]
-_QMUL_IDX = np.array([[0, 1, 2, 3], [1, 0, 3, 2], [2, 3, 0, 1], [3, 2, 1, 0]])
-_QMUL_SIGN = np.array([[1, -1, -1, -1], [1, 1, -1, 1], [1, 1, 1, -1], [1, -1, 1, 1]], float)[:, :, None]
-# R[a, b] = Σ_ij _QMAT[a, b, i, j] q_i q_j (q = (w, x, y, z)), for unit q
-_QMAT = np.zeros((3, 3, 4, 4))
-for (a_, b_), terms in {
-    (0, 0): [(0, 0, 1), (1, 1, 1), (2, 2, -1), (3, 3, -1)],
-    (1, 1): [(0, 0, 1), (1, 1, -1), (2, 2, 1), (3, 3, -1)],
-    (2, 2): [(0, 0, 1), (1, 1, -1), (2, 2, -1), (3, 3, 1)],
-    (0, 1): [(1, 2, 2), (0, 3, -2)], (1, 0): [(1, 2, 2), (0, 3, 2)],
-    (0, 2): [(1, 3, 2), (0, 2, 2)], (2, 0): [(1, 3, 2), (0, 2, -2)],
-    (1, 2): [(2, 3, 2), (0, 1, -2)], (2, 1): [(2, 3, 2), (0, 1, 2)],
-}.items():
-    for i_, j_, c_ in terms:
-        _QMAT[a_, b_, i_, j_] = c_
-del a_, b_, terms, i_, j_, c_
-
-
-def _qmat_small(q: np.ndarray, conj: bool = False) -> np.ndarray:
-    """(3, 3, K) matrices of (4, K) quaternions in a few calls (R = Σ C·q qᵀ)."""
-    R = np.einsum("abij,ik,jk->abk", _QMAT, q, q)
-    return R.transpose(1, 0, 2) if conj else R
-
-
 def sincos(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """sin x, cos x and 1 − cos x for |x| <= π, from t = tan(x/2).
 
@@ -94,10 +66,6 @@ def qmul(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None,
     K = b.shape[1]
     if out is None:
         out = np.empty((4, K))
-    if K < SMALL:
-        L = a[_QMUL_IDX] * _QMUL_SIGN
-        np.einsum("ijk,jk->ik", L, b, out=out)
-        return out
     tmp = (ws or _DEFAULT_WS).get("qmul", (K,))
     a0, a1, a2, a3 = a
     b0, b1, b2, b3 = b
@@ -132,9 +100,6 @@ def qrot(q: np.ndarray, v: np.ndarray, conj: bool = False, out: np.ndarray | Non
     ws = ws or _DEFAULT_WS
     if out is None:
         out = np.empty((3, K))
-    if K < SMALL:
-        np.einsum("abk,bk->ak", _qmat_small(np.broadcast_to(q, (4, K)), conj), v, out=out)
-        return out
     t = ws.get("qrot_t", (3, K))
     tmp = ws.get("qrot_tmp", (K,))
     w = q[0]
