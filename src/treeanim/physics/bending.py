@@ -80,7 +80,7 @@ def _residual(phi, a, theta0, k):
 
 def solve_bend_angle(nn: np.ndarray, dot: np.ndarray, k: np.ndarray, theta0: np.ndarray,
                      phi0: np.ndarray | None = None, tol: float = NEWTON_TOL,
-                     fixed: int = NEWTON_FIXED) -> tuple[np.ndarray, np.ndarray]:
+                     fixed: int = NEWTON_FIXED, a: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Solve |F||s| sin(θ₀ − φ) = k φ for φ ∈ [0, θ₀] (Eqs. 8–9), vectorised.
 
     With a = |F||s| (``a·sin θ₀ = |s × F|`` = ``nn``, ``a·cos θ₀ = s·F`` = ``dot``) the
@@ -106,6 +106,8 @@ def solve_bend_angle(nn: np.ndarray, dot: np.ndarray, k: np.ndarray, theta0: np.
         Convergence: the last correction is below ``tol``.
     fixed : int
         Iterations run on every entry.
+    a : (K,) float, optional
+        |F||s| if the caller has it (else hypot(nn, dot)).
 
     Returns
     -------
@@ -115,13 +117,15 @@ def solve_bend_angle(nn: np.ndarray, dot: np.ndarray, k: np.ndarray, theta0: np.
         tan(φ/2).
     """
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        a = np.hypot(nn, dot)
+        if a is None:
+            a = np.hypot(nn, dot)
         if phi0 is None:
             den = k + dot
             phi = nn / den
             phi = np.where((den > 0) & (phi < theta0), phi, theta0)
         else:
-            phi = np.clip(phi0, 0.0, theta0)
+            phi = np.maximum(phi0, 0.0)
+            np.minimum(phi, theta0, out=phi)
         fixed = max(int(fixed), 1)
         for it in range(fixed):
             h, hp, m = _residual(phi, a, theta0, k)
@@ -138,7 +142,8 @@ def solve_bend_angle(nn: np.ndarray, dot: np.ndarray, k: np.ndarray, theta0: np.
             hp += m
             new /= hp
             new += phi
-            np.clip(new, 0.0, theta0, out=new)  # NaN stays NaN and is caught below
+            np.maximum(new, 0.0, out=new)
+            np.minimum(new, theta0, out=new)  # NaN stays NaN and is caught below
             if it + 1 < fixed:
                 phi = new
         new -= phi
@@ -163,15 +168,18 @@ def _stragglers(phi, a, k, theta0, tol):
         h, hp, m = _residual(phi, a, theta0, k)
         new = h * hp / (hp * hp + 0.5 * h * m)
         new += phi
-        new = np.where(hp > 0, new, theta0)  # left of the apex: restart right of the root
-        np.clip(new, 0.0, theta0, out=new)
-        done = (np.abs(new - phi) < tol) & (hp > 0)
+        right = hp > 0
+        new = np.where(right, new, theta0)  # left of the apex: restart right of the root
+        np.maximum(new, 0.0, out=new)
+        np.minimum(new, theta0, out=new)
+        done = np.abs(new - phi) < tol
+        done &= right
+        if done.all():
+            out[idx] = phi
+            return out
         out[idx[done]] = phi[done]
         keep = ~done
-        if not keep.any():
-            return out
         idx, phi, a, k, theta0 = idx[keep], new[keep], a[keep], k[keep], theta0[keep]
-        phi = np.where(np.isfinite(phi), phi, 0.5 * theta0)
     # Bisection on [0, θ₀] (h(0) >= 0 >= h(θ₀)) for the rest: always converges.
     lo = np.zeros_like(phi)
     hi = theta0.copy()
@@ -267,6 +275,7 @@ class BendingPlan:
         self.seg = []  # (3, K_i) rest segment vectors in each object's local frame
         self.seg_len2 = []  # (K_i,) |sᵢ|²
         self.frac = []  # (K_i,) (n − i)/n of Eq. 7
+        self.frac_len = []  # (K_i,) (n − i)/n · |sᵢ|
         self.taper = []  # (K_i,) D_i of Eq. 10
         diam = np.asarray(tree.node_diameter, float)
         d_root = diam[start]
@@ -288,6 +297,7 @@ class BendingPlan:
             self.seg_len2.append(np.einsum("ik,ik->k", s, s))
             n = nseg[objs].astype(float)
             self.frac.append((n - i) / n)
+            self.frac_len.append(self.frac[-1] * np.sqrt(self.seg_len2[-1]))  # |Fᵢ||sᵢ| / |F|
             t = i / np.maximum(n - 1, 1)
             self.taper.append(d_root[objs] - (d_root[objs] - d_tip[objs]) * t)
         self.flat_of_node = flat_of_node
@@ -356,6 +366,7 @@ class BendingPlan:
         sv = th
         sv *= cv
         np.negative(sv, out=sv)
+        Fmag = np.hypot(Fu, Fw)  # |F| per object
         prev = None
         prev_o = None
         for i, K in enumerate(self.counts):
@@ -402,12 +413,12 @@ class BendingPlan:
                 dot = mul(sx, fu)
                 dot += mul(sz, fw, out=tmp)
                 theta0 = np.arctan2(nn, dot)
-            phi, t = solve_bend_angle(nn, dot, k[i], theta0, mul(rho_start[a:b], theta0))  # Eqs. 8–9
+            amag = mul(Fmag[:K], self.frac_len[i], out=ws.get("amag", (K,)))  # a = |Fᵢ||sᵢ|
+            phi, t = solve_bend_angle(nn, dot, k[i], theta0, mul(rho_start[a:b], theta0),
+                                      a=amag)  # Eqs. 8–9
             # No bend where the force is zero or (anti)parallel to the segment.
-            a2 = mul(dot, dot, out=tmp)
-            a2 += mul(nn, nn)
-            a2 *= 1e-24
-            ok = mul(nn, nn) > a2
+            amag *= 1e-12
+            ok = nn > amag
             phi *= ok
             t *= ok
             inv = np.divide(1.0, nn, out=np.zeros_like(nn), where=ok)
@@ -489,8 +500,9 @@ class BendingPlan:
                 nn = sqrt(n0 * n0 + n1 * n1 + n2 * n2)
                 dot = spx * fu + spz * fw
                 theta0 = atan2(nn, dot)
-                if nn * nn > 1e-24 * (dot * dot + nn * nn):
-                    phi = _solve_scalar(math.hypot(nn, dot), theta0, float(k[i][j]),
+                amag = math.hypot(fu, fw) * math.sqrt(float(self.seg_len2[i][j]))  # |Fᵢ||sᵢ|
+                if nn > 1e-12 * amag:
+                    phi = _solve_scalar(amag, theta0, float(k[i][j]),
                                         float(rho_start[slot]) * theta0)  # Eqs. 8–9
                     t, inv = tan(0.5 * phi), 1.0 / nn
                 else:
