@@ -9,7 +9,8 @@ attach node plus ``f`` applied to the local bent offset Σ_{i<j} Cᵢ sᵢ.
 Within a step only the *structural* objects — those that carry children — are composed node
 by node, level by level (each level one vectorised pass); every other object (leaves, outer
 twigs, grass blades: the bulk of the nodes) needs only its frame f and base, per object. The
-full per-node pose is assembled on demand by :meth:`CompositionPlan.full_pose`.
+full per-node pose is assembled on demand by :meth:`CompositionPlan.positions` and
+:meth:`CompositionPlan.rotations`.
 """
 
 from __future__ import annotations
@@ -57,6 +58,7 @@ class CompositionPlan:
         is_root = parent < 0
         self.q0 = np.ascontiguousarray(q0)
         self.q0_conj = qconj(self.q0)
+        self.q0c_node = np.ascontiguousarray(self.q0_conj[:, node_obj])
         self.q_rel = self.q0.copy()
         nr = np.flatnonzero(~is_root)
         if len(nr):
@@ -115,33 +117,46 @@ class CompositionPlan:
         f = qmul(fp, self.q_rel, out=qo, ws=ws)
         return f, np.take(P, self.base_src, axis=1, out=bo)
 
-    def full_pose(self, q_flat: np.ndarray, o_flat: np.ndarray, f: np.ndarray, base: np.ndarray,
-                  want_positions: bool = True, want_rotations: bool = True):
-        """World positions (N, 3) and rotations relative to rest (N, 3, 3) of every node.
+    def node_frames(self, f: np.ndarray) -> np.ndarray:
+        """(4, N) each node's object frame f (a view of a scratch array, valid until the next call)."""
+        return np.take(f, self.node_obj, axis=1, out=self.ws.get("fn", (4, self.N)))
+
+    def positions(self, o_flat: np.ndarray, fn: np.ndarray, base: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """(N, 3) world positions: base + f ⊗ (bent local offset).
 
         Parameters
         ----------
-        q_flat, o_flat : arrays
-            The bending pass's local rotations and bent offsets.
-        f : (4, M) float
-            Each object's carried frame.
+        o_flat : (3, S + 1) float
+            The bending pass's bent offsets.
+        fn : (4, N) float
+            From :meth:`node_frames`.
         base : (3, M) float
             Each object's deformed base position.
-        want_positions, want_rotations : bool
-            Which outputs to build (None for the other).
+        out : (N, 3) float, optional
         """
         ws = self.ws
         N = self.N
-        fn = np.take(f, self.node_obj, axis=1, out=ws.get("fn", (4, N)))
-        positions = rotations = None
-        if want_positions:
-            on = np.take(o_flat, self.ofs_of_node, axis=1, out=ws.get("on", (3, N)))
-            pos = qrot(fn, on, out=ws.get("pos", (3, N)), ws=ws)
-            pos += np.take(base, self.node_obj, axis=1, out=ws.get("bn", (3, N)))
-            positions = np.ascontiguousarray(pos.T)
-        if want_rotations:
-            qn = np.take(q_flat, self.flat_of_node, axis=1, out=ws.get("qn", (4, N)))
-            g = qmul(fn, qn, out=ws.get("g", (4, N)), ws=ws)
-            q0c = np.take(self.q0_conj, self.node_obj, axis=1, out=ws.get("q0c", (4, N)))
-            rotations = qmat(qmul(g, q0c, out=ws.get("r", (4, N)), ws=ws), ws=ws)
-        return positions, rotations
+        on = np.take(o_flat, self.ofs_of_node, axis=1, out=ws.get("on", (3, N)))
+        pos = qrot(fn, on, out=ws.get("pos", (3, N)), ws=ws)
+        pos += np.take(base, self.node_obj, axis=1, out=ws.get("bn", (3, N)))
+        if out is None:
+            out = np.empty((N, 3))
+        out[...] = pos.T
+        return out
+
+    def rotations(self, q_flat: np.ndarray, fn: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+        """(N, 3, 3) world rotations relative to rest: f ⊗ C ⊗ q₀* per node.
+
+        Parameters
+        ----------
+        q_flat : (4, S + 1) float
+            The bending pass's local rotations.
+        fn : (4, N) float
+            From :meth:`node_frames`.
+        out : (N, 3, 3) float, optional
+        """
+        ws = self.ws
+        N = self.N
+        qn = np.take(q_flat, self.flat_of_node, axis=1, out=ws.get("qn", (4, N)))
+        g = qmul(fn, qn, out=ws.get("g", (4, N)), ws=ws)
+        return qmat(qmul(g, self.q0c_node, out=ws.get("r", (4, N)), ws=ws), out=out, ws=ws)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import sys
 from collections.abc import Iterable
 
 import numpy as np
@@ -171,6 +172,7 @@ class Simulation:
         self._present.setflags(write=False)
 
         self._pulls: dict[int, np.ndarray] = {}
+        self._pos_buf = self._rot_buf = None
         self._coef_cache: dict[float, tuple] = {}
         self._wind = None
         self.wind = wind
@@ -432,14 +434,33 @@ class Simulation:
         """(N, 3) rest node positions (the tree's)."""
         return self._tree.rest_positions
 
+    def _node_frames(self) -> np.ndarray:
+        if self._fn is None:
+            self._fn = self._cplan.node_frames(self._frame)
+        return self._fn
+
+    @staticmethod
+    def _recycled(old, shape):
+        """``old`` if nobody outside holds it any more (so writing to it is invisible), else a
+        new array: outputs are fresh arrays for whoever keeps them, without a fresh allocation
+        (and its page faults) every frame for whoever does not."""
+        if old is not None and sys.getrefcount(old) <= 3:  # the attribute, the argument, getrefcount's
+            old.setflags(write=True)
+            return old
+        return np.empty(shape)
+
     @property
     def positions(self) -> np.ndarray:
-        """(N, 3) deformed world node positions (read-only; built on first access after a step)."""
+        """(N, 3) deformed world node positions (read-only; built on first access after a step).
+
+        An array you keep is never changed by later steps.
+        """
         if self._pos_out is None:
-            pos, _ = self._cplan.full_pose(self._bplan.q, self._bplan.o, self._frame, self._base,
-                                           want_rotations=False)
+            buf = self._recycled(self._pos_buf, (self._N, 3))
+            self._pos_buf = None
+            pos = self._cplan.positions(self._bplan.o, self._node_frames(), self._base, out=buf)
             pos.setflags(write=False)
-            self._pos_out = pos
+            self._pos_out = self._pos_buf = pos
         return self._pos_out
 
     @property
@@ -447,12 +468,14 @@ class Simulation:
         """(N, 3, 3) world rotations relative to rest of the segment leaving each node.
 
         See the class notes for the convention. Read-only; built on first access after a step.
+        An array you keep is never changed by later steps.
         """
         if self._rot_out is None:
-            _, rot = self._cplan.full_pose(self._bplan.q, self._bplan.o, self._frame, self._base,
-                                           want_positions=False)
+            buf = self._recycled(self._rot_buf, (self._N, 3, 3))
+            self._rot_buf = None
+            rot = self._cplan.rotations(self._bplan.q, self._node_frames(), out=buf)
             rot.setflags(write=False)
-            self._rot_out = rot
+            self._rot_out = self._rot_buf = rot
         return self._rot_out
 
     @property
@@ -547,6 +570,7 @@ class Simulation:
         self._pulls.clear()
         self._pos_out = None
         self._rot_out = None
+        self._fn = None
 
     def step(self, dt: float) -> None:
         """Advance the simulation by ``dt`` seconds (DESIGN §6).
@@ -651,6 +675,7 @@ class Simulation:
         self._time = t + dt
         self._pos_out = None
         self._rot_out = None
+        self._fn = None
 
 
 def _polygon_centroid(xy: np.ndarray) -> tuple[float, float]:
