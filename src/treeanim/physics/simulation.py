@@ -26,8 +26,15 @@ INTEGRATORS = ("exact", "euler")
 #: the finite-difference acceleration finite and smooth at any dt and delays it by ~10 ms.
 ACCEL_TAU = 0.01
 
-#: The wind's default bounds; a wind still on them has "no bounds of its own" and is fitted.
-_WIND_DEFAULT_BOUNDS = ((-5.0, 0.0, -5.0), (5.0, 10.0, 5.0))
+
+
+def _wind_default_bounds():
+    """The WindField's default bounds: a wind still on them has "no bounds of its own"."""
+    try:
+        from .wind import DEFAULT_BOUNDS
+    except ImportError:  # pragma: no cover - the wind module is part of the package
+        return ((-5.0, 0.0, -5.0), (5.0, 10.0, 5.0))
+    return DEFAULT_BOUNDS
 
 
 def _finite_float(name: str, value) -> float:
@@ -233,8 +240,7 @@ class Simulation:
         self._ws = Workspace()
         o = self._bplan.order
         self._neg_half_pi_over_n_ord = -0.5 * np.pi / self._nseg[o]
-        mins, maxs = X.min(axis=0), X.max(axis=0)
-        self._rest_bounds = (mins, maxs)
+        self._rest_bounds = (X.min(axis=0), X.max(axis=0))
 
     def _derive_physics(self) -> None:
         """Stiffness, gains, masses and twist constants from ``self._physics``."""
@@ -302,14 +308,18 @@ class Simulation:
                 and np.array_equal(z, snap[3]):
             return snap[4], snap[5]
         shape = (self._M, 3)
-        fa = np.asarray(f, dtype=float) if not isinstance(f, np.ndarray) else f
-        za = np.asarray(z, dtype=float) if not isinstance(z, np.ndarray) else z
+        try:
+            fa = np.asarray(f, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"modes.f must be a ({self._M}, 3) array of numbers") from None
+        try:
+            za = np.asarray(z, dtype=float)
+        except (TypeError, ValueError):
+            raise ValueError(f"modes.zeta must be a ({self._M}, 3) array of numbers") from None
         if fa.shape != shape:
             raise ValueError(f"modes.f must have shape {shape}, got {fa.shape}")
         if za.shape != shape:
             raise ValueError(f"modes.zeta must have shape {shape}, got {za.shape}")
-        fa = fa.astype(float)
-        za = za.astype(float)
         badf = ~(np.isfinite(fa) & (fa > 0))
         if badf.any():
             j, c = np.argwhere(badf)[0]
@@ -418,16 +428,23 @@ class Simulation:
         self._wind = wind
 
     def _fit_wind(self, wind) -> None:
+        """Fit a wind that has no bounds of its own (None or the default) to the rest box."""
+        if not (hasattr(wind, "fit") or hasattr(wind, "bounds")):
+            return  # a field that needs no bounds
         b = getattr(wind, "bounds", None)
-        if b is None or np.allclose(np.asarray(b, float), _WIND_DEFAULT_BOUNDS):
-            lo, hi = self._rest_bounds
-            if hasattr(wind, "fit"):
-                wind.fit((tuple(lo), tuple(hi)))
-            elif hasattr(type(wind), "bounds") or b is None:
-                try:
-                    wind.bounds = (tuple(lo), tuple(hi))
-                except AttributeError:
-                    pass
+        if b is not None:
+            try:
+                own = not np.allclose(np.asarray(b, float), _wind_default_bounds())
+            except (TypeError, ValueError):
+                own = True
+            if own:
+                return
+        lo, hi = self._rest_bounds
+        box = (tuple(map(float, lo)), tuple(map(float, hi)))
+        if hasattr(wind, "fit"):
+            wind.fit(box)
+        else:
+            wind.bounds = box
 
     @property
     def rest_positions(self) -> np.ndarray:
