@@ -160,6 +160,199 @@ def cmd_export(args) -> int:
     return 0
 
 
+# ---------------------------------------------------------------------------- render | trace | bench
+def _one_line_errors(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """Report ``p``'s bad options as one line on stderr, exit status 2 (no usage dump)."""
+
+    def error(message: str):
+        print(f"{p.prog}: error: {message} (see '{p.prog} --help')", file=sys.stderr)
+        sys.exit(2)
+
+    p.error = error
+    return p
+
+
+def _size(text: str) -> tuple[int, int]:
+    from treeanim.offline import InputError, parse_size
+
+    try:
+        return parse_size(text)
+    except InputError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+
+
+def _finite(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if value != value or value in (float("inf"), float("-inf")):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
+def _samples(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= 64:
+        raise argparse.ArgumentTypeError(f"expected an integer in [0, 64], got {text!r}")
+    return value
+
+
+def _force(text: str):
+    from treeanim.scripted import parse_vector
+
+    try:
+        return parse_vector(text, "force")
+    except ValueError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+
+
+def _writable(text: str, suffixes: tuple[str, ...], option: str = "--out"):
+    """:func:`output_path`, then a real try at creating a file in its folder."""
+    from treeanim import offline
+
+    try:
+        path = output_path(text, suffixes)
+        offline.check_folder(path.parent, text)
+    except (UsageError, offline.InputError) as e:
+        raise UsageError(str(e).replace("--out ", f"{option} ", 1)) from None
+    return path
+
+
+def _mb(n: int) -> str:
+    return f"{n / 1e6:.1f} MB" if n >= 1e5 else f"{n / 1e3:.0f} kB"
+
+
+def cmd_render(args) -> int:
+    """Render an MP4 / GIF, a folder of PNG frames, or one PNG still, offscreen."""
+    from treeanim import offline
+
+    try:
+        target = offline.render_target(args.out)
+    except offline.InputError as e:
+        raise UsageError(str(e)) from None
+    seconds = args.seconds if args.seconds is not None else (
+        offline.STILL_SECONDS if target.kind == "still" else 5.0)
+    w, h = args.size
+    job = offline.RenderJob(target, w, h, args.fps, seconds, start=args.start, season=args.season, pulls=args.pull,
+                            azimuth=args.azimuth, elevation=args.elevation, distance=args.distance,
+                            samples=args.samples, quiet=args.quiet)
+    if target.kind != "still" and job.frame_range()[1] < 1:
+        raise UsageError(f"--seconds {seconds:g} at --fps {args.fps:g} gives no frame")
+    tree, sim = make_simulation(args)
+    try:
+        res = offline.run_render(job, tree, sim, log=lambda m: print(m, file=sys.stderr))
+    except offline.GLUnavailable as e:
+        print(f"treeanim: error: {e}", file=sys.stderr)
+        return 1
+    if target.kind == "still":
+        print(f"wrote {res.path}: {w}×{h}, {tree.name} after {job.start + seconds:g} s, {_mb(res.bytes)}")
+        return 0
+    what = f"{res.frames} frame{'s' * (res.frames != 1)}"
+    dur = f"{res.frames / args.fps:.2f} s at {args.fps:g} fps"
+    if target.kind == "video":
+        pad = f", padded to {res.size[0]}×{res.size[1]}" if res.size != (w, h) else ""
+        where = f"{res.path} ({w}×{h}{pad}, {dur}, {_mb(res.bytes)})"
+    else:
+        last = offline.FRAME_NAME.format(max(res.frames - 1, 0))
+        where = f"{res.path}/: {offline.FRAME_NAME.format(0)} … {last} ({w}×{h}, {dur}, {_mb(res.bytes)})"
+    if res.interrupted:
+        if res.kept:
+            print(f"interrupted: kept {what} of {res.total} in {where}", file=sys.stderr)
+        else:
+            print("interrupted before the first frame: nothing written", file=sys.stderr)
+        return 130
+    print(f"wrote {what} to {where}")
+    return 0
+
+
+def cmd_trace(args) -> int:
+    """Pull one object's tip, let go, and record the tip's free swing as CSV (and a plot)."""
+    import numpy as np
+
+    from treeanim import offline
+
+    out = _writable(args.out, (".csv",))
+    plot = _writable(args.plot, (".png", ".svg", ".pdf"), "--plot") if args.plot else None
+    if plot is not None:
+        try:
+            import matplotlib  # noqa: F401
+        except ImportError:
+            raise UsageError("--plot needs matplotlib (pip install 'treeanim[plots]')") from None
+    scene = argparse.Namespace(**vars(args))
+    scene.pull = []
+    tree, sim = make_simulation(scene)
+    if not 0 <= args.object < tree.n_objects:
+        raise UsageError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
+    tr = offline.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
+    offline.write_trace_csv(out, tr)
+    if plot is not None:
+        offline.plot_trace(plot, tr, title=f"{tree.name}: pull {','.join(f'{v:g}' for v in args.pull)} N, "
+                                           f"released after {args.hold:g} s")
+    d = tr.tips - tr.rest
+    f, z = tr.f, tr.zeta
+    fx = offline.zero_crossing_frequency(tr.times, d[:, 0] - d[-len(d) // 4:, 0].mean())
+    fz = offline.zero_crossing_frequency(tr.times, d[:, 2] - d[-len(d) // 4:, 2].mean())
+    print(f"wrote {out}: {len(tr.times)} samples of object {args.object} ({tr.kind})'s tip over {args.seconds:g} s "
+          f"after release at {args.rate:g} Hz" + (f"; plot {plot}" if plot else ""))
+    print(f"held deflection {np.linalg.norm(tr.held - tr.rest) * 100:.1f} cm; modes f u,v,w = "
+          f"{f[0]:.3f}, {f[1]:.3f}, {f[2]:.3f} Hz, ζ = {z[0]:.3f}, {z[1]:.3f}, {z[2]:.3f}; "
+          f"zero crossings: x {fx:.3f} Hz, z {fz:.3f} Hz")
+    return 0
+
+
+def cmd_bench(args) -> int:
+    """The paper's Table 1 beside ours, measured on this machine."""
+    import json
+
+    import treeanim as ta
+    from treeanim import offline
+
+    keys = args.presets or list(offline.BENCH_ROWS)
+    known = list(offline.BENCH_ROWS) + [p for p in ta.list_presets() if p not in offline.BENCH_ROWS]
+    for k in keys:
+        if k not in known:
+            raise UsageError(f"--presets {k}: unknown; expected some of {', '.join(known)}")
+    out = _writable(args.json, (".json",), "--json") if args.json else None
+    w, h = args.size
+    try:
+        res = offline.run_bench(keys, w, h, frames=args.frames, steps=args.steps, samples=args.samples,
+                                wind=args.wind, quiet=args.quiet)
+    except offline.GLUnavailable as e:
+        print(f"treeanim: error: {e}", file=sys.stderr)
+        return 1
+    print(offline.format_bench(res))
+    if out is not None:
+        offline.write_text(out, json.dumps(res, indent=2) + "\n")
+        print(f"wrote {out}")
+    return 0
+
+
+# ---------------------------------------------------------------------------- view
+def _window_size(text: str) -> tuple[int, int]:
+    """WxH, e.g. 1280x720: the viewer's window size in screen units."""
+    m = re.fullmatch(r"\s*(\d{1,5})\s*[xX×]\s*(\d{1,5})\s*", text)
+    if not m or not (1 <= int(m.group(1)) <= 16384 and 1 <= int(m.group(2)) <= 16384):
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT such as 1280x720, got {text!r}")
+    return int(m.group(1)), int(m.group(2))
+
+
+def cmd_view(args) -> int:
+    """Open the interactive viewer (the default command)."""
+    from treeanim.app.main import ViewerUnavailable, view
+
+    tree = load_any(args.preset)
+    try:
+        view(tree, season=args.season, wind_speed=args.wind, size=args.size, frames=args.frames,
+             samples=args.samples)
+    except ViewerUnavailable as e:
+        raise UsageError(str(e)) from None
+    return 0
+
+
 def load_any(name_or_path: str):
     """A preset by name, or a preset TOML file by path."""
     import treeanim as ta
@@ -226,6 +419,75 @@ def build_parser() -> argparse.ArgumentParser:
                    help="make the clip loop by cross-fading this many seconds of its end into its start (default 0)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_export)
+
+    p = _one_line_errors(sub.add_parser(
+        "render", help="render a video (.mp4, .gif), PNG frames (a folder) or one PNG still, offscreen",
+        description="Simulate and render offscreen (EGL): a video (.mp4 H.264, or .gif), a folder of PNG frames "
+        "(frame_00000.png, ...), or one .png still of the state after --seconds. Ctrl-C stops after the current "
+        "frame and keeps a playable file of what was rendered."))
+    add_scene_options(p)
+    for a in p._actions:
+        if a.dest == "seconds":  # a still's default differs from a clip's
+            a.default = None
+            a.help = "clip length in seconds (default 5); for a .png, the time simulated before the still (default 2)"
+    p.add_argument("--out", required=True,
+                   help="clip.mp4 | clip.gif | frames/ (a folder of PNG frames) | still.png")
+    p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH", help="image size (default 1280x720)")
+    p.add_argument("--start", type=_non_negative, default=0.0, metavar="SECONDS",
+                   help="simulated time of the first frame; the tree starts from rest at 0 (default 0)")
+    p.add_argument("--azimuth", type=_finite, default=0.0, metavar="DEG",
+                   help="camera direction about the vertical; 0 looks along -z, the default wind blows left "
+                   "to right (default 0)")
+    p.add_argument("--elevation", type=_finite, default=None, metavar="DEG",
+                   help="camera height angle above the horizon (default 2, or 25 for flat scenes like grass)")
+    p.add_argument("--distance", type=_positive(float), default=None, metavar="METRES",
+                   help="camera distance to the tree's centre (default: framed on the tree)")
+    p.add_argument("--samples", type=_samples, default=4, help="MSAA samples (default 4; 0 = none)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_render)
+
+    p = _one_line_errors(sub.add_parser(
+        "trace", help="pull one object's tip, let go, and record its trace (CSV, optional plot)",
+        description="Pull object OBJECT's tip with a constant world force until it sits at its static "
+        "deflection, let go, and record the tip's position (t, x, y, z) for --seconds at --rate samples per "
+        "second: the Lissajous / harmonograph trace of the paper's Figs. 1 and 4."))
+    p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
+    p.add_argument("--object", type=int, default=0, metavar="I", help="object index (default 0, e.g. the beam)")
+    p.add_argument("--pull", type=_force, required=True, metavar="FX,FY,FZ",
+                   help="world force on the tip in newtons, e.g. 500,0,400")
+    p.add_argument("--hold", type=_positive(float), default=2.0, metavar="SECONDS",
+                   help="how long the pull is held before release (default 2)")
+    p.add_argument("--seconds", type=_positive(float), default=10.0, help="seconds recorded after release (default 10)")
+    p.add_argument("--rate", type=_positive(float), default=240.0, metavar="HZ",
+                   help="samples (and simulation steps) per second (default 240)")
+    p.add_argument("--out", required=True, help="trace.csv (columns t,x,y,z; t = 0 at release)")
+    p.add_argument("--plot", default=None, metavar="FILE",
+                   help="also plot the horizontal (x-z) trace: .png, .svg or .pdf (needs matplotlib)")
+    p.add_argument("--wind", type=_non_negative, default=0.0, metavar="SPEED",
+                   help="wind speed at the tree top, m/s (default 0: calm, a free swing)")
+    p.add_argument("--wind-dir", type=_vector, default=(1.0, 0.0, 0.0), metavar="X,Y,Z",
+                   help="wind direction (default 1,0,0)")
+    p.add_argument("--turbulence", type=float, default=1.5, metavar="LAMBDA", help="λ of Eq. 17 (default 1.5)")
+    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the wind and the modal noise (default 0)")
+    p.set_defaults(func=cmd_trace)
+
+    p = _one_line_errors(sub.add_parser(
+        "bench", help="measure the paper's Table 1 on this machine (simulation and render times, FPS)",
+        description="For every preset: objects, nodes and triangles beside the paper's Table 1, the median "
+        "simulation time per step (wind on), the median offscreen render time per frame (pixels read back), "
+        "and the frame rate they allow, with this machine's CPU and GL renderer."))
+    p.add_argument("--presets", nargs="+", metavar="NAME",
+                   help="rows to measure (default: small_cherry large_cherry large_cherry@winter tulip_poplar "
+                   "grassland)")
+    p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH", help="render size (default 1280x720)")
+    p.add_argument("--frames", type=_positive(int), default=20, help="frames rendered per preset (default 20)")
+    p.add_argument("--steps", type=_positive(int), default=200, help="simulation steps per preset (default 200)")
+    p.add_argument("--samples", type=_samples, default=4, help="MSAA samples (default 4)")
+    p.add_argument("--wind", type=_non_negative, default=5.0, metavar="SPEED", help="wind speed, m/s (default 5)")
+    p.add_argument("--json", default=None, metavar="FILE", help="also write every figure to this .json file")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_bench)
 
     p = sub.add_parser("list", help="list the shipped presets", description="List the shipped presets.")
     p.set_defaults(func=lambda args: print("\n".join(__import__("treeanim").list_presets())) or 0)

@@ -1,0 +1,254 @@
+"""Offline output (issue #6): `treeanim render` videos, frames and stills read back, Ctrl-C
+keeping a playable file, `treeanim trace` carrying the beam's modal frequencies, `treeanim
+bench` reporting every preset, and bad input refused with one line and no file.
+
+Everything renders for real through EGL (Mesa llvmpipe in CI), at small sizes.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import imageio.v3 as iio
+import imageio_ffmpeg
+import numpy as np
+import pytest
+
+import treeanim as ta
+from treeanim import cli, offline
+
+
+def treeanim(*args, cwd=None, timeout=300):
+    return subprocess.run([sys.executable, "-m", "treeanim", *map(str, args)], capture_output=True, text=True,
+                          cwd=cwd, timeout=timeout)
+
+
+def read_video(path):
+    """(frames (K, H, W, 3) uint8, (W, H)) of an MP4 or GIF, decoded by ffmpeg."""
+    gen = imageio_ffmpeg.read_frames(str(path))
+    meta = next(gen)
+    w, h = meta["size"]
+    frames = [np.frombuffer(f, np.uint8).reshape(h, w, 3) for f in gen]
+    return np.stack(frames), (w, h)
+
+
+def moving_pixels(a, b, thr=30):
+    """Pixels whose colour changed noticeably between two images."""
+    return int((np.abs(a.astype(int) - b.astype(int)).max(axis=2) > thr).sum())
+
+
+def leftovers(folder):
+    """Hidden temporary files left in ``folder``."""
+    return sorted(p.name for p in folder.iterdir() if p.name.startswith("."))
+
+
+# ------------------------------------------------------------------------------ render
+@pytest.mark.parametrize("size", [(160, 120), (161, 121)], ids=["even", "odd"])
+def test_render_mp4_reads_back_and_moves(tmp_path, size):
+    w, h = size
+    res = treeanim("render", "small_cherry", "--seconds", 1, "--fps", 10, "--size", f"{w}x{h}", "--wind", 12,
+                   "--out", "clip.mp4", "--quiet", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    assert "clip.mp4" in res.stdout and "10 frames" in res.stdout
+    frames, vsize = read_video(tmp_path / "clip.mp4")
+    assert vsize == (w + w % 2, h + h % 2), "odd sizes are padded up to even for H.264 / yuv420p"
+    assert len(frames) == 10
+    # The wind moves the tree: later frames differ from the first, and from each other.
+    assert moving_pixels(frames[0], frames[-1]) > 0.01 * w * h
+    assert moving_pixels(frames[5], frames[9]) > 0.003 * w * h
+    # Not a blank clip: sky on top, a tree in the middle (dark, saturated pixels).
+    mid = frames[-1][h // 4: 3 * h // 4, w // 3: 2 * w // 3].astype(int)
+    assert mid.std() > 15
+    if w % 2:  # the padding repeats the last column / row
+        last = frames[-1].astype(int)
+        assert np.abs(last[:, -1] - last[:, -2]).mean() < 12
+    assert leftovers(tmp_path) == []
+
+
+def test_render_gif(tmp_path):
+    res = treeanim("render", "beam", "--seconds", 1, "--fps", 10, "--size", "96x72", "--pull", "0:600,0,400@0-0.3",
+                   "--out", "beam.gif", "--quiet", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    frames = iio.imread(tmp_path / "beam.gif", index=None)
+    assert frames.shape[:3] == (10, 72, 96)
+    assert moving_pixels(frames[2], frames[6]) > 20  # the released beam swings
+    assert leftovers(tmp_path) == []
+
+
+def test_png_frames_and_still_match_the_simulated_times(tmp_path):
+    w, h = 161, 121
+    common = ["--size", f"{w}x{h}", "--wind", 12, "--quiet", "--seed", 3]
+    res = treeanim("render", "small_cherry", "--seconds", 1.1, "--fps", 10, *common, "--out", "frames/", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    names = sorted(os.listdir(tmp_path / "frames"))
+    assert names == [f"frame_{k:05d}.png" for k in range(11)]
+    imgs = [iio.imread(tmp_path / "frames" / n) for n in names]
+    assert all(im.shape == (h, w, 3) and im.dtype == np.uint8 for im in imgs), "PNG frames keep the exact size"
+    assert moving_pixels(imgs[0], imgs[10]) > 0.01 * w * h
+    assert moving_pixels(imgs[4], imgs[6]) > 0
+
+    # A still at --seconds 1 is the state after 1 s of simulation: frame 10 of the clip above.
+    res = treeanim("render", "small_cherry", "--seconds", 1, *common, "--out", "still.png", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    still = iio.imread(tmp_path / "still.png")
+    assert still.shape == (h, w, 3)
+    assert moving_pixels(still, imgs[10]) < 0.1 * moving_pixels(still, imgs[0])
+    assert np.abs(still.astype(int) - imgs[10].astype(int)).mean() < 1.5
+    assert leftovers(tmp_path) == [] and leftovers(tmp_path / "frames") == []
+
+
+def test_the_default_camera_frames_the_tree(tmp_path):
+    """Every preset fills the picture without being cut: tree pixels reach near the top and
+    the sides' middle but the borders stay background (sky and ground)."""
+    from treeanim.render.offscreen import OffscreenRenderer
+
+    w, h = 128, 96
+    with OffscreenRenderer(w, h, samples=0) as off:
+        for name in ("small_cherry", "tulip_poplar", "beam"):
+            tree = ta.load_preset(name)
+            off.load(tree)
+            cam = offline.framed_camera(tree, w, h)
+            rest = tree.rest_positions, np.broadcast_to(np.eye(3), (tree.n_nodes, 3, 3))
+            off.update(*rest)
+            img = off.render(cam)
+            off.update(*rest, present=np.zeros(tree.n_objects, bool))
+            bg = off.render(cam)
+            mask = np.abs(img.astype(int) - bg.astype(int)).max(axis=2) > 20
+            rows, cols = np.nonzero(mask)
+            assert rows.min() < 0.15 * h, (name, rows.min())  # the crown reaches up to the top
+            assert not mask[0].any() and not mask[:, 0].any() and not mask[:, -1].any(), name
+
+
+def test_ctrl_c_keeps_a_playable_video(tmp_path):
+    """SIGINT to the whole process group (what Ctrl-C in a terminal does, ffmpeg included)."""
+    proc = subprocess.Popen([sys.executable, "-m", "treeanim", "render", "small_cherry", "--seconds", "60", "--fps", "10",
+                             "--size", "96x72", "--out", "long.mp4", "--quiet"], cwd=tmp_path,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not leftovers(tmp_path) and time.monotonic() < deadline and proc.poll() is None:
+            time.sleep(0.05)  # the temporary video appears when rendering starts
+        assert leftovers(tmp_path), "rendering never started"
+        assert not (tmp_path / "long.mp4").exists(), "the video is written beside its name until it is finished"
+        time.sleep(3.0)
+        os.killpg(proc.pid, signal.SIGINT)
+        out, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130, err
+    assert "Traceback" not in err
+    frames, size = read_video(tmp_path / "long.mp4")
+    assert size == (96, 72) and 1 <= len(frames) < 600
+    assert f"kept {len(frames)} frames of 600" in err
+    assert leftovers(tmp_path) == []
+
+
+# ------------------------------------------------------------------------------ trace
+def test_trace_after_release_has_the_beams_modal_frequencies(tmp_path):
+    res = treeanim("trace", "beam", "--pull", "500,0,400", "--seconds", 8, "--out", "trace.csv", "--plot", "trace.png",
+                   cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    with open(tmp_path / "trace.csv") as fh:
+        assert fh.readline().strip() == "t,x,y,z"
+    data = np.loadtxt(tmp_path / "trace.csv", delimiter=",", skiprows=1)
+    t, tip = data[:, 0], data[:, 1:]
+    assert t[0] == 0 and np.allclose(np.diff(t), 1 / 240, atol=2e-6) and t[-1] == pytest.approx(8, abs=1e-3)
+
+    tree = ta.load_preset("beam")
+    sim = ta.Simulation(tree)
+    f, zeta = sim.modes.f[0], sim.modes.zeta[0]  # columns u, v, w
+    d = tip - tree.rest_positions[tree.object_nodes(0)[-1]]
+    assert np.hypot(d[0, 0], d[0, 2]) > 0.1, "released from the static deflection of the pull"
+    # Free swing: a load along u (x here) swings at f_w, one along w (z) at f_u (DESIGN §5),
+    # each at the damped frequency f·sqrt(1 - ζ²).
+    fx = offline.zero_crossing_frequency(t, d[:, 0])
+    fz = offline.zero_crossing_frequency(t, d[:, 2])
+    assert fx == pytest.approx(f[2] * math.sqrt(1 - zeta[2] ** 2), rel=0.01)
+    assert fz == pytest.approx(f[0] * math.sqrt(1 - zeta[0] ** 2), rel=0.01)
+    # The spectrum peaks there too (zero-padded FFT of the x swing).
+    spec = np.abs(np.fft.rfft(d[:, 0] - d[:, 0].mean(), 1 << 16))
+    freq = np.fft.rfftfreq(1 << 16, t[1] - t[0])
+    assert freq[np.argmax(spec)] == pytest.approx(f[2], rel=0.03)
+    # Damping: successive x maxima shrink by exp(-2π ζ / sqrt(1 - ζ²)) per period.
+    x = d[:, 0]
+    peaks = np.flatnonzero((x[1:-1] > x[:-2]) & (x[1:-1] >= x[2:]) & (x[1:-1] > 0)) + 1
+    decrement = np.log(x[peaks[0]] / x[peaks[-1]]) / (len(peaks) - 1)
+    assert decrement / (2 * np.pi) == pytest.approx(zeta[2], rel=0.2)
+    png = iio.imread(tmp_path / "trace.png")
+    assert png.shape[0] > 400 and png.shape[1] > 400 and png[..., :3].std() > 10
+    assert f"{f[0]:.3f}" in res.stdout
+
+
+# ------------------------------------------------------------------------------ bench
+def test_bench_json_reports_every_preset(tmp_path):
+    res = treeanim("bench", "--size", "64x36", "--frames", 2, "--steps", 5, "--json", "bench.json", "--quiet",
+                   cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    doc = json.loads((tmp_path / "bench.json").read_text())
+    assert [r["key"] for r in doc["rows"]] == list(offline.BENCH_ROWS)
+    assert doc["gl_renderer"] and doc["machine"]["cpu"] and doc["machine"]["cores"] >= 1
+    assert doc["size"] == [64, 36]
+    for r in doc["rows"]:
+        for k in ("sim_ms", "render_ms", "fps"):
+            assert math.isfinite(r[k]) and r[k] > 0, (r["key"], k)
+        assert r["fps"] == pytest.approx(1000 / (r["sim_ms"] + r["render_ms"]))
+        assert r["paper_fps"] == cli.TABLE1_FPS[r["key"]]
+        assert r["paper_objects"] == sum(row[1] for row in cli.TABLE1[r["key"]])
+        assert abs(r["nodes"] / r["paper_nodes"] - 1) < 0.1
+    winter = doc["rows"][2]
+    assert winter["key"] == "large_cherry@winter" and winter["triangles"] < doc["rows"][1]["triangles"] / 5
+    assert "| large_cherry (winter) |" in res.stdout and doc["gl_renderer"] in res.stdout
+
+
+# ------------------------------------------------------------------------------ bad input
+BAD = [
+    (["render", "small_cherry", "--out", "clip.avi"], "unknown extension"),
+    (["render", "small_cherry", "--out", "/nonexistent/dir/clip.mp4"], "does not exist"),
+    (["render", "small_cherry", "--out", "/proc/clip.mp4"], "cannot create files"),
+    (["render", "small_cherry", "--out", "notes.txt/clip.mp4"], "does not exist"),
+    (["render", "small_cherry", "--out", "notes.txt/"], "not a folder"),
+    (["render", "small_cherry", "--out", "c.mp4", "--pull", "99999:1,0,0@0-1"], "objects 0 to 875"),
+    (["render", "small_cherry", "--out", "c.mp4", "--seconds", "0"], "positive"),
+    (["render", "small_cherry", "--out", "c.png", "--seconds=-2"], "positive"),
+    (["render", "small_cherry", "--out", "c.mp4", "--fps", "0"], "positive"),
+    (["render", "small_cherry", "--out", "c.mp4", "--seconds", "0.01", "--fps", "10"], "gives no frame"),
+    (["render", "small_cherry", "--out", "c.mp4", "--size", "0x120"], "at least 1"),
+    (["render", "small_cherry", "--out", "c.mp4", "--size=-160x120"], "WIDTHxHEIGHT"),
+    (["render", "small_cherry", "--out", "c.mp4", "--size", "160"], "WIDTHxHEIGHT"),
+    (["render", "small_cherry", "--out", "c.mp4", "--size", "160x120x3"], "WIDTHxHEIGHT"),
+    (["render", "small_cherry", "--out", "c.mp4", "--distance", "0"], "positive"),
+    (["render", "oak", "--out", "c.mp4"], "unknown preset"),
+    (["trace", "beam", "--object", "1", "--pull", "1,0,0", "--out", "t.csv"], "objects 0 to 0"),
+    (["trace", "beam", "--object", "-1", "--pull", "1,0,0", "--out", "t.csv"], "objects 0 to 0"),
+    (["trace", "beam", "--pull", "1,0", "--out", "t.csv"], "three finite numbers"),
+    (["trace", "beam", "--pull", "1,0,0", "--out", "t.txt"], "unknown extension"),
+    (["trace", "beam", "--pull", "1,0,0", "--out", "t.csv", "--seconds", "0"], "positive"),
+    (["trace", "beam", "--pull", "1,0,0", "--out", "t.csv", "--plot", "/proc/t.png"], "cannot create files"),
+    (["bench", "--presets", "oak"], "unknown"),
+    (["bench", "--json", "b.txt"], "unknown extension"),
+    (["bench", "--size", "1280x"], "WIDTHxHEIGHT"),
+    (["bench", "--frames", "0"], "positive"),
+]
+
+
+@pytest.mark.parametrize("args,words", BAD, ids=[" ".join(a[:1] + a[2:] if a[0] != "bench" else a) for a, _ in BAD])
+def test_bad_input_one_line_exit_2_no_file(tmp_path, monkeypatch, capsys, args, words):
+    (tmp_path / "notes.txt").write_text("a file, not a folder\n")
+    monkeypatch.chdir(tmp_path)
+    try:
+        code = cli.main(args)
+    except SystemExit as e:  # argparse
+        code = e.code
+    out, err = capsys.readouterr()
+    assert code == 2
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert words in lines[0] and "Traceback" not in err
+    assert sorted(os.listdir(tmp_path)) == ["notes.txt"], "no file is left behind"
