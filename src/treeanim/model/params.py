@@ -72,8 +72,11 @@ class PhysicsParams:
     (≈ 8° of twist); 25 m/s gives ≈ 8 % (≈ 30 cm), leaves at ≈ 55° (≈ 35° of twist) and
     twigs at ≈ 30°. With k ∝ D⁴ the
     stiffness scales with the tree's thickest diameter, so a preset of another size sets its
-    own ``ei_max``: (1 … 7)·10⁷ N/m³ × D_max⁴ gives the tree presets that response (the small
-    cherry's 2.5·10⁴ is 6.5·10⁷ × 0.14⁴).
+    own ``ei_max`` (and, for other petioles and laminas, ``wind_gain_leaf``). For the same
+    response (2 % of the height at 5 m/s, leaves ≈ 15°): large_cherry ``ei_max = 9e5``,
+    ``wind_gain_leaf = 0.15``; tulip_poplar ``ei_max = 7e5``, ``wind_gain_leaf = 0.01``;
+    grassland ``ei_max = 1.7`` (blade tips ≈ 5 cm at 5 m/s, ≈ 20 cm at 25 m/s); beam
+    ``ei_max = 50``.
     """
 
     summer: SeasonModes = field(default_factory=_default_season)
