@@ -199,6 +199,10 @@ def rest_frames(tree) -> np.ndarray:
     v = P0P1/|P0P1|; w = the tree's ``rest_w`` made exactly perpendicular to v (Eq. 1's
     P0Pn × v for branches and blades, the lamina normal for leaves; any perpendicular if it is
     parallel to v); u = v × w.
+
+    Parameters
+    ----------
+    tree : Tree
     """
     from ..model.build import perpendicular
 
@@ -220,7 +224,13 @@ def rest_frames(tree) -> np.ndarray:
 
 
 def matrix_to_quat(R: np.ndarray) -> np.ndarray:
-    """(4, K) unit quaternions (w, x, y, z) of (K, 3, 3) rotation matrices."""
+    """(4, K) unit quaternions (w, x, y, z) of (K, 3, 3) rotation matrices.
+
+    Parameters
+    ----------
+    R : (K, 3, 3) float
+        Proper rotations.
+    """
     from scipy.spatial.transform import Rotation
 
     xyzw = Rotation.from_matrix(R).as_quat()
@@ -323,7 +333,19 @@ class BendingPlan:
         self.rho_start = np.zeros(S)
 
     def stiffness(self, ei_max: float, exponent: float) -> list[np.ndarray]:
-        """kᵢ = EI_max (Dᵢ/D_max)^m per block (Eq. 10)."""
+        """kᵢ = EI_max (Dᵢ/D_max)^m per block (Eq. 10).
+
+        Parameters
+        ----------
+        ei_max : float
+            EI_max (N·m/rad).
+        exponent : float
+            m.
+
+        Returns
+        -------
+        list of (K_i,) float
+        """
         return [ei_max * np.maximum(d / self.d_max, 0.0) ** exponent for d in self.taper]
 
     def bend(self, Fu: np.ndarray, Fw: np.ndarray, gamma: np.ndarray, k: list[np.ndarray],

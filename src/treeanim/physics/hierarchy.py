@@ -21,7 +21,12 @@ from .rotation import Workspace, qmat, qmul, qrot
 
 
 def qconj(q: np.ndarray) -> np.ndarray:
-    """Conjugate (inverse) of (4, K) unit quaternions."""
+    """Conjugate (inverse) of (4, K) unit quaternions.
+
+    Parameters
+    ----------
+    q : (4, K) float
+    """
     c = q.copy()
     c[1:] *= -1.0
     return c

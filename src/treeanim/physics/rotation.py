@@ -22,7 +22,14 @@ class Workspace:
         self._arrays: dict = {}
 
     def get(self, name: str, shape: tuple[int, ...]) -> np.ndarray:
-        """An uninitialised float64 array of ``shape`` reserved for ``name``."""
+        """An uninitialised float64 array of ``shape`` reserved for ``name``.
+
+        Parameters
+        ----------
+        name : str
+            What the array is for (two uses that overlap in time need two names).
+        shape : tuple of int
+        """
         key = (name, shape)
         a = self._arrays.get(key)
         if a is None:
@@ -32,36 +39,22 @@ class Workspace:
 
 _DEFAULT_WS = Workspace()
 
-def sincos(x: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """sin x, cos x and 1 − cos x for |x| <= π, from t = tan(x/2).
-
-    ``sin = 2t/(1+t²)``, ``1 − cos = 2t²/(1+t²)`` (no cancellation for small x). numpy's
-    float64 tan is several times faster than its sin and cos.
-
-    Parameters
-    ----------
-    x : array of float
-        Angles in [−π, π] (radians).
-
-    Returns
-    -------
-    s, c, omc : arrays
-        sin x, cos x and 1 − cos x.
-    """
-    t = np.tan(0.5 * x)
-    t2 = t * t
-    r = 2.0 / (1.0 + t2)
-    s = t * r
-    omc = t2 * r
-    c = 1.0 - omc
-    return s, c, omc
-
-
 def qmul(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None,
          ws: Workspace | None = None) -> np.ndarray:
     """Hamilton products a ⊗ b of (4, K) quaternion stacks (rotation b first, then a).
 
-    ``out`` must not alias ``a`` or ``b``.
+    Parameters
+    ----------
+    a, b : (4, K) float
+        Quaternions, rows (w, x, y, z).
+    out : (4, K) float, optional
+        Output; must not alias ``a`` or ``b``.
+    ws : Workspace, optional
+        Scratch arrays.
+
+    Returns
+    -------
+    (4, K) float
     """
     K = b.shape[1]
     if out is None:
@@ -94,7 +87,24 @@ def qrot(q: np.ndarray, v: np.ndarray, conj: bool = False, out: np.ndarray | Non
          ws: Workspace | None = None) -> np.ndarray:
     """Rotate (3, K) vectors by (4, K) unit quaternions (by their inverses if ``conj``).
 
-    v′ = v + w·t + q⃗ × t with t = 2 q⃗ × v. ``out`` must not alias ``v``.
+    v′ = v + w·t + q⃗ × t with t = 2 q⃗ × v.
+
+    Parameters
+    ----------
+    q : (4, K) float
+        Unit quaternions, rows (w, x, y, z).
+    v : (3, K) float
+        Vectors.
+    conj : bool
+        Rotate by the inverse rotations.
+    out : (3, K) float, optional
+        Output; must not alias ``v``.
+    ws : Workspace, optional
+        Scratch arrays.
+
+    Returns
+    -------
+    (3, K) float
     """
     K = v.shape[1]
     ws = ws or _DEFAULT_WS
