@@ -43,9 +43,9 @@ def synthetic(name: str):
 
     rng = np.random.default_rng(0)
     sizes = {  # (levels of branching, children per branch, leaves per terminal branch)
-        "small_cherry": (5, 2, 14),
-        "large_cherry": (7, 3, 10),
-        "tulip_poplar": (3, 13, 6),
+        "small_cherry": (6, 2, 26),
+        "large_cherry": (6, 3, 22),
+        "tulip_poplar": (3, 17, 7),
     }
     specs: list[ObjectSpec] = []
     if name == "grassland":
