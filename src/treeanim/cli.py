@@ -6,6 +6,7 @@ Every subcommand reports bad input as one line on stderr and exits with status 2
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 
 #: The paper's Table 1, per preset: rows of (kind, objects, nodes, triangles, fmin, fmax, ζmin, ζmax).
@@ -22,7 +23,7 @@ TABLE1_FPS = {"small_cherry": 45, "large_cherry": 10, "large_cherry@winter": 41,
 PLURAL = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
 
 #: What plain ``treeanim`` runs.
-DEFAULT_COMMAND = ["info", "small_cherry"]
+DEFAULT_COMMAND = ["view"]
 
 
 class UsageError(Exception):
@@ -488,6 +489,23 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", default=None, metavar="FILE", help="also write every figure to this .json file")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_bench)
+
+    p = _one_line_errors(sub.add_parser(
+        "view", help="open the interactive viewer (what plain 'treeanim' does)",
+        description="Open the viewer: the tree in wind; drag a branch or leaf to pull it and let go to watch it "
+        "swing; sliders for wind, season and physics. Needs a display and OpenGL 3.3."))
+    p.add_argument("preset", nargs="?", default="small_cherry",
+                   help="preset name (see 'treeanim list') or path to a preset .toml (default small_cherry)")
+    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
+    p.add_argument("--wind", type=_non_negative, default=5.0, metavar="SPEED",
+                   help="wind speed at the tree top, m/s (default 5; 0 = calm)")
+    p.add_argument("--size", type=_window_size, default=(1280, 720), metavar="WxH",
+                   help="window size (default 1280x720)")
+    p.add_argument("--samples", type=int, choices=range(0, 17), default=None, metavar="N",
+                   help="MSAA samples, 0-16 (default 4, or 0 on a software renderer such as llvmpipe)")
+    p.add_argument("--frames", type=_positive(int), default=None, metavar="N",
+                   help="quit after N frames (for scripted runs)")
+    p.set_defaults(func=cmd_view)
 
     p = sub.add_parser("list", help="list the shipped presets", description="List the shipped presets.")
     p.set_defaults(func=lambda args: print("\n".join(__import__("treeanim").list_presets())) or 0)

@@ -1,0 +1,39 @@
+"""``treeanim view``: open the window, run the viewer until it is closed."""
+
+from __future__ import annotations
+
+from .window import HEADLESS_HINT, ViewerUnavailable
+
+
+def view(tree, *, season: float = 0.0, wind_speed: float = 5.0, size: tuple[int, int] = (1280, 720),
+         frames: int | None = None, samples: int | None = None, title: str | None = None) -> int:
+    """Show ``tree`` in a new window until the user closes it (or ``frames`` frames are drawn).
+
+    ``samples``: MSAA samples (None: 4, or none on a software rasteriser; see
+    :meth:`Window.open`).
+
+    Returns
+    -------
+    int
+        Frames drawn.
+
+    Raises
+    ------
+    ViewerUnavailable
+        No display, no GLFW, no OpenGL 3.3, or the viewer's libraries cannot load (one line).
+    """
+    try:
+        from .viewer import Viewer, run
+        from .window import Window
+    except (ImportError, OSError) as e:  # e.g. imgui-bundle's or GLFW's shared libraries
+        raise ViewerUnavailable(f"the viewer's libraries cannot load ({' '.join(str(e).split())}); "
+                                f"{HEADLESS_HINT}") from None
+    win = Window.open(*size, title or f"treeanim — {tree.name}", samples=samples)
+    try:
+        viewer = Viewer(win, tree, season=season, wind_speed=wind_speed)
+        try:
+            return run(viewer, max_frames=frames)
+        finally:
+            viewer.release()
+    finally:
+        win.close()

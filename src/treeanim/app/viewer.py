@@ -1,0 +1,680 @@
+"""The interactive viewer: a tree in wind in a GLFW window, pulled with the mouse, tuned from an
+imgui panel.
+
+:class:`Viewer` owns the simulation, the renderer, the camera and the panel of one window. The
+window's GLFW callbacks call its input handlers (``on_mouse_button``, ``on_cursor_pos``,
+``on_scroll``, ``on_key``, ``on_char``, ``on_resize``, ``on_focus``); tests call the same
+handlers. :meth:`Viewer.frame` advances the simulation by the elapsed time and draws one frame;
+:func:`run` is the main loop.
+
+Controls
+--------
+left-drag on a branch, leaf or blade   pull it (a spring to the cursor); let go to release
+left-drag elsewhere                    orbit
+right- or middle-drag                  pan
+wheel                                  zoom
+F frame the tree · Space pause · R reset · S or F12 screenshot · H hide the panel
+F11 full screen · Ctrl+S save the preset · Ctrl+O load it · Esc or Q quit
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from datetime import datetime
+from pathlib import Path
+
+import glfw
+import numpy as np
+
+from ..model.tree import Tree
+from ..physics.simulation import Simulation
+from ..physics.wind import WindField
+from ..render.camera import OrbitCamera
+from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
+from ..render.picking import Picker
+from ..render.renderer import Renderer
+from .gui import Gui
+from .window import Window
+
+#: Longest real time one frame advances the simulation by (s): a stall never makes a jump.
+MAX_FRAME_DT = 1.0 / 20.0
+#: Longest simulation sub-step (s of simulated time).
+MAX_SUBSTEP = 1.0 / 60.0
+#: Time constant (s, simulated) of the low-pass on the pull force: it damps the loop between
+#: the spring and the beam's static deflection, so the grabbed point settles without ringing.
+PULL_TAU = 0.04
+#: The spring's loop gain: at equilibrium the grabbed point covers GAIN / (1 + GAIN) of the
+#: distance to the cursor (60 % for a small drag; a stiff beam bends less than that).
+PULL_GAIN = 1.5
+#: The pull force saturates at the spring force of a drag this many object lengths long.
+PULL_MAX_LENGTHS = 2.0
+#: Orbit speed, degrees per screen unit of drag.
+ORBIT_DEG_PER_UNIT = 0.35
+#: Zoom factor per wheel notch.
+ZOOM_PER_NOTCH = 0.88
+#: Width of the panel in screen units at UI scale 1.
+PANEL_WIDTH = 330
+
+
+@dataclass
+class Grab:
+    """A pull in progress.
+
+    Attributes
+    ----------
+    object : int
+        The grabbed object.
+    node : int
+        Global index of the first node of the segment holding the anchor.
+    s : float
+        Where the anchor lies along that segment, 0 … 1.
+    offset : (3,) float
+        Picked point minus anchor at grab time (the picked point may lie on a leaf's lamina).
+    plane_point, plane_normal : (3,) float
+        The plane facing the camera through the picked point; the cursor is projected on it.
+    target : (3,) float
+        The cursor's point on that plane.
+    k : float
+        Spring constant, N/m.
+    f_max : float
+        Largest force, N.
+    force : (3,) float
+        The current (low-passed) pull force, N.
+    """
+
+    object: int
+    node: int
+    s: float
+    offset: np.ndarray
+    plane_point: np.ndarray
+    plane_normal: np.ndarray
+    target: np.ndarray
+    k: float
+    f_max: float
+    force: np.ndarray
+
+
+def _clone_wind(w: WindField | None, **changes) -> WindField:
+    """A new WindField with ``w``'s settings (its bounds left to the next Simulation to fit)."""
+    keys = ("direction", "speed", "grid", "beta_u", "beta_vw", "turbulence", "c3", "c4", "c5", "c6", "seed")
+    kw = {} if w is None else {k: getattr(w, k) for k in keys}
+    if w is not None and not np.any(kw["direction"]):
+        kw["direction"] = (1.0, 0.0, 0.0)
+    kw.update(changes)
+    return WindField(**kw)
+
+
+def wind_direction(angle_deg: float) -> np.ndarray:
+    """The horizontal unit vector at ``angle_deg`` about +y from +x (90° is −z)."""
+    a = math.radians(angle_deg)
+    return np.array([math.cos(a), 0.0, -math.sin(a)])
+
+
+def wind_angle(direction) -> float:
+    """Inverse of :func:`wind_direction`: degrees in [0, 360)."""
+    d = np.asarray(direction, float)
+    return math.degrees(math.atan2(-d[2], d[0])) % 360.0
+
+
+class _Ema:
+    """Exponential moving average (for the statistics)."""
+
+    def __init__(self, weight: float = 0.1) -> None:
+        self.w = weight
+        self.value: float | None = None
+
+    def add(self, x: float) -> None:
+        self.value = x if self.value is None else self.value + self.w * (x - self.value)
+
+
+class Viewer:
+    """A tree in wind in a window: simulation, renderer, camera, mouse and keys, panel.
+
+    Parameters
+    ----------
+    window : Window
+        An open window (its GL context current).
+    tree : Tree
+    season : float
+        0 summer … 1 winter.
+    wind_speed : float
+        m/s at the tree top (0: calm).
+    wind_angle_deg : float
+        Wind direction, degrees about +y from +x.
+    seed : int
+        Seed of the simulation's random numbers and of the wind.
+    show_panel : bool
+        Show the imgui panel.
+    clock : callable or None
+        Seconds (monotonic); None: ``time.perf_counter``.
+
+    Attributes
+    ----------
+    sim : Simulation
+    renderer : Renderer
+    camera : OrbitCamera
+    paused : bool
+    time_scale : float
+        Simulated seconds per real second (0.05 … 2).
+    gl_renderer : str
+        The OpenGL renderer's name.
+    show_trace, show_frames, show_wind : bool
+        Overlays: the pulled tip's trace, the local frames, the wind slices and arrow.
+    grab : Grab or None
+        The pull in progress.
+    """
+
+    def __init__(self, window: Window, tree: Tree, *, season: float = 0.0, wind_speed: float = 5.0,
+                 wind_angle_deg: float = 0.0, seed: int = 0, show_panel: bool = True, clock=None) -> None:
+        self.window = window
+        self.ctx = window.ctx
+        self.gl_renderer = str(window.ctx.info.get("GL_RENDERER", "unknown renderer"))
+        self.seed = int(seed)
+        self._clock = clock or time.perf_counter
+        self.paused = False
+        self.time_scale = 1.0
+        self.show_panel = bool(show_panel)
+        self.show_trace = True
+        self.show_frames = False
+        self.show_wind = False
+        self.grab: Grab | None = None
+        self.traced: int | None = None  # object whose tip the trace follows
+        self.trace = PullTrace(capacity=2400)
+        self.camera = OrbitCamera(azimuth=20.0, elevation=8.0)
+        self.messages: list[str] = []  # lines for the panel's status line (newest last)
+        self.screenshots: list[Path] = []
+        self.sim_ms, self.render_ms, self.frame_s = _Ema(), _Ema(), _Ema(0.05)
+        self._acc = 0.0
+        self._last_time: float | None = None
+        self._mode: str | None = None  # 'orbit', 'pan', 'pull' while a button is held
+        self._mode_button: int | None = None
+        self._cursor = (0.0, 0.0)
+        self._screenshot_pending: list[Path | None] = []
+        self._readback = None
+        self._stats_key = None
+        self._stats: dict = {}
+        self._win = tuple(window.size)
+        self._fb = tuple(window.framebuffer_size)
+        self._integrator = "exact"
+        self._coupling = True
+        self.sim: Simulation | None = None
+        self.renderer: Renderer | None = None
+        self._wind = _clone_wind(None, speed=float(wind_speed), direction=wind_direction(wind_angle_deg),
+                                 seed=self.seed)
+        self._season = float(season)
+        self.gui = Gui(window.handle, scale=window.content_scale)
+        from .panel import Panel
+
+        self.panel = Panel(self)
+        self.load_tree(tree)
+
+    # ------------------------------------------------------------------ the tree
+    @property
+    def tree(self) -> Tree:
+        return self.sim.tree
+
+    @property
+    def wind(self) -> WindField:
+        """The wind field (also when calm: speed 0)."""
+        return self.sim.wind
+
+    def load_tree(self, tree: Tree) -> None:
+        """Show ``tree``: a new simulation (same wind, season, integrator and coupling), renderer
+        and picker; the camera frames it."""
+        if self.sim is not None:
+            self._season = self.sim.season
+            self._integrator = self.sim.integrator
+            self._coupling = self.sim.coupling
+            self._wind = self.sim.wind
+        self._end_drag()
+        sim = Simulation(tree, wind=_clone_wind(self._wind), season=self._season, seed=self.seed,
+                         integrator=self._integrator, coupling=self._coupling)
+        renderer = Renderer(self.ctx, tree)
+        if self.renderer is not None:
+            self.renderer.release()
+        self.sim, self.renderer = sim, renderer
+        self.picker = Picker(tree)
+        self.trace.clear()
+        self.traced = None
+        self._acc = 0.0
+        lo, hi = renderer.bounds()
+        self.local_frames = LocalFrames(scale=0.25)
+        size = float(np.max(hi - lo))
+        self.wind_slices = WindSlices(self._wind_at, (lo, hi), resolution=9, reference_speed=None)
+        self.wind_arrow = WindArrow(length=0.35 * size, reference_speed=10.0)
+        self._wind_arrow_anchor = (0.5 * (lo + hi), 0.65 * size)
+        self.frame_camera()
+        self.panel.tree_changed()
+
+    def _wind_at(self, points: np.ndarray) -> np.ndarray:
+        return self.sim.wind.sample(points, self.sim.time)
+
+    def set_wind(self, **changes) -> None:
+        """Change wind settings: ``speed``, ``angle`` (degrees), ``turbulence``, ``beta_u``,
+        ``beta_vw``, ``c3``, ``c4`` (each through the WindField's checked setters)."""
+        w = self.sim.wind
+        for k, v in changes.items():
+            if k == "angle":
+                w.direction = wind_direction(v)
+            else:
+                setattr(w, k, v)
+
+    # ------------------------------------------------------------------ camera
+    @property
+    def panel_width(self) -> float:
+        """Screen units the panel covers at the left (0 when hidden)."""
+        return self.panel.width if self.show_panel else 0.0
+
+    def frame_camera(self) -> None:
+        """Aim at the tree so it fills the view beside the panel."""
+        w, h = self._win
+        if w <= 0 or h <= 0:
+            w, h = 16, 9
+        free = max(w - self.panel_width, 0.4 * w)
+        self.camera.frame(self.renderer.bounds(), aspect=free / h)
+        self.camera.pan((w - free) / 2.0, 0.0, h)  # the tree moves right, beside the panel
+
+    # ------------------------------------------------------------------ time
+    @property
+    def substep(self) -> float:
+        """The simulation's fixed step (s): 1/60 × the time scale, at most 1/60.
+
+        At 60 frames a second this is one step a frame at any slow-motion scale, and the exact
+        integrator's coefficients stay cached while the scale is unchanged."""
+        return MAX_SUBSTEP * min(1.0, self.time_scale)
+
+    def advance(self, real_dt: float) -> int:
+        """Advance the simulation by ``real_dt`` seconds of real time × the time scale, in
+        fixed sub-steps; ``real_dt`` is clamped to :data:`MAX_FRAME_DT`. Returns the steps taken."""
+        if self.paused:
+            return 0
+        dt = min(max(float(real_dt), 0.0), MAX_FRAME_DT) * self.time_scale
+        self._acc += dt
+        h = self.substep
+        n = int(math.floor(self._acc / h + 0.25))  # a step within a quarter of due is taken now
+        n = min(n, int(math.ceil(MAX_FRAME_DT * self.time_scale / h)) + 1)
+        self._acc = min(max(self._acc - n * h, -0.25 * h), h)
+        sim = self.sim
+        for _ in range(n):
+            if self.grab is not None:
+                self._update_pull(h)
+            sim.step(h)
+            if self.traced is not None:
+                self.trace.push(sim.tip_position(self.traced))
+        return n
+
+    # ------------------------------------------------------------------ frames
+    def frame(self, dt: float | None = None) -> bool:
+        """Advance and draw one frame (not swapped). ``dt``: real seconds since the last frame
+        (None: measured). Returns False when nothing was drawn (a minimised window)."""
+        now = self._clock()
+        if dt is None:
+            dt = 0.0 if self._last_time is None else now - self._last_time
+        self._last_time = now
+        w, h = self._fb
+        if w <= 0 or h <= 0:
+            return False
+        self.window.make_current()
+        t0 = time.perf_counter()
+        self.advance(dt)
+        t1 = time.perf_counter()
+        self.draw(dt)
+        t2 = time.perf_counter()
+        self.sim_ms.add(1e3 * (t1 - t0))
+        self.render_ms.add(1e3 * (t2 - t1))
+        if dt > 0:
+            self.frame_s.add(dt)
+        while self._screenshot_pending:
+            self.screenshot(self._screenshot_pending.pop(0))
+        return True
+
+    def draw(self, dt: float = 1 / 60) -> None:
+        """Upload the pose and draw the scene and the panel into the window's back buffer."""
+        fw, fh = self._fb
+        if fw <= 0 or fh <= 0:
+            return
+        sim, r = self.sim, self.renderer
+        highlight = self.grab.object if self.grab is not None else None
+        r.update(sim.positions, sim.rotations, present=sim.present, highlight=highlight)
+        self.ctx.screen.use()
+        r.draw(self.camera, fw, fh, season=sim.season, overlays=self.overlays())
+        if self.show_panel:
+            ww, wh = self._win
+            self.gui.new_frame(ww, wh, fw, fh, dt if dt > 0 else 1 / 60)
+            self.panel.draw()
+            self.gui.render()
+
+    def overlays(self) -> list:
+        """The overlays switched on."""
+        out = []
+        if self.show_trace and len(self.trace) > 1:
+            out.append(self.trace)
+        if self.show_frames:
+            out.append(self.local_frames)
+        if self.show_wind and not self.sim.wind.calm:
+            w = self.sim.wind
+            a = self.wind_arrow
+            a.direction = w.direction
+            a.speed = w.speed
+            centre, dist = self._wind_arrow_anchor
+            d = w.direction / max(np.linalg.norm(w.direction), 1e-12)
+            a.origin = centre - dist * d
+            out += [self.wind_slices, a]
+        return out
+
+    def stats(self) -> dict:
+        """The tree's counts at the current season (cached)."""
+        key = (id(self.sim.tree), self.sim.season)
+        if key != self._stats_key:
+            self._stats = self.sim.tree.stats(self.sim.season)
+            self._stats_key = key
+        return self._stats
+
+    # ------------------------------------------------------------------ pixels
+    def read_pixels(self) -> np.ndarray:
+        """The back buffer as drawn so far, (height, width, 3) uint8, row 0 at the top
+        (a multisampled buffer is resolved first)."""
+        fw, fh = self._fb
+        if fw <= 0 or fh <= 0:
+            return np.zeros((max(fh, 0), max(fw, 0), 3), np.uint8)
+        from OpenGL import GL
+
+        self.window.make_current()
+        ctx = self.ctx
+        if self._readback is None or self._readback[0] != (fw, fh):
+            if self._readback is not None:
+                ctx.screen.use()
+                for o in self._readback[1:]:
+                    o.release()
+            rb = ctx.renderbuffer((fw, fh), 4)
+            fbo = ctx.framebuffer([rb])
+            self._readback = ((fw, fh), fbo, rb)
+        fbo = self._readback[1]
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, 0)
+        GL.glReadBuffer(GL.GL_BACK)
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, fbo.glo)
+        GL.glBlitFramebuffer(0, 0, fw, fh, 0, 0, fw, fh, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
+        data = fbo.read(components=3, alignment=1)
+        ctx.screen.use()
+        img = np.frombuffer(data, np.uint8).reshape(fh, fw, 3)
+        return np.ascontiguousarray(img[::-1])
+
+    def request_screenshot(self, path=None) -> None:
+        """Write a screenshot after the next frame is drawn (see :meth:`screenshot`)."""
+        self._screenshot_pending.append(None if path is None else Path(path))
+
+    def screenshot(self, path=None) -> Path:
+        """Write the back buffer as a PNG and print its path.
+
+        Parameters
+        ----------
+        path : path-like or None
+            None: ``treeanim-YYYYmmdd-HHMMSS.png`` in the current folder (``-2``, ``-3`` … if
+            taken within the same second).
+        """
+        import imageio.v3 as iio
+
+        if path is None:
+            stem = "treeanim-" + datetime.now().strftime("%Y%m%d-%H%M%S")
+            path = Path(stem + ".png")
+            k = 2
+            while path.exists():
+                path = Path(f"{stem}-{k}.png")
+                k += 1
+        path = Path(path)
+        iio.imwrite(path, self.read_pixels())
+        self.screenshots.append(path)
+        self.say(f"screenshot: {path}")
+        print(f"treeanim: screenshot {path.resolve()}", flush=True)
+        return path
+
+    def say(self, line: str) -> None:
+        """Show one line in the panel's status line."""
+        self.messages.append(line)
+        del self.messages[:-4]
+
+    # ------------------------------------------------------------------ picking and pulling
+    def _ray(self, x: float, y: float):
+        w, h = self._win
+        return self.camera.ray(x, y, max(w, 1), max(h, 1))
+
+    def pick(self, x: float, y: float):
+        """The object under window point (x, y) (screen units, y down), or None."""
+        o, d = self._ray(x, y)
+        return self.picker.pick(self.sim.positions, self.sim.rotations, o, d, present=self.sim.present,
+                                pixel_angle=self.camera.pixel_angle(max(self._win[1], 1)), min_pixels=4.0)
+
+    def _cursor_target(self, x: float, y: float, g: Grab) -> np.ndarray:
+        o, d = self._ray(x, y)
+        denom = float(d @ g.plane_normal)
+        if abs(denom) < 1e-9:
+            return g.target
+        t = float((g.plane_point - o) @ g.plane_normal) / denom
+        return o + max(t, 0.0) * d
+
+    def compliance(self, obj: int, k: int, s: float) -> float:
+        """Metres the anchor (segment ``k`` of object ``obj``, at ``s`` along it) moves per
+        newton of a tip force across the object, by the linearised bending of DESIGN §5."""
+        tree = self.sim.tree
+        p = self.sim.physics
+        nodes = tree.object_nodes(obj)
+        X = tree.rest_positions[nodes]
+        D = tree.node_diameter[nodes]
+        seg = np.diff(X, axis=0)
+        L = np.linalg.norm(seg, axis=1)
+        n = len(L)
+        dmax = float(np.max(tree.node_diameter))
+        stiff = p.ei_max * (0.5 * (D[:-1] + D[1:]) / dmax) ** p.stiffness_exponent
+        phi = (n - np.arange(n)) / n * L / np.maximum(stiff, 1e-30)
+        anchor = X[k] + s * seg[k]
+        lever = np.linalg.norm(anchor - X[: k + 1], axis=1)
+        return float(np.sum(phi[: k + 1] * lever))
+
+    def start_pull(self, x: float, y: float) -> bool:
+        """Grab the object under (x, y), if any. Returns whether something was grabbed."""
+        hit = self.pick(x, y)
+        if hit is None:
+            return False
+        tree, sim = self.sim.tree, self.sim
+        obj = hit.object
+        nodes = tree.object_nodes(obj)
+        P = sim.positions
+        a, b = P[nodes[:-1]], P[nodes[1:]]
+        e = b - a
+        s = np.clip(np.einsum("ij,ij->i", hit.point - a, e) / np.maximum(np.einsum("ij,ij->i", e, e), 1e-30), 0, 1)
+        dist = np.linalg.norm(a + s[:, None] * e - hit.point, axis=1)
+        k = int(np.argmin(dist))
+        anchor = a[k] + s[k] * e[k]
+        G = max(self.compliance(obj, k, float(s[k])), 1e-12)
+        spring = PULL_GAIN / G
+        length = float(np.sum(np.linalg.norm(np.diff(tree.rest_positions[nodes], axis=0), axis=1)))
+        length += float(tree.lamina_length[obj])
+        point = np.asarray(hit.point, float)
+        self.grab = Grab(object=obj, node=int(nodes[k]), s=float(s[k]), offset=point - anchor,
+                         plane_point=point.copy(), plane_normal=self.camera.forward.copy(), target=point.copy(),
+                         k=spring, f_max=spring * PULL_MAX_LENGTHS * length, force=np.zeros(3))
+        self.trace.clear()
+        self.traced = obj
+        self.trace.push(sim.tip_position(obj))
+        return True
+
+    def anchor_point(self) -> np.ndarray | None:
+        """Where the grabbed point is now (world), or None."""
+        g = self.grab
+        if g is None:
+            return None
+        P = self.sim.positions
+        return P[g.node] + g.s * (P[g.node + 1] - P[g.node]) + g.offset
+
+    def _update_pull(self, h: float) -> None:
+        g = self.grab
+        raw = g.k * (g.target - self.anchor_point())
+        mag = float(np.linalg.norm(raw))
+        if mag > g.f_max:
+            raw *= g.f_max / mag
+        g.force += (h / (PULL_TAU + h)) * (raw - g.force)
+        self.sim.pull(g.object, g.force)
+
+    def end_pull(self) -> None:
+        """Let go of the grabbed object (it swings freely; the trace goes on)."""
+        if self.grab is not None:
+            self.sim.release(self.grab.object)
+            self.grab = None
+
+    def _end_drag(self) -> None:
+        self.end_pull()
+        self._mode = None
+        self._mode_button = None
+
+    # ------------------------------------------------------------------ input handlers
+    def _over_panel(self, x: float, y: float) -> bool:
+        return self.show_panel and (self.gui.wants_mouse or self.panel.contains(x, y))
+
+    def on_cursor_pos(self, x: float, y: float) -> None:
+        """Cursor moved to (x, y) screen units, origin top-left."""
+        px, py = self._cursor
+        self._cursor = (float(x), float(y))
+        if self.show_panel:
+            self.gui.mouse_pos(x, y)
+        dx, dy = x - px, y - py
+        if self._mode == "orbit":
+            self.camera.orbit(-ORBIT_DEG_PER_UNIT * dx, ORBIT_DEG_PER_UNIT * dy)
+        elif self._mode == "pan":
+            self.camera.pan(dx, dy, max(self._win[1], 1))
+        elif self._mode == "pull" and self.grab is not None:
+            self.grab.target = self._cursor_target(x, y, self.grab)
+
+    def on_mouse_button(self, button: int, action: int, mods: int = 0) -> None:
+        """A mouse button went down (``glfw.PRESS``) or up (``glfw.RELEASE``)."""
+        x, y = self._cursor
+        if action == glfw.PRESS:
+            over = self._over_panel(x, y)
+            if self.show_panel:
+                self.gui.mouse_button(button, True)
+            if over or self._mode is not None:
+                return
+            if button == glfw.MOUSE_BUTTON_LEFT:
+                self._mode = "pull" if self.start_pull(x, y) else "orbit"
+            elif button in (glfw.MOUSE_BUTTON_RIGHT, glfw.MOUSE_BUTTON_MIDDLE):
+                self._mode = "pan"
+            else:
+                return
+            self._mode_button = button
+        elif action == glfw.RELEASE:
+            self.gui.mouse_button(button, False)
+            if button == self._mode_button:
+                self._end_drag()
+
+    def on_scroll(self, dx: float, dy: float) -> None:
+        """Wheel turned (dy > 0: away from the user, zooms in)."""
+        if self._over_panel(*self._cursor):
+            self.gui.scroll(dx, dy)
+            return
+        self.camera.zoom(ZOOM_PER_NOTCH ** float(dy))
+
+    def on_char(self, codepoint: int) -> None:
+        """A character was typed (for the panel's text fields)."""
+        if self.show_panel:
+            self.gui.char(codepoint)
+
+    def on_key(self, key: int, scancode: int, action: int, mods: int) -> None:
+        """A key went down, repeated or up. Shortcuts act on presses while the panel does not
+        want the keyboard."""
+        if self.show_panel or action == glfw.RELEASE:
+            self.gui.key(key, action, mods)
+        if action != glfw.PRESS or (self.show_panel and self.gui.wants_keyboard):
+            return
+        ctrl = bool(mods & glfw.MOD_CONTROL)
+        if ctrl and key == glfw.KEY_S:
+            self.panel.save()
+        elif ctrl and key == glfw.KEY_O:
+            self.panel.load()
+        elif ctrl:
+            return
+        elif key in (glfw.KEY_ESCAPE, glfw.KEY_Q):
+            self.window.request_close()
+        elif key == glfw.KEY_SPACE:
+            self.paused = not self.paused
+        elif key == glfw.KEY_R:
+            self.reset()
+        elif key == glfw.KEY_F:
+            self.frame_camera()
+        elif key in (glfw.KEY_S, glfw.KEY_F12):
+            self.request_screenshot()
+        elif key == glfw.KEY_F11:
+            self.window.toggle_fullscreen()
+        elif key == glfw.KEY_H:
+            self.show_panel = not self.show_panel
+            if self.show_panel:
+                self.gui.mouse_pos(*self._cursor)
+
+    def on_resize(self, width: int, height: int) -> None:
+        """The framebuffer is now ``width`` × ``height`` pixels (0 × 0: minimised)."""
+        self._fb = (max(int(width), 0), max(int(height), 0))
+        try:
+            self._win = tuple(self.window.size)
+        except Exception:  # pragma: no cover
+            self._win = self._fb
+
+    def on_window_size(self, width: int, height: int) -> None:
+        """The window is now ``width`` × ``height`` screen units."""
+        self._win = (max(int(width), 0), max(int(height), 0))
+
+    def on_focus(self, focused: bool) -> None:
+        """Focus gained or lost; losing it ends any drag and lets go of a pull."""
+        self.gui.focus(focused)
+        if not focused:
+            self._end_drag()
+
+    def on_cursor_enter(self, entered: bool) -> None:
+        if not entered:
+            self.gui.mouse_left()
+
+    def on_refresh(self) -> None:
+        """The window needs redrawing (nothing to do: the loop draws continuously)."""
+
+    # ------------------------------------------------------------------ actions
+    def reset(self) -> None:
+        """Back to rest: the simulation at time 0, no pull, no trace."""
+        self._end_drag()
+        self.sim.reset()
+        self.trace.clear()
+        self.traced = None
+        self._acc = 0.0
+
+    def release(self) -> None:
+        """Free the GL resources (the window stays open)."""
+        self.window.make_current()
+        if self._readback is not None:
+            self.ctx.screen.use()
+            for o in self._readback[1:]:
+                o.release()
+            self._readback = None
+        if self.renderer is not None:
+            self.renderer.release()
+            self.renderer = None
+        self.gui.release()
+
+
+def run(viewer: Viewer, max_frames: int | None = None) -> int:
+    """The main loop: poll input, advance and draw, swap; until the window closes (or
+    ``max_frames`` frames have been drawn). Returns the number of frames drawn."""
+    win = viewer.window
+    win.connect(viewer)
+    drawn = 0
+    while not win.should_close:
+        w, h = viewer._fb
+        if w <= 0 or h <= 0:  # minimised: sleep until something happens
+            win.wait(0.1)
+            viewer._last_time = None
+            viewer.on_resize(*win.framebuffer_size)
+            continue
+        win.poll()
+        if viewer.frame():
+            win.swap()
+            drawn += 1
+        if max_frames is not None and drawn >= max_frames:
+            break
+    return drawn

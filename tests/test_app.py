@@ -1,0 +1,555 @@
+"""The viewer app in a real GLFW window (under Xvfb through pytest-xvfb): drawing, pulling,
+camera, panel, resizing, settings, screenshots, and the one-line failures without a display or
+without OpenGL 3.3."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+import re
+import subprocess
+import sys
+import tomllib
+
+import glfw
+import numpy as np
+import pytest
+
+import treeanim as ta
+from treeanim.app.settings import physics_toml, preset_text, save_preset
+from treeanim.app.viewer import MAX_FRAME_DT, Viewer, run
+from treeanim.app.window import Window
+
+W, H = 480, 360
+DT = 1.0 / 60.0
+
+
+@pytest.fixture(scope="module")
+def app():
+    win = Window.open(W, H, "treeanim test", samples=4)  # 4x MSAA: screenshots resolve it
+    v = Viewer(win, ta.load_preset("small_cherry"), wind_speed=0.0)
+    win.connect(v)
+    yield v
+    v.release()
+    win.close()
+
+
+@pytest.fixture()
+def viewer(app):
+    """The module's viewer, back at rest, calm, panel hidden, 480 × 360, framed."""
+    v = app
+    if v.tree.name != "small_cherry" or v.sim.physics != v.tree.physics:
+        v.load_tree(ta.load_preset("small_cherry"))
+    glfw.set_window_size(v.window.handle, W, H)
+    _settle(v, (W, H))
+    v.show_panel = False
+    v.paused = False
+    v.time_scale = 1.0
+    v.set_wind(speed=0.0)
+    v.reset()
+    v.frame_camera()
+    v.frame(DT)
+    return v
+
+
+def _settle(v, size):
+    """Poll until the X server's resize reached the viewer through the GLFW callbacks."""
+    for _ in range(200):
+        glfw.poll_events()
+        if v._fb == size and v._win == size:
+            return
+        glfw.wait_events_timeout(0.005)
+    raise AssertionError(f"the window never became {size}: framebuffer {v._fb}, window {v._win}")
+
+
+def _press(v, x, y, button=glfw.MOUSE_BUTTON_LEFT):
+    v.on_cursor_pos(x, y)
+    v.on_mouse_button(button, glfw.PRESS, 0)
+
+
+def _click(v, x, y):
+    """A click on the panel: imgui sees the move, the press and the release in separate frames."""
+    v.on_cursor_pos(x, y)
+    v.frame(DT)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.PRESS, 0)
+    v.frame(DT)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    v.frame(DT)
+
+
+def _reveal(v, label):
+    """Scroll the panel with the wheel until ``label`` is in view; its centre."""
+    for _ in range(12):
+        r = v.panel.item_rects.get(label)
+        if r is not None and r[1] > 4 and r[3] < H - 4:
+            return _centre(r)
+        v.on_cursor_pos(150, H / 2)
+        v.frame(DT)
+        v.on_scroll(0.0, -2.0 if r is None or r[3] >= H - 4 else 2.0)
+        v.frame(DT)
+        v.frame(DT)
+    raise AssertionError(f"{label} never came into view")
+
+
+def _centre(rect):
+    return 0.5 * (rect[0] + rect[2]), 0.5 * (rect[1] + rect[3])
+
+
+# ---------------------------------------------------------------------------- drawing
+def test_window_draws_the_tree_and_the_panel(viewer):
+    v = viewer
+    v.show_panel = True
+    assert v.frame(DT)
+    assert v.frame(DT)  # imgui sizes a new window to its content over its first frames
+    with_panel = v.read_pixels()
+    assert with_panel.shape == (H, W, 3)
+    assert v.window.samples in (0, 4)  # pytest-xvfb's 16-bit screen has no multisampled visual
+    v.show_panel = False
+    v.frame(DT)
+    scene = v.read_pixels()
+    # The same view without the tree (the renderer told that nothing is present).
+    r = v.renderer
+    r.update(v.sim.positions, v.sim.rotations, present=np.zeros(v.tree.n_objects, bool))
+    v.ctx.screen.use()
+    r.draw(v.camera, W, H, season=v.sim.season)
+    empty = v.read_pixels()
+    assert v.ctx.error == "GL_NO_ERROR"
+    tree_px = np.abs(scene.astype(int) - empty.astype(int)).max(axis=2) > 24
+    assert tree_px.mean() > 0.03, "the tree covers too little of the window"
+    ys, xs = np.nonzero(tree_px)
+    assert 0.1 * W < xs.mean() < 0.9 * W and 0.1 * H < ys.mean() < 0.9 * H
+    # The panel is drawn over the scene at the left, where its rectangle says.
+    x0, y0, x1, y1 = (int(round(c)) for c in v.panel.rect)
+    assert x0 < 20 and x1 > 200 and y1 > 100
+    differs = np.abs(with_panel.astype(int) - scene.astype(int)).max(axis=2) > 24
+    assert differs[y0 + 2:y1 - 2, x0 + 2:x1 - 2].mean() > 0.5
+    assert differs[:, x1 + 4:].mean() < 0.01
+
+
+# ---------------------------------------------------------------------------- pulling
+def _branch_on_screen(v):
+    """A branch whose tip region is visible and picks as itself: (object, x, y)."""
+    tree, P = v.tree, v.sim.positions
+    branches = [i for i in np.flatnonzero(tree.kind == "branch") if tree.level[i] >= 2]
+    length = lambda i: np.linalg.norm(np.diff(tree.rest_positions[tree.object_nodes(i)], axis=0), axis=1).sum()  # noqa: E731
+    for i in sorted(branches, key=length, reverse=True):
+        nodes = tree.object_nodes(i)
+        for f in (0.75, 0.6, 0.9):
+            pt = P[nodes[0]] + f * (P[nodes[-1]] - P[nodes[0]])
+            x, y, z = v.camera.project(pt, W, H)[0]
+            if not (40 < x < W - 40 and 40 < y < H - 40 and 0 < z < 1):
+                continue
+            hit = v.pick(x, y)
+            if hit is not None and hit.object == i:
+                return int(i), float(x), float(y)
+    raise AssertionError("no branch of the small cherry is visible on its own")
+
+
+def test_dragging_a_branch_pulls_it_and_it_swings_after_release(viewer):
+    v = viewer
+    calls = []
+    update = v.renderer.update
+
+    def spy(*a, **kw):
+        calls.append(kw.get("highlight"))
+        return update(*a, **kw)
+
+    v.renderer.update = spy
+    try:
+        obj, x, y = _branch_on_screen(v)
+        _press(v, x, y)
+        assert v.grab is not None and v.grab.object == obj
+        assert v._mode == "pull"
+        start = v.anchor_point()
+        # Drag across the branch on the screen, about 60 screen units.
+        nodes = v.tree.object_nodes(obj)
+        a, b = v.camera.project(v.sim.positions[[nodes[0], nodes[-1]]], W, H)[:, :2]
+        along = (b - a) / np.linalg.norm(b - a)
+        across = np.array([-along[1], along[0]])
+        cx, cy = x + 60 * across[0], y + 60 * across[1]
+        v.on_cursor_pos(cx, cy)
+        target = v.grab.target.copy()
+        assert abs((target - v.camera.eye) @ v.camera.forward - (start - v.camera.eye) @ v.camera.forward) < 1e-6
+        gaps, moved = [], []
+        for k in range(90):  # drawn frames at first (the highlight), then the simulation alone
+            v.frame(DT) if k < 8 else v.advance(DT)
+            p = v.anchor_point()
+            gaps.append(np.linalg.norm(target - p))
+            moved.append(v.camera.project(p, W, H)[0, :2])
+        assert calls[-1] == obj, "the grabbed branch is drawn highlighted"
+        assert v.sim.pulls and obj in v.sim.pulls
+        gap0 = np.linalg.norm(target - start)
+        assert gaps[-1] < 0.65 * gap0, "the grabbed point did not follow the cursor"
+        shift = np.asarray(moved[-1]) - np.array([x, y])
+        assert shift @ across > 0.3 * 60, "the branch did not move towards the cursor on the screen"
+        held = np.array([v.anchor_point()])
+        # Held still: it settles (no ringing, no drift).
+        late = []
+        for _ in range(10):
+            v.advance(DT)
+            late.append(v.anchor_point())
+        assert np.ptp(np.array(late), axis=0).max() < 0.05 * gap0
+        # Let go: it swings back and forth through its rest pose.
+        v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+        assert v.grab is None and not v.sim.pulls and v._mode is None
+        assert calls[-1] == obj
+        v.frame(DT)
+        assert calls[-1] is None
+        tips = []
+        for k in range(150):
+            v.frame(DT) if k % 25 == 0 else v.advance(DT)
+            tips.append(v.sim.tip_position(obj))
+        tips = np.array(tips)
+        rest = v.tree.rest_positions[nodes[-1]]
+        off = (tips - rest) @ (held[0] - rest) / np.linalg.norm(held[0] - rest)
+        assert off.max() > 0.3 * np.linalg.norm(held[0] - rest) or off[0] > 0
+        assert (np.diff(np.sign(off[np.abs(off) > 1e-4])) != 0).sum() >= 2, "no swing through rest"
+        assert np.ptp(tips[-40:], axis=0).max() > 1e-3, "it stopped at once"
+        assert len(v.trace) > 200
+        assert np.all(np.isfinite(v.trace.points))
+    finally:
+        v.renderer.update = update
+
+
+def test_losing_focus_mid_drag_lets_go(viewer):
+    v = viewer
+    obj, x, y = _branch_on_screen(v)
+    _press(v, x, y)
+    v.on_cursor_pos(x + 40, y)
+    v.frame(DT)
+    assert v.sim.pulls
+    v.on_focus(False)
+    assert v.grab is None and not v.sim.pulls and v._mode is None
+    v.on_focus(True)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)  # the late release does nothing
+    v.frame(DT)
+
+
+# ---------------------------------------------------------------------------- camera
+def test_orbit_pan_zoom_on_empty_sky(viewer):
+    v = viewer
+    x, y = W - 10, 10
+    assert v.pick(x, y) is None
+    az, el = v.camera.azimuth, v.camera.elevation
+    _press(v, x, y)
+    assert v._mode == "orbit" and v.grab is None
+    v.on_cursor_pos(x - 40, y + 20)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    assert (v.camera.azimuth - az) % 360 == pytest.approx(14.0)
+    assert v.camera.elevation == pytest.approx(el + 7.0)
+    target = v.camera.target.copy()
+    _press(v, x, y, glfw.MOUSE_BUTTON_RIGHT)
+    v.on_cursor_pos(x - 30, y)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_RIGHT, glfw.RELEASE, 0)
+    assert np.linalg.norm(v.camera.target - target) > 0.01
+    d = v.camera.distance
+    v.on_scroll(0.0, 2.0)
+    assert v.camera.distance == pytest.approx(d * 0.88**2)
+    v.on_cursor_pos(x - 80, y + 40)  # no button held: nothing moves
+    assert v.camera.distance == pytest.approx(d * 0.88**2)
+    v.on_key(glfw.KEY_F, 0, glfw.PRESS, 0)  # frame the tree again
+    assert v.frame(DT)
+
+
+def test_the_panel_keeps_the_mouse(viewer):
+    v = viewer
+    v.show_panel = True
+    v.frame(DT)
+    x, y = _centre(v.panel.item_rects["season"])
+    x -= 40  # on the slider's frame, away from its grab
+    az = v.camera.azimuth
+    _press(v, x, y)
+    assert v._mode is None and v.grab is None
+    v.on_cursor_pos(x + 60, y + 30)
+    v.frame(DT)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    v.frame(DT)
+    assert v.camera.azimuth == az
+    d = v.camera.distance
+    v.on_cursor_pos(*_centre(v.panel.item_rects["preset"]))
+    v.frame(DT)
+    v.on_scroll(0.0, 3.0)
+    assert v.camera.distance == d
+
+
+# ---------------------------------------------------------------------------- panel
+def test_panel_slider_and_checkbox_change_the_scene(viewer):
+    v = viewer
+    v.show_panel = True
+    v.frame(DT)
+    v.frame(DT)
+    x0, y0, x1, y1 = v.panel.item_rects["speed"]
+    _click(v, x0 + 0.8 * (x1 - x0), 0.5 * (y0 + y1))
+    assert v.sim.wind.speed == pytest.approx(24.0, abs=2.0)
+    x0, y0, x1, y1 = v.panel.item_rects["direction"]
+    _click(v, x0 + 0.25 * (x1 - x0), 0.5 * (y0 + y1))
+    d = v.sim.wind.direction
+    assert np.degrees(np.arctan2(-d[2], d[0])) == pytest.approx(90.0, abs=10.0)
+    assert not v.show_wind
+    for section in ("Physics", "Wind"):  # fold two sections: the overlays come into view
+        _click(v, *_centre(v.panel.item_rects[section]))
+    assert "f branch" not in v.panel.item_rects and "speed" not in v.panel.item_rects
+    x, y = _centre(v.panel.item_rects["wind slices + arrow"])
+    assert y < H - 8
+    _click(v, x, y)
+    assert v.show_wind
+    for section in ("Physics", "Wind"):
+        _click(v, *_centre(v.panel.item_rects[section]))
+    assert "speed" in v.panel.item_rects
+    assert v.wind_slices in v.overlays() and v.wind_arrow in v.overlays()
+    # a wind overlay frame draws without GL errors and moves the tree
+    t0 = v.sim.tip_position(0).copy()
+    for _ in range(20):
+        v.frame(DT)
+    assert v.ctx.error == "GL_NO_ERROR"
+    assert np.linalg.norm(v.sim.tip_position(0) - t0) > 0
+    v.show_wind = False
+
+
+def test_panel_apply_sets_physics_season_and_time(viewer):
+    v = viewer
+    p = v.panel
+    assert p.apply("season", 0.6) and v.sim.season == 0.6
+    assert p.apply("ei_max", 5000.0) and v.sim.physics.ei_max == 5000.0
+    p.edit_season = "winter"
+    assert p.apply("f:branch", (0.9, 1.7))
+    assert v.sim.physics.winter.branch.f == (0.9, 1.7)
+    assert v.sim.physics.summer.branch == v.tree.physics.summer.branch
+    assert p.apply("zeta:leaf", (0.05, 0.02))  # given backwards: sorted
+    assert v.sim.physics.winter.leaf.zeta == (0.02, 0.05)
+    assert p.apply("turbulence", 1.9) and v.sim.wind.turbulence == 1.9
+    assert p.apply("beta_u", 2.0) and v.sim.wind.beta_u == 2.0
+    assert p.apply("c3", 0.8) and v.sim.wind.c3 == 0.8
+    assert p.apply("integrator", "euler") and v.sim.integrator == "euler"
+    assert p.apply("coupling", False) and not v.sim.coupling
+    assert p.apply("time_scale", 0.25) and v.time_scale == 0.25
+    assert not p.apply("turbulence", 7.0)  # refused by the wind field: shown, not raised
+    assert v.messages[-1].startswith("error: turbulence")
+    assert v.sim.wind.turbulence == 1.9
+    # everything still runs
+    v.show_panel = True
+    for _ in range(3):
+        assert v.frame(DT)
+    p.apply("integrator", "exact")
+    p.apply("coupling", True)
+    p.apply("season", 0.0)
+
+
+def test_keys_go_to_a_text_field_while_typing(viewer):
+    v = viewer
+    v.show_panel = True
+    v.frame(DT)
+    _click(v, *_reveal(v, "Preset file"))
+    _click(v, *_reveal(v, "path"))
+    assert v.gui.wants_keyboard
+    before = v.panel.path
+    for key, ch in ((glfw.KEY_SPACE, " "), (glfw.KEY_R, "r"), (glfw.KEY_Q, "q")):
+        v.on_key(key, 0, glfw.PRESS, 0)
+        v.on_char(ord(ch))
+        v.on_key(key, 0, glfw.RELEASE, 0)
+        v.frame(DT)
+    assert not v.paused and not v.window.should_close
+    assert v.panel.path != before and v.panel.path.replace(" rq", "", 1) == before
+    v.panel.path = before
+    _click(v, W - 10, 10)  # click the sky: the field lets go of the keyboard
+    assert not v.gui.wants_keyboard
+    v.on_key(glfw.KEY_SPACE, 0, glfw.PRESS, 0)
+    assert v.paused
+    v.on_key(glfw.KEY_SPACE, 0, glfw.PRESS, 0)
+    assert not v.paused
+    _click(v, *_reveal(v, "Preset file"))  # fold it again
+
+
+def test_keys_pause_reset_hide(viewer):
+    v = viewer
+    v.set_wind(speed=8.0)
+    for _ in range(5):
+        v.frame(DT)
+    assert v.sim.time > 0
+    v.on_key(glfw.KEY_SPACE, 0, glfw.PRESS, 0)
+    t = v.sim.time
+    v.frame(DT)
+    assert v.paused and v.sim.time == t
+    v.on_key(glfw.KEY_R, 0, glfw.PRESS, 0)
+    assert v.sim.time == 0.0
+    v.on_key(glfw.KEY_SPACE, 0, glfw.PRESS, 0)
+    v.on_key(glfw.KEY_H, 0, glfw.PRESS, 0)
+    assert v.show_panel
+    v.frame(DT)
+    v.on_key(glfw.KEY_H, 0, glfw.PRESS, 0)
+    assert not v.show_panel
+    v.on_key(glfw.KEY_ESCAPE, 0, glfw.PRESS, 0)
+    assert v.window.should_close
+    glfw.set_window_should_close(v.window.handle, False)
+
+
+# ---------------------------------------------------------------------------- time
+def test_time_steps_are_clamped_and_fixed(viewer):
+    v = viewer
+    t = v.sim.time
+    n = v.advance(10.0)  # a 10 s stall
+    assert v.sim.time - t <= MAX_FRAME_DT + v.substep + 1e-12
+    assert n == 3
+    v.time_scale = 0.25
+    assert v.substep == pytest.approx(DT / 4)
+    t = v.sim.time
+    assert sum(v.advance(DT) for _ in range(60)) == 60  # one step a 60 Hz frame in slow motion
+    assert v.sim.time - t == pytest.approx(0.25, abs=v.substep)
+    v.time_scale = 2.0
+    assert v.substep == DT
+    t = v.sim.time
+    for _ in range(30):
+        v.advance(DT)
+    assert v.sim.time - t == pytest.approx(1.0, abs=DT)
+    v.paused = True
+    assert v.advance(DT) == 0
+
+
+# ---------------------------------------------------------------------------- window states
+def test_resize_to_odd_sizes_and_minimise(viewer):
+    v = viewer
+    for w, h in ((333, 211), (1, 1), (97, 401), (W, H)):
+        glfw.set_window_size(v.window.handle, w, h)
+        _settle(v, (w, h))
+        fw, fh = v.window.framebuffer_size
+        assert v._fb == (fw, fh), "the framebuffer-size callback reached the viewer"
+        v.show_panel = (w, h) != (1, 1)
+        assert v.frame(DT)
+        assert v.read_pixels().shape == (fh, fw, 3)
+        assert v.ctx.error == "GL_NO_ERROR"
+    v.on_resize(0, 0)  # minimised
+    assert not v.frame(DT)
+    assert v.read_pixels().shape == (0, 0, 3)
+    v.on_key(glfw.KEY_S, 0, glfw.PRESS, 0)  # a screenshot waits for a drawn frame
+    assert not v.frame(DT)
+    v._screenshot_pending.clear()
+    v.on_resize(*v.window.framebuffer_size)
+    assert v.frame(DT)
+    assert v.ctx.error == "GL_NO_ERROR"
+
+
+def test_screenshot_key_writes_a_png(viewer, tmp_path, monkeypatch, capsys):
+    import imageio.v3 as iio
+
+    monkeypatch.chdir(tmp_path)
+    v = viewer
+    v.show_panel = True
+    v.on_key(glfw.KEY_S, 0, glfw.PRESS, 0)
+    v.frame(DT)
+    v.on_key(glfw.KEY_F12, 0, glfw.PRESS, 0)
+    v.frame(DT)
+    files = sorted(tmp_path.glob("treeanim-*.png"))
+    assert len(files) == 2
+    assert all(re.fullmatch(r"treeanim-\d{8}-\d{6}(-\d+)?\.png", f.name) for f in files)
+    img = iio.imread(files[0])
+    assert img.shape == (H, W, 3) and img.std() > 10
+    assert str(files[0].resolve()) in capsys.readouterr().out
+
+
+# ---------------------------------------------------------------------------- settings
+def test_settings_round_trip_through_the_panel(viewer, tmp_path):
+    v = viewer
+    p = v.panel
+    p.apply("ei_max", 12345.678)
+    p.edit_season = "summer"
+    p.apply("f:leaf", (1.1, 2.3))
+    physics = v.sim.physics
+    path = tmp_path / "mine.toml"
+    p.path = str(path)
+    v.on_key(glfw.KEY_S, 0, glfw.PRESS, glfw.MOD_CONTROL)  # Ctrl+S
+    assert path.is_file()
+    assert [f.name for f in tmp_path.iterdir()] == ["mine.toml"], "no temporary file is left behind"
+    text = path.read_text()
+    original = (ta.load_preset("small_cherry").source)
+    with open(original, "rb") as f:
+        data = tomllib.load(f)
+    saved = tomllib.loads(text)
+    assert {k: x for k, x in saved.items() if k != "physics"} == {k: x for k, x in data.items() if k != "physics"}
+    assert "# level 2: the first fork" in text, "the shape tables keep their comments"
+    loaded = ta.load_tree(path)
+    assert loaded.physics == physics
+    assert np.array_equal(loaded.rest_positions, v.tree.rest_positions)
+    v.load_tree(ta.load_preset("small_cherry"))
+    assert v.sim.physics != physics
+    v.on_key(glfw.KEY_O, 0, glfw.PRESS, glfw.MOD_CONTROL)  # Ctrl+O
+    assert v.sim.physics == physics
+    assert v.frame(DT)
+    # a failed save says why and leaves nothing behind
+    assert p.save(str(tmp_path / "nowhere" / "x.toml")) is None
+    assert "does not exist" in v.messages[-1]
+    assert not p.load(str(tmp_path / "missing.toml"))
+    assert v.messages[-1].startswith("error")
+
+
+def test_preset_text_rewrites_unusual_layouts(tmp_path):
+    tree = ta.load_preset("beam")
+    physics = dataclasses.replace(tree.physics, ei_max=321.0)
+    original = (
+        'name = "beam"\ntype = "beam"\nphysics.ei_max = 99.0\n'
+        '[physics.summer]\nbranch = { f = [1.0, 2.0], zeta = [0.1, 0.2] }\n'
+        '[physics.winter]\nbranch = { f = [1.0, 2.0], zeta = [0.1, 0.2] }\n[beam]\nsegments = 6\n'
+    )
+    text = preset_text(original, physics, seed=7)
+    data = tomllib.loads(text)
+    assert data["seed"] == 7 and data["beam"] == {"segments": 6} and data["physics"]["ei_max"] == 321.0
+    path = tmp_path / "b.toml"
+    path.write_text(text)
+    assert ta.load_tree(path).physics == physics
+    assert save_preset(tmp_path / "c.toml", tree, physics) == tmp_path / "c.toml"
+    assert ta.load_tree(tmp_path / "c.toml").physics == physics
+    with pytest.raises(ValueError, match="positive"):
+        physics_toml(dataclasses.replace(physics, twist_c0=0.0))
+
+
+def test_presets_switch_in_the_viewer(viewer):
+    v = viewer
+    v.set_wind(speed=3.0)
+    assert v.panel.apply("preset", "beam")
+    assert v.tree.name == "beam" and v.sim.wind.speed == 3.0
+    assert v.frame(DT)
+    assert not v.panel.apply("preset", "no_such_tree")
+    assert v.tree.name == "beam"
+    v.load_tree(ta.load_preset("small_cherry"))
+
+
+# ---------------------------------------------------------------------------- the command line
+def test_view_command_runs_frames(tmp_path, monkeypatch):
+    from treeanim.cli import main
+
+    monkeypatch.chdir(tmp_path)
+    assert main(["view", "beam", "--size", "320x200", "--season", "0.5", "--wind", "3", "--frames", "3"]) == 0
+
+
+def _one_line_failure(env, *args):
+    res = subprocess.run([sys.executable, "-m", "treeanim", *args], env=env, capture_output=True, text=True,
+                         timeout=60)
+    lines = res.stderr.strip().splitlines()
+    assert res.returncode == 2, res.stderr
+    assert len(lines) == 1, res.stderr
+    assert "Traceback" not in res.stderr and res.stdout == ""
+    return lines[0]
+
+
+def test_no_display_is_one_clear_line():
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    line = _one_line_failure(env)  # plain `treeanim` opens the viewer
+    assert "no display" in line and "treeanim render" in line and "treeanim export" in line
+
+
+def test_no_opengl_33_is_one_clear_line():
+    env = dict(os.environ, MESA_GL_VERSION_OVERRIDE="3.0", MESA_GLSL_VERSION_OVERRIDE="130")
+    line = _one_line_failure(env, "view", "beam")
+    assert "OpenGL 3.3" in line and "treeanim render" in line
+
+
+def test_bad_view_options_are_one_line():
+    line = _one_line_failure(dict(os.environ), "view", "beam", "--size", "12by7")
+    assert "--size" in line
+
+
+def test_run_loop_stops_on_close(viewer):
+    v = viewer
+    v.window.request_close()
+    assert run(v, max_frames=5) == 0
+    glfw.set_window_should_close(v.window.handle, False)
+    assert run(v, max_frames=2) == 2
