@@ -443,7 +443,8 @@ class BendingPlan:
             ok = nn > amag
             phi *= ok
             t *= ok
-            inv = np.divide(1.0, nn, out=np.zeros_like(nn), where=ok)
+            inv = np.maximum(nn, 1e-300)  # 1/|N|; where no bend, t = 0 zeroes its uses
+            np.divide(1.0, inv, out=inv)
             self.phi[a:b] = phi
             np.divide(phi, np.maximum(theta0, 1e-300), out=self.rho[a:b])
             # Bend quaternion (cos φ/2, sin φ/2 · N/|N|)

@@ -618,7 +618,8 @@ class Simulation:
         mul = np.multiply
         Fw = ws.get("Fw", (3, M))
         if self._wind is not None:
-            pts = np.ascontiguousarray(self._sample_pos.T)
+            pts = ws.get("pts", (M, 3))
+            pts[...] = self._sample_pos.T
             U = np.asarray(self._wind.sample(pts, t), dtype=float)
             if U.shape != (M, 3):
                 raise ValueError(f"wind.sample returned shape {U.shape}, expected {(M, 3)}")
