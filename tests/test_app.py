@@ -28,6 +28,7 @@ DT = 1.0 / 60.0
 def app():
     win = Window.open(W, H, "treeanim test", samples=4)  # 4x MSAA: screenshots resolve it
     v = Viewer(win, ta.load_preset("small_cherry"), wind_speed=0.0)
+    v.panel.record_rects = True  # where the widgets are, to click on them
     win.connect(v)
     yield v
     v.release()

@@ -9,8 +9,10 @@ any refusal in the panel's status line instead of raising.
 from __future__ import annotations
 
 import dataclasses
+import time
 from pathlib import Path
 
+import numpy as np
 from imgui_bundle import imgui
 
 from ..model.params import ModeRange
@@ -33,6 +35,7 @@ RANGES = {
     "time_scale": (0.05, 2.0, "%.2f×", True),
 }
 _PLURAL = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
+_WINDOW_FLAGS = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize | imgui.WindowFlags_.no_saved_settings
 
 
 class Panel:
@@ -44,9 +47,12 @@ class Panel:
         The preset file the Save and Load buttons use.
     edit_season : {'summer', 'winter'}
         Which season's f and ζ ranges the range widgets edit.
+    record_rects : bool
+        Fill :attr:`item_rects` while drawing (off by default: it costs a few imgui calls a
+        widget).
     item_rects : dict
-        Label → (x0, y0, x1, y1) in screen units of each widget as last drawn (tests click on
-        them).
+        Label → (x0, y0, x1, y1) in screen units of each widget as last drawn, for tests and
+        scripts that click on them.
     rect : tuple or None
         (x0, y0, x1, y1) of the panel window as last drawn.
     """
@@ -58,7 +64,13 @@ class Panel:
         self.item_rects: dict[str, tuple[float, float, float, float]] = {}
         self.rect: tuple[float, float, float, float] | None = None
         self._presets: list[str] | None = None
+        self._kinds: list[str] = []
         self._pending: dict[str, float] = {}  # slider values applied when the slider is let go
+        self.record_rects = False
+        self._text_key = None
+        self._text: tuple[str, str] = ("", "")
+        self._timing_at = -1.0
+        self._timing = ""
 
     # ------------------------------------------------------------------ geometry
     @property
@@ -83,6 +95,7 @@ class Panel:
         v = self.viewer
         self.path = self.path or f"{v.sim.tree.name}-custom.toml"
         self.edit_season = "summer" if v.sim.season < 0.5 else "winter"
+        self._kinds = [k for k in KINDS if np.any(v.sim.tree.kind == k)]
         self._pending.clear()
 
     # ------------------------------------------------------------------ changes
@@ -168,6 +181,8 @@ class Panel:
 
     # ------------------------------------------------------------------ drawing
     def _rect(self, label: str, frame_only: bool = False) -> None:
+        if not self.record_rects:
+            return
         a, b = imgui.get_item_rect_min(), imgui.get_item_rect_max()
         x1 = a.x + imgui.calc_item_width() if frame_only else b.x  # the widget without its label
         self.item_rects[label] = (a.x, a.y, x1, b.y)
@@ -208,8 +223,7 @@ class Panel:
         imgui.set_next_window_pos(imgui.ImVec2(8 * s, 8 * s), imgui.Cond_.always)
         imgui.set_next_window_size_constraints(imgui.ImVec2(self.width, 0), imgui.ImVec2(self.width, max(wh - 16 * s, 60)))
         imgui.set_next_window_size(imgui.ImVec2(self.width, 0), imgui.Cond_.always)
-        flags = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize | imgui.WindowFlags_.no_saved_settings
-        expanded, _ = imgui.begin("treeanim", None, flags)
+        expanded, _ = imgui.begin("treeanim", None, _WINDOW_FLAGS)
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self.rect = (pos.x, pos.y, pos.x + size.x, pos.y + size.y)
         if not expanded:
@@ -218,12 +232,21 @@ class Panel:
         imgui.push_item_width(-110 * s)
 
         # --- statistics
-        st = v.stats()
-        kinds = [k for k in KINDS if st[_PLURAL[k]]]
-        imgui.text("  ".join(f"{st[_PLURAL[k]]:,} {_PLURAL[k]}" for k in kinds))
-        imgui.text(f"{st['objects']:,} objects  {st['nodes']:,} nodes  {st['triangles']:,} tris")
-        fps = 1.0 / v.frame_s.value if v.frame_s.value else 0.0
-        imgui.text(f"sim {v.sim_ms.value or 0:.1f} ms  render {v.render_ms.value or 0:.1f} ms  {fps:.0f} FPS")
+        key = (id(sim.tree), sim.season)
+        if key != self._text_key:  # the counts change only with the tree and the season
+            st = v.stats()
+            kinds = [k for k in KINDS if st[_PLURAL[k]]]
+            self._text = ("  ".join(f"{st[_PLURAL[k]]:,} {_PLURAL[k]}" for k in kinds),
+                          f"{st['objects']:,} objects  {st['nodes']:,} nodes  {st['triangles']:,} tris")
+            self._text_key = key
+        imgui.text(self._text[0])
+        imgui.text(self._text[1])
+        now = time.perf_counter()
+        if now - self._timing_at > 0.25:  # readable, and cheaper than formatting every frame
+            fps = 1.0 / v.frame_s.value if v.frame_s.value else 0.0
+            self._timing = f"sim {v.sim_ms.value or 0:.1f} ms  render {v.render_ms.value or 0:.1f} ms  {fps:.0f} FPS"
+            self._timing_at = now
+        imgui.text(self._timing)
         gl = v.gl_renderer.split(" (")[0][:24]
         msaa = f"MSAA {v.window.samples}×" if v.window.samples else "no MSAA"
         state = f"{'paused' if v.paused else f't = {sim.time:.1f} s'}   {gl}, {msaa}"
@@ -265,9 +288,7 @@ class Panel:
             if imgui.radio_button("winter", self.edit_season == "winter"):
                 self.edit_season = "winter"
             table = getattr(p, self.edit_season)
-            for kind in KINDS:
-                if not (sim.tree.kind == kind).any():
-                    continue
+            for kind in self._kinds:
                 r = table.of(kind) or p.modes(kind, sim.season)
                 if r is None:
                     continue
