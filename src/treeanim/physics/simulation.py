@@ -456,12 +456,13 @@ class Simulation:
             self._fn = self._cplan.node_frames(self._frame)
         return self._fn
 
-    @staticmethod
-    def _recycled(old, shape):
-        """``old`` if nobody outside holds it any more (so writing to it is invisible), else a
-        new array: outputs are fresh arrays for whoever keeps them, without a fresh allocation
-        (and its page faults) every frame for whoever does not."""
-        if old is not None and sys.getrefcount(old) <= 3:  # the attribute, the argument, getrefcount's
+    def _recycled(self, attr: str, shape: tuple[int, ...]) -> np.ndarray:
+        """The array in ``attr`` if nobody outside holds it any more (so overwriting it is
+        invisible), else a new one: outputs stay fresh arrays for whoever keeps them, without a
+        new allocation (and its page faults) every frame for whoever does not."""
+        old = getattr(self, attr)
+        setattr(self, attr, None)
+        if old is not None and old.shape == shape and sys.getrefcount(old) <= _UNSHARED_REFS:
             old.setflags(write=True)
             return old
         return np.empty(shape)
@@ -473,8 +474,7 @@ class Simulation:
         An array you keep is never changed by later steps.
         """
         if self._pos_out is None:
-            buf = self._recycled(self._pos_buf, (self._N, 3))
-            self._pos_buf = None
+            buf = self._recycled("_pos_buf", (self._N, 3))
             pos = self._cplan.positions(self._bplan.o, self._node_frames(), self._base, out=buf)
             pos.setflags(write=False)
             self._pos_out = self._pos_buf = pos
@@ -488,8 +488,7 @@ class Simulation:
         An array you keep is never changed by later steps.
         """
         if self._rot_out is None:
-            buf = self._recycled(self._rot_buf, (self._N, 3, 3))
-            self._rot_buf = None
+            buf = self._recycled("_rot_buf", (self._N, 3, 3))
             rot = self._cplan.rotations(self._bplan.q, self._node_frames(), out=buf)
             rot.setflags(write=False)
             self._rot_out = self._rot_buf = rot
@@ -694,6 +693,23 @@ class Simulation:
         self._pos_out = None
         self._rot_out = None
         self._fn = None
+
+
+def _unshared_refs() -> int:
+    """sys.getrefcount of an array held only by an attribute, seen as in _recycled (measured,
+    since the count of a lone object differs between Python versions)."""
+
+    class Holder:
+        pass
+
+    h = Holder()
+    h.a = np.empty(1)
+    old = getattr(h, "a")
+    h.a = None
+    return sys.getrefcount(old)
+
+
+_UNSHARED_REFS = _unshared_refs()
 
 
 def _polygon_centroid(xy: np.ndarray) -> tuple[float, float]:
