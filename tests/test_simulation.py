@@ -349,3 +349,19 @@ def test_bad_constructor_arguments(tree):
         Simulation("small_cherry")
     with pytest.raises(ValueError, match="wind"):
         Simulation(tree, wind=42)
+
+
+def test_outputs_you_keep_are_never_overwritten(tree):
+    sim = Simulation(tree, wind=Uniform((12.0, 0.0, 4.0)))
+    kept = []
+    for k in range(6):
+        sim.step(1 / 30)
+        P, R = sim.positions, sim.rotations
+        assert not P.flags.writeable and not R.flags.writeable
+        assert sim.positions is P  # cached until the next step
+        if k % 2 == 0:
+            kept.append((P, P.copy(), R[:5], R[:5].copy()))  # a view keeps its base alive too
+    for P, P0, Rv, R0 in kept:
+        np.testing.assert_array_equal(P, P0)
+        np.testing.assert_array_equal(Rv, R0)
+    assert not np.array_equal(kept[0][0], kept[-1][0])
