@@ -114,6 +114,7 @@ def test_window_draws_the_tree_and_the_panel(viewer):
     v.ctx.screen.use()
     r.draw(v.camera, W, H, season=v.sim.season)
     empty = v.read_pixels()
+    v._uploaded = None  # the viewer uploads its pose again on its next frame
     assert v.ctx.error == "GL_NO_ERROR"
     tree_px = np.abs(scene.astype(int) - empty.astype(int)).max(axis=2) > 24
     assert tree_px.mean() > 0.03, "the tree covers too little of the window"
@@ -418,6 +419,13 @@ def test_resize_to_odd_sizes_and_minimise(viewer):
         assert v.frame(DT)
         assert v.read_pixels().shape == (fh, fw, 3)
         assert v.ctx.error == "GL_NO_ERROR"
+    v.on_key(glfw.KEY_F11, 0, glfw.PRESS, 0)  # full screen: the whole (virtual) monitor
+    mode = glfw.get_video_mode(glfw.get_primary_monitor())
+    _settle(v, (mode.size.width, mode.size.height))
+    assert v.window.fullscreen and v.frame(DT)
+    v.on_key(glfw.KEY_F11, 0, glfw.PRESS, 0)
+    _settle(v, (W, H))
+    assert not v.window.fullscreen and v.frame(DT)
     v.on_resize(0, 0)  # minimised
     assert not v.frame(DT)
     assert v.read_pixels().shape == (0, 0, 3)

@@ -31,9 +31,11 @@ RANGES = {
     "beta_vw": (0.5, 3.0, "%.2f", False),
     "c3": (0.0, 2.0, "%.2f", False),
     "c4": (0.0, 2.0, "%.2f", False),
-    "ei_max": (100.0, 1.0e6, "%.3g N·m²", True),
+    "ei_max": (0.0, 0.0, "%.3g N·m²", True),  # set per tree: the preset's value ÷ or × EI_SPAN
     "time_scale": (0.05, 2.0, "%.2f×", True),
 }
+#: The EI_max slider spans the preset's value divided or multiplied by this.
+EI_SPAN = 30.0
 _PLURAL = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
 _WINDOW_FLAGS = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize | imgui.WindowFlags_.no_saved_settings
 
@@ -65,6 +67,7 @@ class Panel:
         self.rect: tuple[float, float, float, float] | None = None
         self._presets: list[str] | None = None
         self._kinds: list[str] = []
+        self._ranges: dict[str, tuple] = {}
         self._pending: dict[str, float] = {}  # slider values applied when the slider is let go
         self.record_rects = False
         self._text_key = None
@@ -96,6 +99,8 @@ class Panel:
         self.path = self.path or f"{v.sim.tree.name}-custom.toml"
         self.edit_season = "summer" if v.sim.season < 0.5 else "winter"
         self._kinds = [k for k in KINDS if np.any(v.sim.tree.kind == k)]
+        ei = float(v.sim.tree.physics.ei_max)
+        self._ranges = {"ei_max": (ei / EI_SPAN, ei * EI_SPAN, *RANGES["ei_max"][2:])}
         self._pending.clear()
 
     # ------------------------------------------------------------------ changes
@@ -193,7 +198,7 @@ class Panel:
         return shown
 
     def _slider(self, label: str, name: str, value: float, deferred: bool = False) -> None:
-        lo, hi, fmt, log = RANGES[name]
+        lo, hi, fmt, log = self._ranges.get(name) or RANGES[name]
         flags = imgui.SliderFlags_.logarithmic if log else 0
         shown = self._pending.get(name, value)
         changed, new = imgui.slider_float(label, shown, lo, hi, fmt, flags)

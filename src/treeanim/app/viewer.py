@@ -215,6 +215,7 @@ class Viewer:
         self._cursor = (0.0, 0.0)
         self._screenshot_pending: list[Path | None] = []
         self._readback = None
+        self._uploaded = None
         self._stats_key = None
         self._stats: dict = {}
         self._win = tuple(window.size)
@@ -295,7 +296,10 @@ class Viewer:
         if w <= 0 or h <= 0:
             w, h = 16, 9
         free = max(w - self.panel_width, 0.4 * w)
-        self.camera.frame(self.renderer.bounds(), aspect=free / h)
+        lo, hi = self.renderer.bounds()
+        flat = (hi[1] - lo[1]) < 0.5 * max(hi[0] - lo[0], hi[2] - lo[2])
+        self.camera.elevation = 25.0 if flat else 8.0  # look down on a meadow, along a tree
+        self.camera.frame((lo, hi), aspect=free / h)
         self.camera.pan((w - free) / 2.0, 0.0, h)  # the tree moves right, beside the panel
 
     # ------------------------------------------------------------------ time
@@ -362,7 +366,11 @@ class Viewer:
             return
         sim, r = self.sim, self.renderer
         highlight = self.grab.object if self.grab is not None else None
-        r.update(sim.positions, sim.rotations, present=sim.present, highlight=highlight)
+        pos = sim.positions
+        key = (id(r), id(pos), sim.time, id(sim.present), highlight)
+        if key != self._uploaded:  # the pose is unchanged while paused or between steps
+            r.update(pos, sim.rotations, present=sim.present, highlight=highlight)
+            self._uploaded = key
         self.ctx.screen.use()
         r.draw(self.camera, fw, fh, season=sim.season, overlays=self.overlays())
         if self.show_panel:
@@ -479,9 +487,12 @@ class Viewer:
         t = float((g.plane_point - o) @ g.plane_normal) / denom
         return o + max(t, 0.0) * d
 
-    def compliance(self, obj: int, k: int, s: float) -> float:
-        """Metres the anchor (segment ``k`` of object ``obj``, at ``s`` along it) moves per
-        newton of a tip force across the object, by the linearised bending of DESIGN §5."""
+    def compliance(self, obj: int, k: int, s: float, offset=(0.0, 0.0, 0.0)) -> float:
+        """Metres a point moves per newton of a tip force across object ``obj``, by the
+        linearised bending of DESIGN §5 (small angles, the rest pose).
+
+        The point is carried by segment ``k`` at ``s`` (0 … 1) along it, plus ``offset`` (a
+        point on a leaf's lamina lies beyond the petiole's tip)."""
         tree = self.sim.tree
         p = self.sim.physics
         nodes = tree.object_nodes(obj)
@@ -493,7 +504,7 @@ class Viewer:
         dmax = float(np.max(tree.node_diameter))
         stiff = p.ei_max * (0.5 * (D[:-1] + D[1:]) / dmax) ** p.stiffness_exponent
         phi = (n - np.arange(n)) / n * L / np.maximum(stiff, 1e-30)
-        anchor = X[k] + s * seg[k]
+        anchor = X[k] + s * seg[k] + np.asarray(offset, float)
         lever = np.linalg.norm(anchor - X[: k + 1], axis=1)
         return float(np.sum(phi[: k + 1] * lever))
 
@@ -512,11 +523,11 @@ class Viewer:
         dist = np.linalg.norm(a + s[:, None] * e - hit.point, axis=1)
         k = int(np.argmin(dist))
         anchor = a[k] + s[k] * e[k]
-        G = max(self.compliance(obj, k, float(s[k])), 1e-12)
+        point = np.asarray(hit.point, float)
+        G = max(self.compliance(obj, k, float(s[k]), point - anchor), 1e-12)
         spring = PULL_GAIN / G
         length = float(np.sum(np.linalg.norm(np.diff(tree.rest_positions[nodes], axis=0), axis=1)))
         length += float(tree.lamina_length[obj])
-        point = np.asarray(hit.point, float)
         self.grab = Grab(object=obj, node=int(nodes[k]), s=float(s[k]), offset=point - anchor,
                          plane_point=point.copy(), plane_normal=self.camera.forward.copy(), target=point.copy(),
                          k=spring, f_max=spring * PULL_MAX_LENGTHS * length, force=np.zeros(3))
