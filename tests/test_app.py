@@ -133,7 +133,10 @@ def _branch_on_screen(v):
     """A branch whose tip region is visible and picks as itself: (object, x, y)."""
     tree, P = v.tree, v.sim.positions
     branches = [i for i in np.flatnonzero(tree.kind == "branch") if tree.level[i] >= 2]
-    length = lambda i: np.linalg.norm(np.diff(tree.rest_positions[tree.object_nodes(i)], axis=0), axis=1).sum()  # noqa: E731
+
+    def length(i):
+        return np.linalg.norm(np.diff(tree.rest_positions[tree.object_nodes(i)], axis=0), axis=1).sum()
+
     for i in sorted(branches, key=length, reverse=True):
         nodes = tree.object_nodes(i)
         for f in (0.75, 0.6, 0.9):
@@ -272,6 +275,18 @@ def test_the_panel_keeps_the_mouse(viewer):
     v.frame(DT)
     v.on_scroll(0.0, 3.0)
     assert v.camera.distance == d
+    # An open combo owns the next click, even on the sky: it only closes the list.
+    _click(v, *_centre(v.panel.item_rects["preset"]))
+    assert v.panel.busy
+    _press(v, W - 10, 10)
+    assert v._mode is None
+    v.frame(DT)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    v.frame(DT)
+    assert not v.panel.busy and v.tree.name == "small_cherry" and v.camera.azimuth == az
+    _press(v, W - 10, 10)  # now the sky orbits again
+    assert v._mode == "orbit"
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
 
 
 # ---------------------------------------------------------------------------- panel

@@ -70,6 +70,7 @@ class Panel:
         self._ranges: dict[str, tuple] = {}
         self._pending: dict[str, float] = {}  # slider values applied when the slider is let go
         self.record_rects = False
+        self.busy = False  # a widget is active or a popup is open (it owns the mouse)
         self._text_key = None
         self._text: tuple[str, str] = ("", "")
         self._timing_at = -1.0
@@ -85,6 +86,11 @@ class Panel:
         """Whether screen point (x, y) lies on the panel as last drawn."""
         r = self.rect
         return r is not None and r[0] <= x < r[2] and r[1] <= y < r[3]
+
+    def owns_mouse(self, x: float, y: float) -> bool:
+        """Whether a click at (x, y) belongs to the panel: on it, or anywhere while one of its
+        widgets is active or a popup (a combo's list) is open."""
+        return self.busy or self.contains(x, y)
 
     def presets(self) -> list[str]:
         if self._presets is None:
@@ -226,13 +232,15 @@ class Panel:
         ww, wh = v._win
         self.item_rects = {}
         imgui.set_next_window_pos(imgui.ImVec2(8 * s, 8 * s), imgui.Cond_.always)
-        imgui.set_next_window_size_constraints(imgui.ImVec2(self.width, 0), imgui.ImVec2(self.width, max(wh - 16 * s, 60)))
+        imgui.set_next_window_size_constraints(imgui.ImVec2(self.width, 0),
+                                               imgui.ImVec2(self.width, max(wh - 16 * s, 60)))
         imgui.set_next_window_size(imgui.ImVec2(self.width, 0), imgui.Cond_.always)
         expanded, _ = imgui.begin("treeanim", None, _WINDOW_FLAGS)
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self.rect = (pos.x, pos.y, pos.x + size.x, pos.y + size.y)
         if not expanded:
             imgui.end()
+            self.busy = False
             return
         imgui.push_item_width(-110 * s)
 
@@ -367,4 +375,6 @@ class Panel:
                 imgui.text_disabled(line)
         imgui.pop_item_width()
         imgui.end()
+        # What the next clicks belong to (io.want_capture_mouse lags a frame behind the cursor).
+        self.busy = imgui.is_any_item_active() or imgui.is_popup_open("", imgui.PopupFlags_.any_popup)
 

@@ -566,7 +566,7 @@ class Viewer:
 
     # ------------------------------------------------------------------ input handlers
     def _over_panel(self, x: float, y: float) -> bool:
-        return self.show_panel and (self.gui.wants_mouse or self.panel.contains(x, y))
+        return self.show_panel and self.panel.owns_mouse(x, y)
 
     def on_cursor_pos(self, x: float, y: float) -> None:
         """Cursor moved to (x, y) screen units, origin top-left."""
