@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from .window import HEADLESS_HINT, ViewerUnavailable
+from .errors import HEADLESS_HINT, ViewerUnavailable, check_display
 
 
 def view(tree, *, season: float = 0.0, wind_speed: float = 5.0, size: tuple[int, int] = (1280, 720),
@@ -22,10 +22,11 @@ def view(tree, *, season: float = 0.0, wind_speed: float = 5.0, size: tuple[int,
     ViewerUnavailable
         No display, no GLFW, no OpenGL 3.3, or the viewer's libraries cannot load (one line).
     """
+    check_display()  # before loading GLFW, OpenGL and imgui: the clearest message
     try:
         from .viewer import Viewer, run
         from .window import Window
-    except (ImportError, OSError) as e:  # e.g. imgui-bundle's or GLFW's shared libraries
+    except (ImportError, OSError) as e:  # e.g. imgui-bundle's, GLFW's or OpenGL's shared libraries
         raise ViewerUnavailable(f"the viewer's libraries cannot load ({' '.join(str(e).split())}); "
                                 f"{HEADLESS_HINT}") from None
     win = Window.open(*size, title or f"treeanim — {tree.name}", samples=samples)

@@ -9,9 +9,7 @@ headless commands.
 from __future__ import annotations
 
 import ctypes
-import os
 import re
-import sys
 
 # imgui_bundle ships its own libglfw; importing it first makes pyGLFW load that same library, so
 # the process holds one GLFW state (the order matters only when both are imported).
@@ -19,17 +17,12 @@ import imgui_bundle  # noqa: F401  (side effect: PYGLFW_LIBRARY)
 import glfw
 import moderngl
 
-#: What to use where no window can be opened.
-HEADLESS_HINT = ("the headless commands need no window: 'treeanim render PRESET --out FILE' "
-                 "(images, video) and 'treeanim export PRESET --out FILE.glb'")
+from .errors import HEADLESS_HINT, ViewerUnavailable, check_display
 
+__all__ = ["Window", "ViewerUnavailable", "HEADLESS_HINT", "SOFTWARE_RENDERER"]
 
 #: Windows open now: GLFW is stopped when the last one closes.
 _open_windows: set = set()
-
-
-class ViewerUnavailable(RuntimeError):
-    """The viewer cannot open its window here; ``str(exc)`` is one line saying why."""
 
 
 #: GL_RENDERER strings of software rasterisers.
@@ -95,9 +88,7 @@ class Window:
         ViewerUnavailable
             No display, GLFW cannot start, or no OpenGL 3.3 core context.
         """
-        if sys.platform.startswith("linux") and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-            raise ViewerUnavailable(f"no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset); "
-                                    f"{HEADLESS_HINT}")
+        check_display()
         errors: list[str] = []
 
         def on_error(code, description):
