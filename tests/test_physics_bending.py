@@ -211,26 +211,3 @@ def test_frames_follow_eq1_and_fig6():
             n = tree.rest_w[obj] - (tree.rest_w[obj] @ v) * v
             np.testing.assert_allclose(w, n / np.linalg.norm(n), atol=1e-12)
     assert dataclasses.is_dataclass(tree.physics)
-
-
-def test_scalar_tail_matches_the_vector_path(monkeypatch):
-    """Blocks with few segments are bent object by object; the result must not change."""
-    import treeanim as ta
-    import treeanim.physics.bending as bending
-
-    class Wind:
-        def sample(self, points, t):
-            p = np.asarray(points)
-            return np.stack([20 + 5 * np.sin(p[:, 1] + 3 * t), np.cos(p[:, 0]), 8 * np.sin(p[:, 2] - t)], 1)
-
-    tree = ta.load_preset("tulip_poplar")  # a 20-segment trunk: blocks 6… hold it alone
-    out = []
-    for tail in (bending.TAIL_MAX, 0, 10**9):
-        monkeypatch.setattr(bending, "TAIL_MAX", tail)
-        sim = Simulation(tree, wind=Wind())
-        sim.step(1.0)  # one step: no feedback amplifies the solver's 1e-7 rad tolerance
-        out.append((sim.positions.copy(), sim.rotations.copy()))
-    for pos, rot in out[1:]:  # equal up to the 1e-7 rad tolerance of the angle solve
-        np.testing.assert_allclose(pos, out[0][0], atol=1e-6)
-        np.testing.assert_allclose(rot, out[0][1], atol=1e-6)
-    assert np.linalg.norm(out[0][0] - tree.rest_positions, axis=1).max() > 0.05

@@ -21,7 +21,7 @@ import numpy as np
 import pygltflib as gl
 
 from .model.tree import Tree
-from .render.mesh import MATERIAL_BARK, MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh, build_mesh
+from .render.mesh import MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh, build_mesh
 
 # Base colours (linear RGB) by material; leaves turn through autumn with the season.
 _BARK = (0.23, 0.16, 0.11)

@@ -32,7 +32,6 @@ object's base, Σ_{j<=i} Cⱼ sⱼ (accumulated per object, so no round-off cros
 
 from __future__ import annotations
 
-import math
 
 import numpy as np
 
@@ -50,10 +49,6 @@ NEWTON_TOL = 1e-7
 NEWTON_FIXED = 2
 #: Further Newton iterations for the stragglers before bisection takes over.
 NEWTON_EXTRA = 12
-#: Blocks with at most this many segments (the tail of long objects: a tulip poplar's trunk
-#: beyond its branches' last segments, a lone beam) are bent object by object in plain Python,
-#: which is faster than a hundred numpy calls on a handful of numbers.
-TAIL_MAX = 4
 
 
 def _residual(phi, a, theta0, k):
@@ -368,7 +363,6 @@ class BendingPlan:
             ρ_previous): 0 restarts from the last fractions, dt/dt_prev extrapolates linearly
             in time (a better start, fewer iterations).
         """
-        M = len(gamma)
         # Start of the angle solve: the bend as a fraction ρ = φ/θ₀ of the angle to the force
         # (nearly constant from step to step even where θ₀ moves), extrapolated linearly.
         rho_start = self.rho_start
@@ -392,9 +386,6 @@ class BendingPlan:
         prev = None
         prev_o = None
         for i, K in enumerate(self.counts):
-            if K <= TAIL_MAX:
-                self._bend_tail(i, Fu, Fw, cv, sv, k, rho_start)
-                break
             a, b = self.offsets[i], self.offsets[i + 1]
             s = self.seg[i]
             fu = mul(Fu[:K], self.frac[i], out=ws.get("fu", (K,)))  # Eq. 7
@@ -492,90 +483,3 @@ class BendingPlan:
                 oo += prev_o[:, :K]  # accumulate along the object
             prev = dst
             prev_o = oo
-
-    def _bend_tail(self, i0: int, Fu, Fw, cv, sv, k, rho_start) -> None:
-        """Blocks i0… (few objects left): the same arithmetic as :meth:`bend`, object by object."""
-        q, o, phis, rho = self.q, self.o, self.phi, self.rho
-        sqrt, atan2, tan = math.sqrt, math.atan2, math.tan
-        for j in range(self.counts[i0]):
-            fu0, fw0, c, sn = float(Fu[j]), float(Fw[j]), float(cv[j]), float(sv[j])
-            if i0 > 0:
-                ps = self.offsets[i0 - 1] + j
-                Cw, Cx, Cy, Cz = q[:, ps].tolist()
-                ox0, oy0, oz0 = o[:, ps].tolist()
-            for i in range(i0, int(self.nseg_ord[j])):
-                slot = self.offsets[i] + j
-                sx, sy, sz = self.seg[i][:, j].tolist()
-                fr = float(self.frac[i][j])
-                fu, fw = fu0 * fr, fw0 * fr  # Eq. 7
-                if i == 0:  # T = Rot(v, −γ); s′ = s₀ (on v)
-                    Tw, Tx, Ty, Tz = c, 0.0, sn, 0.0
-                    spx, spy, spz = sx, sy, sz
-                else:  # T = Rot(v, −γ) ⊗ C_{i−1};  s′ = T s
-                    Tw, Tx, Ty, Tz = c * Cw - sn * Cy, c * Cx + sn * Cz, c * Cy + sn * Cw, c * Cz - sn * Cx
-                    tx = 2.0 * (Ty * sz - Tz * sy)
-                    ty = 2.0 * (Tz * sx - Tx * sz)
-                    tz = 2.0 * (Tx * sy - Ty * sx)
-                    spx = sx + Tw * tx + (Ty * tz - Tz * ty)
-                    spy = sy + Tw * ty + (Tz * tx - Tx * tz)
-                    spz = sz + Tw * tz + (Tx * ty - Ty * tx)
-                n0, n1, n2 = spy * fw, spz * fu - spx * fw, -(spy * fu)
-                nn = sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-                dot = spx * fu + spz * fw
-                theta0 = atan2(nn, dot)
-                amag = math.hypot(fu, fw) * math.sqrt(float(self.seg_len2[i][j]))  # |Fᵢ||sᵢ|
-                if nn > 1e-12 * amag:
-                    phi = _solve_scalar(amag, theta0, float(k[i][j]),
-                                        float(rho_start[slot]) * theta0)  # Eqs. 8–9
-                    t, inv = tan(0.5 * phi), 1.0 / nn
-                else:
-                    phi = t = inv = 0.0
-                phis[slot] = phi
-                rho[slot] = phi / max(theta0, 1e-300)
-                t2 = t * t
-                ch2 = 1.0 / (1.0 + t2)
-                ch = sqrt(ch2)
-                sh = t * ch * inv
-                b0, b1, b2, b3 = ch, n0 * sh, n1 * sh, n2 * sh
-                # Cᵢ = q_bend ⊗ T
-                Cw = b0 * Tw - b1 * Tx - b2 * Ty - b3 * Tz
-                Cx = b0 * Tx + b1 * Tw + b2 * Tz - b3 * Ty
-                Cy = b0 * Ty - b1 * Tz + b2 * Tw + b3 * Tx
-                Cz = b0 * Tz + b1 * Ty - b2 * Tx + b3 * Tw
-                q[0, slot], q[1, slot], q[2, slot], q[3, slot] = Cw, Cx, Cy, Cz
-                c_phi = (1.0 - t2) * ch2
-                s_phi = 2.0 * t * ch2 * inv  # sin φ / |N|
-                L2 = float(self.seg_len2[i][j])
-                ox = c_phi * spx + s_phi * (fu * L2 - spx * dot)
-                oy = c_phi * spy - s_phi * spy * dot
-                oz = c_phi * spz + s_phi * (fw * L2 - spz * dot)
-                if i > 0:
-                    ox, oy, oz = ox + ox0, oy + oy0, oz + oz0
-                o[0, slot], o[1, slot], o[2, slot] = ox, oy, oz
-                ox0, oy0, oz0 = ox, oy, oz
-
-
-def _solve_scalar(a: float, theta0: float, k: float, phi: float) -> float:
-    """:func:`solve_bend_angle` for one segment (a = |F||s| > 0)."""
-    sin, cos = math.sin, math.cos
-    phi = min(max(phi, 0.0), theta0)
-    for _ in range(NEWTON_FIXED + NEWTON_EXTRA):
-        psi = theta0 - phi
-        m = a * sin(psi)
-        hp = a * cos(psi) + k
-        h = m - k * phi
-        if hp <= 0:  # left of the apex: restart on the right of the root
-            new = theta0
-        else:
-            new = min(max(phi + h * hp / (hp * hp + 0.5 * h * m), 0.0), theta0)  # Halley
-        if abs(new - phi) < NEWTON_TOL and hp > 0:
-            return phi
-        phi = new
-    lo, hi = 0.0, theta0  # bisection: h(0) >= 0 >= h(θ₀)
-    while hi - lo >= NEWTON_TOL:
-        mid = 0.5 * (lo + hi)
-        if a * sin(theta0 - mid) - k * mid > 0:
-            lo = mid
-        else:
-            hi = mid
-    return 0.5 * (lo + hi)

@@ -610,7 +610,6 @@ class Simulation:
         f3, z3 = self._modes_arrays()
         M = self._M
         t = self._time
-        u, v, w = self._u, self._v, self._w
 
         # 1–2. World force on each object: wind (Eq. 19 × area × gain), pulls, base excitation.
         ws = self._ws
