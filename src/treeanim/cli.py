@@ -455,7 +455,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
     p.add_argument("--object", type=int, default=0, metavar="I", help="object index (default 0, e.g. the beam)")
     p.add_argument("--pull", type=_force, required=True, metavar="FX,FY,FZ",
-                   help="world force on the tip in newtons, e.g. 500,0,400")
+                   help="world force on the tip in newtons, e.g. 1.5,0,1.2 for the beam")
     p.add_argument("--hold", type=_positive(float), default=2.0, metavar="SECONDS",
                    help="how long the pull is held before release (default 2)")
     p.add_argument("--seconds", type=_positive(float), default=10.0, help="seconds recorded after release (default 10)")
