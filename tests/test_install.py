@@ -1,6 +1,7 @@
 """A plain (non-editable) wheel install finds its presets and shaders."""
 
 import os
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -9,9 +10,13 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_installed_wheel_finds_assets(tmp_path):
+    # Build from a clean copy: a build/ folder left in the checkout would leak stale files.
+    src = tmp_path / "src"
+    shutil.copytree(ROOT, src, ignore=shutil.ignore_patterns(".git", ".venv", "build", "dist", "*.egg-info", "__pycache__",
+                                                             ".pytest_cache", ".hypothesis", "out", "docs"))
     wheels = tmp_path / "wheels"
     subprocess.run(
-        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(wheels), str(ROOT)],
+        [sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(wheels), str(src)],
         check=True, capture_output=True, timeout=300,
     )
     (wheel,) = wheels.glob("treeanim-*.whl")
