@@ -6,7 +6,6 @@ Every subcommand reports bad input as one line on stderr and exits with status 2
 from __future__ import annotations
 
 import argparse
-import re
 import sys
 
 #: The paper's Table 1, per preset: rows of (kind, objects, nodes, triangles, fmin, fmax, ζmin, ζmax).
@@ -63,22 +62,46 @@ def _non_negative(text: str) -> float:
     return value
 
 
-def _vector(text: str):
+def _checked(parse):
+    """An argparse type from a parser that raises ValueError with a clear message."""
+
+    def checked(text: str):
+        try:
+            return parse(text)
+        except ValueError as e:
+            raise argparse.ArgumentTypeError(str(e)) from None
+
+    checked.__name__ = parse.__name__
+    return checked
+
+
+def _size(text: str) -> tuple[int, int]:
+    from treeanim.offline import parse_size
+
+    return _checked(parse_size)(text)
+
+
+def _vector(what: str):
     from treeanim.scripted import parse_vector
 
-    try:
-        return parse_vector(text, "direction")
-    except ValueError as e:
-        raise argparse.ArgumentTypeError(str(e)) from None
+    return _checked(lambda text: parse_vector(text, what))
 
 
 def _pull(text: str):
     from treeanim.scripted import parse_pull
 
-    try:
-        return parse_pull(text)
-    except ValueError as e:
-        raise argparse.ArgumentTypeError(str(e)) from None
+    return _checked(parse_pull)(text)
+
+
+def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
+    """Wind, season and seed options (the scene around the tree)."""
+    p.add_argument("--wind", type=_non_negative, default=wind, metavar="SPEED",
+                   help=f"wind speed at the tree top, m/s (default {wind:g}; 0 = calm)")
+    p.add_argument("--wind-dir", type=_vector("direction"), default=(1.0, 0.0, 0.0), metavar="X,Y,Z",
+                   help="wind direction; needs a horizontal part (default 1,0,0)")
+    p.add_argument("--turbulence", type=float, default=1.5, metavar="LAMBDA", help="λ of Eq. 17, in [1, 2] (default 1.5)")
+    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the wind and the modal noise (default 0)")
 
 
 def add_scene_options(p: argparse.ArgumentParser, seconds: float = 5.0, fps: float = 30.0) -> None:
@@ -86,13 +109,7 @@ def add_scene_options(p: argparse.ArgumentParser, seconds: float = 5.0, fps: flo
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
     p.add_argument("--seconds", type=_positive(float), default=seconds, help=f"duration in seconds (default {seconds:g})")
     p.add_argument("--fps", type=_positive(float), default=fps, help=f"frames per second (default {fps:g})")
-    p.add_argument("--wind", type=_non_negative, default=5.0, metavar="SPEED",
-                   help="wind speed at the tree top, m/s (default 5; 0 = calm)")
-    p.add_argument("--wind-dir", type=_vector, default=(1.0, 0.0, 0.0), metavar="X,Y,Z",
-                   help="wind direction; needs a horizontal part (default 1,0,0)")
-    p.add_argument("--turbulence", type=float, default=1.5, metavar="LAMBDA", help="λ of Eq. 17, in [1, 2] (default 1.5)")
-    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the wind and the modal noise (default 0)")
+    add_wind_options(p)
     p.add_argument("--pull", type=_pull, action="append", default=[], metavar="OBJECT:FX,FY,FZ@T0-T1",
                    help="pull OBJECT's tip with a world force in newtons from T0 to T1 s, then let go; repeatable")
 
@@ -114,19 +131,19 @@ def make_simulation(args):
     return tree, sim
 
 
-def output_path(text: str, suffixes: tuple[str, ...]):
-    """Check an output path: a known extension and a writable folder."""
-    import os
+def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
+    """Check an output path: a known extension and a folder where files can really be created."""
     from pathlib import Path
+
+    from treeanim import offline
 
     path = Path(text)
     if path.suffix.lower() not in suffixes:
-        raise UsageError(f"--out {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise UsageError(f"--out {text}: folder {folder} does not exist")
-    if not os.access(folder, os.W_OK):
-        raise UsageError(f"--out {text}: folder {folder} is not writable")
+        raise UsageError(f"{option} {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
+    try:
+        offline.check_folder(path.parent, text)
+    except offline.InputError as e:
+        raise UsageError(str(e).replace("--out ", f"{option} ", 1)) from None
     return path
 
 
@@ -173,15 +190,6 @@ def _one_line_errors(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
     return p
 
 
-def _size(text: str) -> tuple[int, int]:
-    from treeanim.offline import InputError, parse_size
-
-    try:
-        return parse_size(text)
-    except InputError as e:
-        raise argparse.ArgumentTypeError(str(e)) from None
-
-
 def _finite(text: str) -> float:
     try:
         value = float(text)
@@ -200,27 +208,6 @@ def _samples(text: str) -> int:
     if not 0 <= value <= 64:
         raise argparse.ArgumentTypeError(f"expected an integer in [0, 64], got {text!r}")
     return value
-
-
-def _force(text: str):
-    from treeanim.scripted import parse_vector
-
-    try:
-        return parse_vector(text, "force")
-    except ValueError as e:
-        raise argparse.ArgumentTypeError(str(e)) from None
-
-
-def _writable(text: str, suffixes: tuple[str, ...], option: str = "--out"):
-    """:func:`output_path`, then a real try at creating a file in its folder."""
-    from treeanim import offline
-
-    try:
-        path = output_path(text, suffixes)
-        offline.check_folder(path.parent, text)
-    except (UsageError, offline.InputError) as e:
-        raise UsageError(str(e).replace("--out ", f"{option} ", 1)) from None
-    return path
 
 
 def _mb(n: int) -> str:
@@ -276,8 +263,8 @@ def cmd_trace(args) -> int:
 
     from treeanim import offline
 
-    out = _writable(args.out, (".csv",))
-    plot = _writable(args.plot, (".png", ".svg", ".pdf"), "--plot") if args.plot else None
+    out = output_path(args.out, (".csv",))
+    plot = output_path(args.plot, (".png", ".svg", ".pdf"), "--plot") if args.plot else None
     if plot is not None:
         try:
             import matplotlib  # noqa: F401
@@ -317,7 +304,7 @@ def cmd_bench(args) -> int:
     for k in keys:
         if k not in known:
             raise UsageError(f"--presets {k}: unknown; expected some of {', '.join(known)}")
-    out = _writable(args.json, (".json",), "--json") if args.json else None
+    out = output_path(args.json, (".json",), "--json") if args.json else None
     w, h = args.size
     try:
         res = offline.run_bench(keys, w, h, frames=args.frames, steps=args.steps, samples=args.samples,
@@ -333,14 +320,6 @@ def cmd_bench(args) -> int:
 
 
 # ---------------------------------------------------------------------------- view
-def _window_size(text: str) -> tuple[int, int]:
-    """WxH, e.g. 1280x720: the viewer's window size in screen units."""
-    m = re.fullmatch(r"\s*(\d{1,5})\s*[xX×]\s*(\d{1,5})\s*", text)
-    if not m or not (1 <= int(m.group(1)) <= 16384 and 1 <= int(m.group(2)) <= 16384):
-        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT such as 1280x720, got {text!r}")
-    return int(m.group(1)), int(m.group(2))
-
-
 def cmd_view(args) -> int:
     """Open the interactive viewer (the default command)."""
     from treeanim.app.main import ViewerUnavailable, view
@@ -421,11 +400,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_export)
 
-    p = _one_line_errors(sub.add_parser(
+    p = sub.add_parser(
         "render", help="render a video (.mp4, .gif), PNG frames (a folder) or one PNG still, offscreen",
         description="Simulate and render offscreen (EGL): a video (.mp4 H.264, or .gif), a folder of PNG frames "
         "(frame_00000.png, ...), or one .png still of the state after --seconds. Ctrl-C stops after the current "
-        "frame and keeps a playable file of what was rendered."))
+        "frame and keeps a playable file of what was rendered.")
     add_scene_options(p)
     for a in p._actions:
         if a.dest == "seconds":  # a still's default differs from a clip's
@@ -447,14 +426,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_render)
 
-    p = _one_line_errors(sub.add_parser(
+    p = sub.add_parser(
         "trace", help="pull one object's tip, let go, and record its trace (CSV, optional plot)",
         description="Pull object OBJECT's tip with a constant world force until it sits at its static "
         "deflection, let go, and record the tip's position (t, x, y, z) for --seconds at --rate samples per "
-        "second: the Lissajous / harmonograph trace of the paper's Figs. 1 and 4."))
+        "second: the Lissajous / harmonograph trace of the paper's Figs. 1 and 4.")
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
     p.add_argument("--object", type=int, default=0, metavar="I", help="object index (default 0, e.g. the beam)")
-    p.add_argument("--pull", type=_force, required=True, metavar="FX,FY,FZ",
+    p.add_argument("--pull", type=_vector("force"), required=True, metavar="FX,FY,FZ",
                    help="world force on the tip in newtons, e.g. 1.5,0,1.2 for the beam")
     p.add_argument("--hold", type=_positive(float), default=2.0, metavar="SECONDS",
                    help="how long the pull is held before release (default 2)")
@@ -464,20 +443,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", required=True, help="trace.csv (columns t,x,y,z; t = 0 at release)")
     p.add_argument("--plot", default=None, metavar="FILE",
                    help="also plot the horizontal (x-z) trace: .png, .svg or .pdf (needs matplotlib)")
-    p.add_argument("--wind", type=_non_negative, default=0.0, metavar="SPEED",
-                   help="wind speed at the tree top, m/s (default 0: calm, a free swing)")
-    p.add_argument("--wind-dir", type=_vector, default=(1.0, 0.0, 0.0), metavar="X,Y,Z",
-                   help="wind direction (default 1,0,0)")
-    p.add_argument("--turbulence", type=float, default=1.5, metavar="LAMBDA", help="λ of Eq. 17 (default 1.5)")
-    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the wind and the modal noise (default 0)")
+    add_wind_options(p, wind=0.0)  # calm by default: a free swing
     p.set_defaults(func=cmd_trace)
 
-    p = _one_line_errors(sub.add_parser(
+    p = sub.add_parser(
         "bench", help="measure the paper's Table 1 on this machine (simulation and render times, FPS)",
         description="For every preset: objects, nodes and triangles beside the paper's Table 1, the median "
         "simulation time per step (wind on), the median offscreen render time per frame (pixels read back), "
-        "and the frame rate they allow, with this machine's CPU and GL renderer."))
+        "and the frame rate they allow, with this machine's CPU and GL renderer.")
     p.add_argument("--presets", nargs="+", metavar="NAME",
                    help="rows to measure (default: small_cherry large_cherry large_cherry@winter tulip_poplar "
                    "grassland)")
@@ -490,16 +463,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_bench)
 
-    p = _one_line_errors(sub.add_parser(
+    p = sub.add_parser(
         "view", help="open the interactive viewer (what plain 'treeanim' does)",
         description="Open the viewer: the tree in wind; drag a branch or leaf to pull it and let go to watch it "
-        "swing; sliders for wind, season and physics. Needs a display and OpenGL 3.3."))
+        "swing; sliders for wind, season and physics. Needs a display and OpenGL 3.3.")
     p.add_argument("preset", nargs="?", default="small_cherry",
                    help="preset name (see 'treeanim list') or path to a preset .toml (default small_cherry)")
     p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
     p.add_argument("--wind", type=_non_negative, default=5.0, metavar="SPEED",
                    help="wind speed at the tree top, m/s (default 5; 0 = calm)")
-    p.add_argument("--size", type=_window_size, default=(1280, 720), metavar="WxH",
+    p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH",
                    help="window size (default 1280x720)")
     p.add_argument("--samples", type=int, choices=range(0, 17), default=None, metavar="N",
                    help="MSAA samples, 0-16 (default 4, or 0 on a software renderer such as llvmpipe)")
@@ -509,6 +482,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("list", help="list the shipped presets", description="List the shipped presets.")
     p.set_defaults(func=lambda args: print("\n".join(__import__("treeanim").list_presets())) or 0)
+    for p in (parser, *sub.choices.values()):
+        _one_line_errors(p)
     return parser
 
 
