@@ -11,15 +11,13 @@ only, one float32 quaternion key per joint and frame, sharing one time accessor.
 
 from __future__ import annotations
 
-import os
-import struct
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pygltflib as gl
 
+from .files import write_bytes
 from .model.tree import Tree
 from .render.mesh import MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh, build_mesh
 
@@ -289,21 +287,5 @@ def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
         doc.buffers[0].uri = bin_path.name
         payloads = [(bin_path, data), (path, doc.to_json(separators=(",", ":")).encode())]
     for target, payload in payloads:
-        fd, tmp = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".part")
-        try:
-            with os.fdopen(fd, "wb") as f:
-                f.write(payload)
-            os.replace(tmp, target)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
+        write_bytes(target, payload)
     return [p for p, _ in payloads]
-
-
-def read_glb_header(path: str | Path) -> tuple[int, int]:
-    """(version, length) from a .glb header, for quick checks."""
-    with open(path, "rb") as f:
-        magic, version, length = struct.unpack("<4sII", f.read(12))
-    if magic != b"glTF":
-        raise ValueError(f"{path}: not a binary glTF file")
-    return version, length
