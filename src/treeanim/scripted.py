@@ -71,24 +71,25 @@ def frames(sim, seconds: float, fps: float, pulls: list[Pull] = (), max_step: fl
     """Advance ``sim`` to each frame time k / fps for k = 0 .. round(seconds * fps) - 1.
 
     Yields the frame index after the simulation reached that frame's time. Steps are at most
-    ``max_step`` long; pulls start and end on the step that reaches their times.
+    ``max_step`` long. Before every step, exactly the pulls whose interval [T0, T1) holds the
+    step's start time are held (pulls on different objects may overlap); the others are let go.
     """
     n = int(round(seconds * fps))
-    active: Pull | None = None
+    held: dict[int, tuple[float, float, float]] = {}
     t = 0.0
     for k in range(n):
         target = k / fps
         while t < target - 1e-12:
+            want = {p.obj: p.force for p in pulls if p.start <= t < p.end}
+            for obj in held.keys() - want.keys():
+                sim.release(obj)
+            for obj, force in want.items():
+                if held.get(obj) != force:
+                    sim.pull(obj, np.asarray(force, float))
+            held = want
             dt = min(max_step, target - t)
-            want = next((p for p in pulls if p.start <= t < p.end), None)
-            if want is not active:
-                if want is None:
-                    sim.release()
-                else:
-                    sim.pull(want.obj, np.asarray(want.force, float))
-                active = want
             sim.step(dt)
             t += dt
         yield k
-    if active is not None:
-        sim.release()
+    for obj in held:
+        sim.release(obj)
