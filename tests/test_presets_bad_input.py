@@ -96,3 +96,23 @@ def test_cli_info_prints_table1_row():
     res = run_cli("info", "large_cherry", "--season", "1")
     assert res.returncode == 0, res.stderr
     assert "344" in res.stdout and "1,376" in res.stdout and "48,504" in res.stdout
+
+
+@pytest.mark.parametrize("args,words", [
+    (["export", "beam", "--seconds", "1e308", "--out", "a.glb"], "--seconds"),
+    (["export", "beam", "--seconds", "100000", "--fps", "100000", "--out", "a.glb"], "at most"),
+    (["export", "beam", "--turbulence", "5", "--out", "a.glb"], "[1, 2]"),
+    (["export", "beam", "--seed", "-1", "--out", "a.glb"], "--seed"),
+    (["render", "beam", "--start", "1e5", "--seconds", "100", "--out", "a.mp4"], "at most"),
+    (["trace", "beam", "--pull", "1,0,0", "--hold", "1e308", "--out", "a.csv"], "--hold"),
+    (["bench", "--wind", "5000"], "--wind"),
+    (["view", "beam", "--size", "0x3"], "at least 1 pixel"),
+    (["bogus"], "invalid choice"),
+])
+def test_cli_out_of_range_one_line(tmp_path, args, words):
+    res = subprocess.run([sys.executable, "-m", "treeanim", *args], capture_output=True, text=True, cwd=tmp_path,
+                         timeout=120)
+    assert res.returncode == 2
+    assert "Traceback" not in res.stderr
+    assert len(res.stderr.strip().splitlines()) == 1 and words in res.stderr
+    assert not list(tmp_path.iterdir())

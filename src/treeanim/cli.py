@@ -39,27 +39,39 @@ def _season(text: str) -> float:
     return value
 
 
-def _positive(kind):
+#: Upper bound of times, rates and counts on the command line: large enough for any real use,
+#: small enough that products of them stay finite and allocations sane.
+LIMIT = 1e6
+#: Most frames (or samples) one command may produce.
+MAX_FRAMES = 1_000_000
+
+
+def _number(kind, lo: float, hi: float, lo_open: bool):
+    """An argparse type: a ``kind`` (int or float) in (lo, hi] or [lo, hi]."""
+    fmt = (lambda x: f"{int(x):,}") if kind is int else (lambda x: f"{x:g}")
+    noun = "integer" if kind is int else "number"
+    if lo_open and lo == 0:
+        what = f"a positive {noun} up to {fmt(hi)}"
+    else:
+        what = f"{'an' if kind is int else 'a'} {noun} in [{fmt(lo)}, {fmt(hi)}]"
+
     def parse(text: str):
         try:
             value = kind(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a positive {kind.__name__}, got {text!r}") from None
-        if not (value > 0 and value < float("inf")):
-            raise argparse.ArgumentTypeError(f"expected a positive {kind.__name__}, got {text!r}")
+            value = float("nan")
+        if not ((value > lo) if lo_open else (value >= lo)) or not value <= hi:
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
         return value
 
     return parse
 
 
-def _non_negative(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if not 0 <= value < float("inf"):
-        raise argparse.ArgumentTypeError(f"expected a number >= 0, got {text!r}")
-    return value
+def _positive(kind, hi: float = LIMIT):
+    return _number(kind, 0, hi, lo_open=True)
+
+
+_non_negative = _number(float, 0, LIMIT, lo_open=False)
 
 
 def _checked(parse):
@@ -93,15 +105,23 @@ def _pull(text: str):
     return _checked(parse_pull)(text)
 
 
+def _wind_speed(text: str) -> float:
+    from treeanim.physics.wind import MAX_SPEED
+
+    return _number(float, 0, MAX_SPEED, lo_open=False)(text)
+
+
 def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
     """Wind, season and seed options (the scene around the tree)."""
-    p.add_argument("--wind", type=_non_negative, default=wind, metavar="SPEED",
+    p.add_argument("--wind", type=_wind_speed, default=wind, metavar="SPEED",
                    help=f"wind speed at the tree top, m/s (default {wind:g}; 0 = calm)")
     p.add_argument("--wind-dir", type=_vector("direction"), default=(1.0, 0.0, 0.0), metavar="X,Y,Z",
                    help="wind direction; needs a horizontal part (default 1,0,0)")
-    p.add_argument("--turbulence", type=float, default=1.5, metavar="LAMBDA", help="λ of Eq. 17, in [1, 2] (default 1.5)")
+    p.add_argument("--turbulence", type=_number(float, 1, 2, lo_open=False), default=1.5, metavar="LAMBDA",
+                   help="λ of Eq. 17, in [1, 2] (default 1.5)")
     p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the wind and the modal noise (default 0)")
+    p.add_argument("--seed", type=_number(int, 0, 2**32 - 1, lo_open=False), default=0,
+                   help="seed of the wind and the modal noise (default 0)")
 
 
 def add_scene_options(p: argparse.ArgumentParser, seconds: float = 5.0, fps: float = 30.0) -> None:
@@ -112,6 +132,14 @@ def add_scene_options(p: argparse.ArgumentParser, seconds: float = 5.0, fps: flo
     add_wind_options(p)
     p.add_argument("--pull", type=_pull, action="append", default=[], metavar="OBJECT:FX,FY,FZ@T0-T1",
                    help="pull OBJECT's tip with a world force in newtons from T0 to T1 s, then let go; repeatable")
+
+
+def check_frames(seconds: float, fps: float) -> int:
+    """The number of frames ``seconds`` at ``fps`` give; UsageError beyond :data:`MAX_FRAMES`."""
+    n = seconds * fps
+    if n > MAX_FRAMES:
+        raise UsageError(f"--seconds {seconds:g} at --fps {fps:g} is {n:.3g} frames; at most {MAX_FRAMES:,}")
+    return int(round(n))
 
 
 def make_simulation(args):
@@ -157,12 +185,16 @@ def cmd_export(args) -> int:
     out = output_path(args.out, (".glb", ".gltf"))
     tree, sim = make_simulation(args)
     skel = export.skeleton(tree)
-    fade = int(round(args.loop * args.fps))
-    n = int(round(args.seconds * args.fps))
+    n = check_frames(args.seconds, args.fps)
+    fade = check_frames(args.loop, args.fps)
     if n < 2:
         raise UsageError(f"--seconds {args.seconds:g} at --fps {args.fps:g} gives fewer than 2 frames")
     if fade >= n:
         raise UsageError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
+    size = (n + fade) * skel.count * 16
+    if size > 8e9:
+        raise UsageError(f"{n + fade:,} frames of {skel.count:,} joints would need {size / 1e9:.0f} GB of keys; "
+                         "export fewer seconds or frames per second")
     keys = np.empty((n + fade, skel.count, 4), np.float32)
     bar = tqdm(total=n + fade, desc=f"baking {tree.name}", unit="frame", disable=args.quiet, leave=False)
     for k in scripted.frames(sim, (n + fade) / args.fps, args.fps, args.pull):
@@ -200,14 +232,7 @@ def _finite(text: str) -> float:
     return value
 
 
-def _samples(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if not 0 <= value <= 64:
-        raise argparse.ArgumentTypeError(f"expected an integer in [0, 64], got {text!r}")
-    return value
+_samples = _number(int, 0, 64, lo_open=False)
 
 
 def _mb(n: int) -> str:
@@ -228,6 +253,7 @@ def cmd_render(args) -> int:
     job = offline.RenderJob(target, w, h, args.fps, seconds, start=args.start, season=args.season, pulls=args.pull,
                             azimuth=args.azimuth, elevation=args.elevation, distance=args.distance,
                             samples=args.samples, quiet=args.quiet)
+    check_frames(args.start + seconds, args.fps)
     if target.kind != "still" and job.frame_range()[1] < 1:
         raise UsageError(f"--seconds {seconds:g} at --fps {args.fps:g} gives no frame")
     tree, sim = make_simulation(args)
@@ -275,6 +301,7 @@ def cmd_trace(args) -> int:
     tree, sim = make_simulation(scene)
     if not 0 <= args.object < tree.n_objects:
         raise UsageError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
+    check_frames(args.hold + args.seconds, args.rate)
     tr = offline.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
     offline.write_trace_csv(out, tr)
     if plot is not None:
@@ -328,7 +355,7 @@ def cmd_view(args) -> int:
     try:
         view(tree, season=args.season, wind_speed=args.wind, size=args.size, frames=args.frames,
              samples=args.samples)
-    except ViewerUnavailable as e:
+    except (ViewerUnavailable, ValueError) as e:
         raise UsageError(str(e)) from None
     return 0
 
@@ -458,7 +485,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--frames", type=_positive(int), default=20, help="frames rendered per preset (default 20)")
     p.add_argument("--steps", type=_positive(int), default=200, help="simulation steps per preset (default 200)")
     p.add_argument("--samples", type=_samples, default=4, help="MSAA samples (default 4)")
-    p.add_argument("--wind", type=_non_negative, default=5.0, metavar="SPEED", help="wind speed, m/s (default 5)")
+    p.add_argument("--wind", type=_wind_speed, default=5.0, metavar="SPEED", help="wind speed, m/s (default 5)")
     p.add_argument("--json", default=None, metavar="FILE", help="also write every figure to this .json file")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_bench)
@@ -470,7 +497,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("preset", nargs="?", default="small_cherry",
                    help="preset name (see 'treeanim list') or path to a preset .toml (default small_cherry)")
     p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
-    p.add_argument("--wind", type=_non_negative, default=5.0, metavar="SPEED",
+    p.add_argument("--wind", type=_wind_speed, default=5.0, metavar="SPEED",
                    help="wind speed at the tree top, m/s (default 5; 0 = calm)")
     p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH",
                    help="window size (default 1280x720)")
