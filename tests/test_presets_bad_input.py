@@ -92,10 +92,27 @@ def test_cli_unknown_preset(tmp_path):
     assert res.returncode == 2 and "Traceback" not in res.stderr and "small_cherry" in res.stderr
 
 
-def test_cli_info_prints_table1_row():
+def test_cli_info_prints_our_counts_beside_the_paper():
     res = run_cli("info", "large_cherry", "--season", "1")
     assert res.returncode == 0, res.stderr
-    assert "344" in res.stdout and "1,376" in res.stdout and "48,504" in res.stdout
+    ours = ta.load_preset("large_cherry").stats(1.0)
+    leaf_row = next(line for line in res.stdout.splitlines() if line.startswith("leaf"))
+    assert f"{ours['leaves']:,} /" in leaf_row and f"{ours['leaf_nodes']:,} /" in leaf_row
+    assert f"{ours['leaf_triangles']:,} /" in leaf_row
+    assert "48,504" in leaf_row  # the paper's winter leaf triangles, beside ours
+
+
+def test_missing_modes_for_a_kind_the_tree_has(tmp_path):
+    text = GOOD.replace('leaf = { f = [1.2, 1.8], zeta = [0.08, 0.12] }\n', "", 1)
+    assert text != GOOD
+    with pytest.raises(PresetError, match="'physics.summer.leaf': missing; the tree has leaves"):
+        ta.load_tree(write(tmp_path, text))
+
+
+def test_empty_grass_refused(tmp_path):
+    grass = Path(ta.load_preset("grassland").source).read_text().replace("count = 5000", "count = 0")
+    with pytest.raises(PresetError, match="'grass.count': expected at least 1 blade"):
+        ta.load_tree(write(tmp_path, grass))
 
 
 @pytest.mark.parametrize("args,words", [

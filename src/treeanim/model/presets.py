@@ -12,6 +12,8 @@ import tomllib
 from importlib import resources
 from pathlib import Path
 
+import numpy as np
+
 from .errors import PresetError
 from .generate import BeamSpec, GrassSpec, LaminaSpec, LeafSpec, LevelSpec, TreeSpec, generate
 from .params import SCALAR_KEYS, ModeRange, PhysicsParams, SeasonModes
@@ -100,9 +102,16 @@ def load_tree(path: str | Path) -> Tree:
     """
     spec = read_spec(path)
     try:
-        return generate(spec)
+        tree = generate(spec)
     except ValueError as e:  # the generator names the key it could not use
         raise PresetError(f"{path}: {e}") from None
+    plural = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
+    for kind in np.unique(tree.kind):
+        for season in ("summer", "winter"):
+            if getattr(tree.physics, season).of(kind) is None:
+                raise PresetError(f"{path}: key 'physics.{season}.{kind}': missing; the tree has {plural[kind]}, "
+                                  "so it needs their f and zeta ranges")
+    return tree
 
 
 def read_spec(path: str | Path) -> TreeSpec:
@@ -279,6 +288,8 @@ def _tree_spec(data: dict, source: str) -> TreeSpec:
 
 
 def _check_leaves(spec: TreeSpec) -> None:
+    if spec.type == "grass" and spec.grass.count < 1:
+        raise _KeyProblem("grass.count", f"expected at least 1 blade, got {spec.grass.count}")
     lf = spec.leaves
     if lf.winter_count > lf.count:
         raise _KeyProblem("leaves.winter_count", f"expected at most leaves.count ({lf.count}), got {lf.winter_count}")
