@@ -134,3 +134,19 @@ def test_export_bad_input(tmp_path, args, words):
     assert res.returncode == 2
     assert "Traceback" not in res.stderr and words in res.stderr
     assert not list(tmp_path.iterdir()), "no file is left behind"
+
+
+def test_exported_leaf_colours_turn_with_the_season(tmp_path):
+    means = []
+    for season in ("0", "0.5", "1"):
+        out = tmp_path / f"s{season}.glb"
+        assert export("small_cherry", "--seconds", "0.2", "--fps", "10", "--season", season, "--out", str(out)).returncode == 0
+        doc, blob = load(out)
+        prim = doc.meshes[0].primitives[0]
+        col = accessor(doc, blob, prim.attributes.COLOR_0)[:, :3]
+        pos = accessor(doc, blob, prim.attributes.POSITION)
+        crown = pos[:, 1] > 1.5  # leaves and twigs, not the trunk
+        means.append(col[crown].mean(axis=0))
+    (r0, g0, _), (r5, g5, _), (r1, g1, _) = means
+    assert g0 > 2 * r0, "summer leaves are green"
+    assert r5 > g5 and r1 > g1, "autumn and winter leaves are red-brown"

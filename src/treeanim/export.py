@@ -21,15 +21,6 @@ from .files import write_bytes
 from .model.tree import Tree
 from .render.mesh import MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh, build_mesh
 
-# Base colours (linear RGB) by material; leaves turn through autumn with the season.
-_BARK = (0.23, 0.16, 0.11)
-_PETIOLE = (0.30, 0.42, 0.12)
-_LEAF_SUMMER = (0.13, 0.38, 0.07)
-_LEAF_AUTUMN = (0.75, 0.32, 0.05)
-_LEAF_WINTER = (0.45, 0.20, 0.06)
-_BLADE = (0.20, 0.45, 0.10)
-
-
 @dataclass(frozen=True)
 class Skeleton:
     """Joints of a tree: one per segment-starting node, plus a root joint 0 at the origin.
@@ -125,22 +116,43 @@ def crossfade_loop(keys: np.ndarray, fade: int) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- mesh
+def _lin(*rgb) -> np.ndarray:
+    return np.power(np.asarray(rgb, float), 2.2)
+
+
+def _smoothstep(e0, e1, x):
+    t = np.clip((x - e0) / (e1 - e0), 0.0, 1.0)
+    return t * t * (3 - 2 * t)
+
+
+def _mix(a, b, t):
+    return a + (b - a) * np.asarray(t, float)[..., None]
+
+
 def vertex_colours(tree: Tree, mesh: TreeMesh, season: float) -> np.ndarray:
-    """(V, 4) float linear RGBA per vertex: bark, petiole, lamina (season-tinted), blade."""
+    """(V, 4) linear RGBA per vertex: the albedo the viewer's vertex shader gives at ``season``.
+
+    This is ``shaders/tree.vert`` (``leaf_color`` and the material branches of ``main``) in
+    numpy, so an exported tree has the viewer's bark, leaf and autumn colours.
+    """
     mat = mesh.material
     jitter = mesh.vertices["extra"][:, 1].astype(float)
     key = mesh.vertices["extra"][:, 3].astype(float)
-    col = np.empty((len(mat), 3))
-    col[:] = _BARK
-    col[mat == MATERIAL_PETIOLE] = _PETIOLE
-    col[mat == MATERIAL_BLADE] = _BLADE
-    leaf = mat == MATERIAL_LAMINA
-    # Leaves turn in their drop order: the ones that fall first turn first.
-    turn = np.clip(season * 2.0 - key[leaf] * 0.8, 0.0, 1.0)[:, None]
-    late = np.clip(season * 2.0 - 1.0, 0.0, 1.0)
-    autumn = np.asarray(_LEAF_AUTUMN) * (1 - late) + np.asarray(_LEAF_WINTER) * late
-    col[leaf] = np.asarray(_LEAF_SUMMER) * (1 - turn) + autumn * turn
-    col *= (0.85 + 0.3 * jitter)[:, None]
+    j2 = np.modf(jitter * 13.37)[0]
+    summer = _mix(_lin(0.13, 0.33, 0.05), _lin(0.33, 0.55, 0.10), jitter)
+    summer = _mix(summer, _lin(0.24, 0.46, 0.16), 0.35 * j2)
+    prog = _smoothstep(0.05 + 0.35 * key, 0.30 + 0.45 * key, season)  # leaves that fall first turn first
+    leaf = _mix(summer, _lin(0.88, 0.70, 0.12), _smoothstep(0.0, 0.35, prog))
+    leaf = _mix(leaf, _mix(_lin(0.92, 0.40, 0.06), _lin(0.70, 0.10, 0.06), j2),
+                _smoothstep(0.3, 0.7, prog) * (0.55 + 0.45 * jitter))
+    leaf = _mix(leaf, _lin(0.40, 0.17, 0.06), 0.75 * _smoothstep(0.8, 1.0, prog))
+    blade = _mix(_lin(0.10, 0.24, 0.05), _mix(_lin(0.42, 0.58, 0.16), _lin(0.55, 0.60, 0.22), jitter), key)
+    blade = _mix(blade, _lin(0.62, 0.55, 0.32) * (0.6 + 0.4 * key)[:, None], 0.6 * season)
+    col = np.select(
+        [mat[:, None] == MATERIAL_LAMINA, mat[:, None] == MATERIAL_PETIOLE, mat[:, None] == MATERIAL_BLADE],
+        [leaf, _mix(leaf, _lin(0.55, 0.28, 0.14), 0.4), blade],
+        _lin(0.34, 0.29, 0.25) * (0.8 + 0.4 * jitter)[:, None],
+    )
     return np.column_stack([np.clip(col, 0, 1), np.ones(len(col))])
 
 
