@@ -8,9 +8,10 @@ from scipy.optimize import curve_fit
 
 import treeanim as ta
 from treeanim.model.build import ObjectSpec, assemble
+from treeanim.model.geometry import lamina_frames, polygon_centroid
 from treeanim.model.params import PhysicsParams
 from treeanim.physics.bending import rest_frames
-from treeanim.physics.simulation import Simulation, trace_tips
+from treeanim.physics.simulation import MAX_PULL, Simulation, trace_tips
 
 
 def straight_beam(n=8, length=2.0):
@@ -365,3 +366,114 @@ def test_outputs_you_keep_are_never_overwritten(tree):
         np.testing.assert_array_equal(P, P0)
         np.testing.assert_array_equal(Rv, R0)
     assert not np.array_equal(kept[0][0], kept[-1][0])
+
+
+class Broken:
+    """A wind whose samples are not finite."""
+
+    def __init__(self, value):
+        self.value = value
+
+    def sample(self, points, t):
+        U = np.full((len(points), 3), 2.0)
+        U[len(points) // 2, 1] = self.value
+        return U
+
+
+@pytest.mark.parametrize("value", [float("nan"), float("inf"), -float("inf")])
+def test_non_finite_wind_is_refused_and_the_state_kept(busy, value):
+    good = busy.wind
+    busy.wind = Broken(value)
+    before = snapshot(busy)
+    with pytest.raises(ValueError, match="wind"):
+        busy.step(1 / 60)
+    assert_same(before, snapshot(busy))
+    busy.wind = good
+    busy.step(1 / 60)  # a good wind steps again
+    assert np.all(np.isfinite(busy.positions))
+
+
+@pytest.mark.parametrize("force", [(1e308, 0, 0), (0, -1e308, 1e308), (MAX_PULL * 1.01, 0, 0),
+                                   (0.8 * MAX_PULL, 0.8 * MAX_PULL, 0)])
+def test_pull_above_the_largest_force_is_refused(busy, force):
+    before = snapshot(busy)
+    with pytest.raises(ValueError, match="force_xyz"):
+        busy.pull(5, force)
+    assert_same(before, snapshot(busy))
+
+
+@pytest.mark.parametrize("integrator", ["exact", "euler"])
+def test_largest_legal_pulls_give_finite_positions(tree, integrator):
+    sim = Simulation(tree, wind=Uniform((30.0, 0.0, 10.0)), integrator=integrator)
+    d = np.array([1.0, -2.0, 2.0]) / 3.0
+    for i in (0, 1, 5, tree.n_objects - 1):
+        sim.pull(i, MAX_PULL * d)
+    for _ in range(5):
+        sim.step(1 / 30)
+    P = sim.positions
+    assert np.all(np.isfinite(P)) and np.all(np.isfinite(sim.rotations))
+    for i in range(tree.n_objects):  # only rotations: lengths kept
+        nodes = tree.object_nodes(i)
+        np.testing.assert_allclose(np.linalg.norm(np.diff(P[nodes], axis=0), axis=1),
+                                   np.linalg.norm(np.diff(tree.rest_positions[nodes], axis=0), axis=1),
+                                   rtol=1e-9)
+
+
+@pytest.mark.parametrize("objects", [1.0, [0, 2.5], np.array([0.0, 1.0]), [-1], [10**6], True, "0", [[0, 1]]])
+def test_trace_tips_refuses_bad_indices(tree, objects):
+    sim = Simulation(tree)
+    with pytest.raises(ValueError, match="object"):
+        trace_tips(sim, objects, 0.1, 0.01)
+    assert sim.time == 0.0
+
+
+@pytest.mark.parametrize("duration, dt", [(1e300, 1e-300), (1e308, 1e-10), (1e9, 1e-3), (1.0, 1e-12)])
+def test_trace_tips_refuses_absurd_durations(tree, duration, dt):
+    sim = Simulation(tree)
+    with pytest.raises(ValueError, match="duration"):
+        trace_tips(sim, [0, 1], duration, dt)
+    assert sim.time == 0.0
+
+
+def test_trace_tips_accepts_numpy_indices(tree):
+    sim = Simulation(tree)
+    t, tips = trace_tips(sim, np.array([0, 3]), 0.05, 0.01)
+    assert tips.shape == (6, 2, 3) and len(t) == 6
+
+
+def test_modal_seeds_use_every_bit(tree):
+    a = Simulation(tree, seed=0).modes
+    b = Simulation(tree, seed=2**32).modes
+    c = Simulation(tree, seed=2**64 + 7).modes
+    assert not np.array_equal(a.f, b.f)
+    assert not np.array_equal(b.f, c.f)
+    np.testing.assert_array_equal(Simulation(tree, seed=2**32).modes.f, b.f)
+
+
+def test_leaf_lever_arm_uses_the_lamina_frame_of_the_mesh(tree):
+    def lever(t, frame_of):
+        leaves = np.flatnonzero(t.kind == "leaf")
+        cx, cy = polygon_centroid(t.lamina.outline)
+        tipn, u, v = frame_of(t, leaves)
+        centroid = t.rest_positions[tipn] + t.lamina_length[leaves, None] * (cx * u + cy * v)
+        return leaves, np.linalg.norm(centroid - t.rest_positions[t.object_start[leaves]], axis=1)
+
+    mesh_frame = lambda t, leaves: lamina_frames(t, leaves)[:3]  # noqa: E731
+    leaves, r = lever(tree, mesh_frame)
+    np.testing.assert_allclose(Simulation(tree)._lever[leaves], r, rtol=1e-12)
+
+    # A petiole bent through a right angle: the lamina lies along its last segment (as the
+    # mesh and picking draw it), not along the first.
+    twig = np.stack([np.zeros(3), np.linspace(0, 1, 3), np.zeros(3)], 1)
+    pet = twig[-1] + np.array([[0, 0, 0], [0, 0.02, 0], [0, 0.04, 0], [0.01, 0.04, 0]])
+    bent = assemble([ObjectSpec(twig, np.array([0.03, 0.02, 0.01]), "branch", 1),
+                     ObjectSpec(pet, np.full(4, 0.003), "leaf", 2, parent=0, attach=2,
+                                w=np.array([0.0, 0.0, 1.0]), lamina_length=0.2)],
+                    name="bent_petiole", lamina=tree.lamina)
+    first_frame = lambda t, leaves: (t.object_start[leaves] + t.object_count[leaves] - 1,  # noqa: E731
+                                     rest_frames(t)[leaves, :, 0], rest_frames(t)[leaves, :, 1])
+    leaves, r = lever(bent, mesh_frame)
+    _, r_first = lever(bent, first_frame)
+    lev = Simulation(bent)._lever[leaves]
+    np.testing.assert_allclose(lev, r, rtol=1e-12)
+    assert abs(lev[0] - r_first[0]) > 0.01

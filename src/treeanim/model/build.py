@@ -6,7 +6,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .geometry import perpendicular, unit
 from .tree import Tree
+
+__all__ = ["ObjectSpec", "assemble", "eq1_w", "perpendicular"]
 
 
 @dataclass
@@ -43,18 +46,21 @@ class ObjectSpec:
     lamina_length: float = 0.0
 
 
-def perpendicular(v: np.ndarray) -> np.ndarray:
-    """A unit vector perpendicular to each row of ``v`` (..., 3), stable for any direction."""
-    v = np.asarray(v, float)
-    helper = np.where(np.abs(v[..., 1:2]) < 0.9, [0.0, 1.0, 0.0], [1.0, 0.0, 0.0])
-    p = np.cross(v, helper)
-    return p / np.linalg.norm(p, axis=-1, keepdims=True)
-
-
 def eq1_w(points: np.ndarray) -> np.ndarray:
-    """Eq. 1's w = P0Pn x v / |P0Pn x v| for one object; a fixed perpendicular when straight."""
-    v = points[1] - points[0]
-    v = v / np.linalg.norm(v)
+    """Eq. 1's w = P0Pn x v / |P0Pn x v| for one object; a fixed perpendicular when straight.
+
+    Parameters
+    ----------
+    points : (n, 3) float
+        The object's nodes, root to tip (n >= 2).
+
+    Returns
+    -------
+    numpy.ndarray, (3,) float
+        Unit w axis.
+    """
+    points = np.asarray(points, float)
+    v = unit(points[1] - points[0])
     w = np.cross(points[-1] - points[0], v)
     n = np.linalg.norm(w)
     if n < 1e-6 * np.linalg.norm(points[-1] - points[0]) or n < 1e-12:
@@ -74,6 +80,16 @@ def assemble(specs: list[ObjectSpec], **tree_kw) -> Tree:
         Parents must have a lower level than their children.
     **tree_kw
         Passed to :class:`Tree` (name, lamina, physics, ...).
+
+    Returns
+    -------
+    Tree
+        The validated tree.
+
+    Raises
+    ------
+    ValueError
+        If the assembled tree breaks a structural invariant (:meth:`Tree.validate`).
     """
     kind_order = {"branch": 0, "blade": 1, "leaf": 2}
     order = sorted(range(len(specs)), key=lambda i: (specs[i].level, kind_order[specs[i].kind]))

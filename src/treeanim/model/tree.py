@@ -7,10 +7,13 @@ so each level is one contiguous slice of the object arrays (and of the node arra
 
 from __future__ import annotations
 
+import math
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .geometry import polygon_area
 from .params import PhysicsParams
 
 KINDS = ("branch", "leaf", "blade")
@@ -44,8 +47,7 @@ class Lamina:
     @property
     def area(self) -> float:
         """Area of the unit lamina (midrib length 1), in units of length squared."""
-        x, y = self.outline[:, 0], self.outline[:, 1]
-        return 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+        return polygon_area(self.outline)
 
 
 @dataclass(eq=False)
@@ -140,9 +142,21 @@ class Tree:
         ----------
         i : int
             Object index in ``range(n_objects)``.
+
+        Returns
+        -------
+        numpy.ndarray, (object_count[i],) int
+
+        Raises
+        ------
+        ValueError
+            If ``i`` is not an integer or is out of range.
         """
-        if not 0 <= int(i) < self.n_objects:
-            raise IndexError(f"object {i} out of range: the tree has {self.n_objects} objects")
+        if isinstance(i, bool) or not isinstance(i, numbers.Integral):
+            raise ValueError(f"object index i must be an integer, got {i!r}")
+        i = int(i)
+        if not 0 <= i < self.n_objects:
+            raise ValueError(f"object index i={i} is out of range: the tree has {self.n_objects} objects")
         s = int(self.object_start[i])
         return np.arange(s, s + int(self.object_count[i]))
 
@@ -158,8 +172,28 @@ class Tree:
 
         Leaves fall in the fixed seeded order ``leaf_drop_rank`` from the summer count down to
         ``winter_leaves``; branches and blades are always present.
+
+        Parameters
+        ----------
+        season : float
+            Finite; values outside [0, 1] are clipped to it.
+
+        Returns
+        -------
+        numpy.ndarray, (M,) bool
+
+        Raises
+        ------
+        ValueError
+            If ``season`` is not a finite real number.
         """
-        season = float(np.clip(season, 0.0, 1.0))
+        try:
+            season = float(season)
+        except (TypeError, ValueError):
+            raise ValueError(f"season must be a finite number, got {season!r}") from None
+        if not math.isfinite(season):
+            raise ValueError(f"season must be finite, got {season!r}")
+        season = min(max(season, 0.0), 1.0)
         n_leaves = int(np.count_nonzero(self.kind == "leaf"))
         keep = int(round(n_leaves + (self.winter_leaves - n_leaves) * season))
         fallen = n_leaves - keep

@@ -32,9 +32,9 @@ object's base, Σ_{j<=i} Cⱼ sⱼ (accumulated per object, so no round-off cros
 
 from __future__ import annotations
 
-
 import numpy as np
 
+from ..model.geometry import perpendicular
 from .rotation import Workspace, qmul, qrot
 
 # Rot(v, −γ) ⊗ C = cos·C + sin·(−C_y, C_z, C_w, −C_x): rows and signs of the second term.
@@ -49,6 +49,9 @@ NEWTON_TOL = 1e-7
 NEWTON_FIXED = 2
 #: Further Newton iterations for the stragglers before bisection takes over.
 NEWTON_EXTRA = 12
+#: Above this bound on |F||s| (N·m) the squares in |N| = |s′ × F| could overflow: |N| is then
+#: computed with hypot (slower, never needed by any physical load).
+_SQUARE_SAFE = 1e150
 
 
 def _residual(phi, a, theta0, k):
@@ -198,9 +201,12 @@ def rest_frames(tree) -> np.ndarray:
     Parameters
     ----------
     tree : Tree
-    """
-    from ..model.build import perpendicular
 
+    Returns
+    -------
+    numpy.ndarray, (M, 3, 3) float
+        Columns u, v, w of each object's frame, world rest coordinates.
+    """
     X = np.asarray(tree.rest_positions, float)
     start = np.asarray(tree.object_start)
     M = len(start)
@@ -225,6 +231,11 @@ def matrix_to_quat(R: np.ndarray) -> np.ndarray:
     ----------
     R : (K, 3, 3) float
         Proper rotations.
+
+    Returns
+    -------
+    numpy.ndarray, (4, K) float
+        C-contiguous, scalar part first.
     """
     from scipy.spatial.transform import Rotation
 
@@ -268,7 +279,6 @@ class BendingPlan:
         self.M = len(start)
         self.N = len(X)
         self.order = np.argsort(-nseg, kind="stable")
-        self.nseg_ord = nseg[self.order]
         max_n = int(nseg.max()) if self.M else 0
         self.counts = [int(np.count_nonzero(nseg > i)) for i in range(max_n)]
         self.offsets = [int(x) for x in np.concatenate([[0], np.cumsum(self.counts)])]
@@ -305,6 +315,7 @@ class BendingPlan:
             self.frac_len.append(self.frac[-1] * np.sqrt(self.seg_len2[-1]))  # |Fᵢ||sᵢ| / |F|
             t = i / np.maximum(n - 1, 1)
             self.taper.append(d_root[objs] - (d_root[objs] - d_tip[objs]) * t)
+        self.max_seg = max((float(np.sqrt(x.max())) for x in self.seg_len2 if len(x)), default=0.0)
         self.flat_of_node = flat_of_node
         self.ofs_of_node = ofs_of_node
         self.ws = Workspace()
@@ -383,6 +394,8 @@ class BendingPlan:
         sv *= cv
         np.negative(sv, out=sv)
         Fmag = np.hypot(Fu, Fw)  # |F| per object
+        # |N| <= |F||s|: below the bound the plain sum of squares cannot overflow.
+        safe = not (Fmag.max(initial=0.0) * self.max_seg > _SQUARE_SAFE)
         prev = None
         prev_o = None
         for i, K in enumerate(self.counts):
@@ -399,9 +412,12 @@ class BendingPlan:
                 n2 = mul(l, fu)
                 np.negative(n2, out=n2)
                 n1 = None
-                nn = mul(n0, n0)
-                nn += mul(n2, n2, out=tmp)
-                np.sqrt(nn, out=nn)
+                if safe:
+                    nn = mul(n0, n0)
+                    nn += mul(n2, n2, out=tmp)
+                    np.sqrt(nn, out=nn)
+                else:
+                    nn = np.hypot(n0, n2)
                 dot = np.zeros(K)
                 theta0 = np.full(K, 0.5 * np.pi)
             else:
@@ -419,10 +435,13 @@ class BendingPlan:
                 n1 -= mul(sx, fw, out=tmp)
                 n2 = mul(sy, fu)
                 np.negative(n2, out=n2)
-                nn = mul(n0, n0)
-                nn += mul(n1, n1, out=tmp)
-                nn += mul(n2, n2, out=tmp)
-                np.sqrt(nn, out=nn)
+                if safe:
+                    nn = mul(n0, n0)
+                    nn += mul(n1, n1, out=tmp)
+                    nn += mul(n2, n2, out=tmp)
+                    np.sqrt(nn, out=nn)
+                else:
+                    nn = np.hypot(np.hypot(n0, n1), n2)
                 dot = mul(sx, fu)
                 dot += mul(sz, fw, out=tmp)
                 theta0 = np.arctan2(nn, dot)

@@ -21,11 +21,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.geometry import object_lengths
 from ..model.params import PhysicsParams
 from ..model.tree import KINDS, Tree
 
-#: Columns of the (M, 3) mode arrays.
-MODE_AXES = ("u", "v", "w")
+__all__ = ["ModalParameters", "ModalDraws", "object_lengths", "mean_diameters", "descendant_counts",
+           "derive_modes"]
 
 
 @dataclass
@@ -69,8 +70,21 @@ class ModalDraws:
 
     @classmethod
     def draw(cls, n_objects: int, seed: int) -> "ModalDraws":
-        """Draw the numbers for ``n_objects`` objects from ``seed`` (deterministic)."""
-        rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, 0x6D6F646573])  # stream "modes"
+        """Draw the numbers for ``n_objects`` objects from ``seed`` (deterministic).
+
+        Parameters
+        ----------
+        n_objects : int
+            Number of objects M.
+        seed : int
+            Any non-negative integer; every bit counts (seeds 0 and 2**32 differ).
+
+        Returns
+        -------
+        ModalDraws
+        """
+        # The whole seed, not its low 32 bits, plus the stream tag "modes".
+        rng = np.random.default_rng([int(seed), 0x6D6F646573])
         return cls(
             f_uniform=rng.random(n_objects),
             zeta_uniform=rng.random(n_objects),
@@ -78,22 +92,27 @@ class ModalDraws:
         )
 
 
-def object_lengths(tree: Tree) -> np.ndarray:
-    """(M,) float: rest length of each object (sum of its segment lengths), metres."""
-    seg = np.linalg.norm(np.diff(tree.rest_positions, axis=0), axis=1)
-    seg = np.append(seg, 0.0)
-    tips = tree.object_start + tree.object_count - 1
-    seg[tips] = 0.0  # differences across object boundaries are not segments
-    return np.add.reduceat(seg, tree.object_start)
-
-
 def mean_diameters(tree: Tree) -> np.ndarray:
-    """(M,) float: mean of each object's node diameters, metres."""
+    """Mean of each object's node diameters.
+
+    Parameters
+    ----------
+    tree : Tree
+
+    Returns
+    -------
+    numpy.ndarray, (M,) float
+        Metres.
+    """
     return np.add.reduceat(tree.node_diameter, tree.object_start) / tree.object_count
 
 
 def descendant_counts(tree: Tree) -> tuple[np.ndarray, np.ndarray]:
     """Descendant sub-branches and descendant leaves of every object (all generations).
+
+    Parameters
+    ----------
+    tree : Tree
 
     Returns
     -------

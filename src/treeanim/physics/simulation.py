@@ -9,15 +9,18 @@ from collections.abc import Iterable
 
 import numpy as np
 
+from ..model.geometry import lamina_frames, object_lengths, polygon_centroid, segment_lengths
 from ..model.params import PhysicsParams
 from ..model.tree import KINDS, Tree
 from .bending import BendingPlan, matrix_to_quat, rest_frames
+from .checks import finite_float
 from .hierarchy import CompositionPlan
-from .modal import ModalDraws, ModalParameters, derive_modes, mean_diameters, object_lengths
+from .modal import ModalDraws, ModalParameters, derive_modes, mean_diameters
 from .oscillator import euler_step, exact_coefficients, exact_step
 from .rotation import Workspace, qrot
+from .wind import DEFAULT_BOUNDS
 
-__all__ = ["Simulation", "trace_tips", "INTEGRATORS"]
+__all__ = ["Simulation", "trace_tips", "INTEGRATORS", "MAX_PULL", "MAX_TRACE_VALUES"]
 
 #: Oscillator integrators (see :mod:`treeanim.physics.oscillator`).
 INTEGRATORS = ("exact", "euler")
@@ -26,25 +29,13 @@ INTEGRATORS = ("exact", "euler")
 #: the finite-difference acceleration finite and smooth at any dt and delays it by ~10 ms.
 ACCEL_TAU = 0.01
 
+#: Largest pull force accepted (N): far beyond any hand on a tree (the bending stays finite
+#: and keeps lengths far above it; the cap keeps absurd inputs out).
+MAX_PULL = 1e9
 
-
-def _wind_default_bounds():
-    """The WindField's default bounds: a wind still on them has "no bounds of its own"."""
-    try:
-        from .wind import DEFAULT_BOUNDS
-    except ImportError:  # pragma: no cover - the wind module is part of the package
-        return ((-5.0, 0.0, -5.0), (5.0, 10.0, 5.0))
-    return DEFAULT_BOUNDS
-
-
-def _finite_float(name: str, value) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a real number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return x
+#: Largest number of floats :func:`trace_tips` records ((steps + 1) × (3·objects + 1)),
+#: about 1 GB of float64.
+MAX_TRACE_VALUES = 125_000_000
 
 
 def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
@@ -53,12 +44,12 @@ def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
         raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
     positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness")
     for name in positive:
-        x = _finite_float(f"physics.{name}", getattr(p, name))
+        x = finite_float(f"physics.{name}", getattr(p, name))
         if x <= 0:
             raise ValueError(f"physics.{name} must be > 0, got {x!r}")
     for name in ("stiffness_exponent", "twist_c0", "leaf_twist_c0", "leaf_zeta_w_scale",
                  "leaf_zeta_v_scale", "wind_gain_branch", "wind_gain_leaf", "wind_gain_blade"):
-        x = _finite_float(f"physics.{name}", getattr(p, name))
+        x = finite_float(f"physics.{name}", getattr(p, name))
         if x < 0:
             raise ValueError(f"physics.{name} must be >= 0, got {x!r}")
     for season in ("summer", "winter"):
@@ -70,8 +61,8 @@ def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
                     raise ValueError(f"physics: no f/zeta range for kind {kind!r}, which the tree has")
                 continue
             for i in (0, 1):
-                f = _finite_float(f"physics.{season}.{kind}.f", r.f[i])
-                z = _finite_float(f"physics.{season}.{kind}.zeta", r.zeta[i])
+                f = finite_float(f"physics.{season}.{kind}.f", r.f[i])
+                z = finite_float(f"physics.{season}.{kind}.zeta", r.zeta[i])
                 if f <= 0:
                     raise ValueError(f"physics.{season}.{kind}.f must be > 0, got {r.f!r}")
                 if z < 0:
@@ -208,20 +199,21 @@ class Simulation:
         r = np.einsum("ij,ij->i", u, p0pn)  # Eq. 3: r = u · P0Pn
         lam_area = np.zeros(M)
         if tree.lamina is not None and np.any(leaf):
+            leaves = np.flatnonzero(leaf)
             unit_area = float(tree.lamina.area)
-            cx, cy = _polygon_centroid(np.asarray(tree.lamina.outline, float))
-            L = np.asarray(tree.lamina_length, float)
-            lam_area[leaf] = unit_area * L[leaf] ** 2
-            centroid = X[tip] + L[:, None] * (cx * u + cy * v)
-            r[leaf] = np.linalg.norm(centroid[leaf] - X[start[leaf]], axis=1)
+            cx, cy = polygon_centroid(tree.lamina.outline)
+            L = np.asarray(tree.lamina_length, float)[leaves, None]
+            lam_area[leaves] = unit_area * L[:, 0] ** 2
+            # The lamina sits on the petiole's tip, in the frame the mesh and picking use.
+            tipn, lu, lv, _ = lamina_frames(tree, leaves)
+            centroid = X[tipn] + L * (cx * lu + cy * lv)
+            r[leaves] = np.linalg.norm(centroid - X[start[leaves]], axis=1)
         self._lever = r
         self._area = length * dmean + lam_area
         # Volumes: tapered segments (frusta ≈ cylinders of the mean diameter).
-        seg = np.linalg.norm(np.diff(X, axis=0), axis=1)
+        seg = segment_lengths(tree)
         dseg = 0.5 * (tree.node_diameter[1:] + tree.node_diameter[:-1])
-        seg = np.append(seg, 0.0)
         dseg = np.append(dseg, 0.0)
-        seg[tip] = 0.0
         self._round_volume = np.add.reduceat(0.25 * np.pi * dseg**2 * seg, start)
         self._flat_area = np.add.reduceat(dseg * seg, start)  # blades: width × length
         self._lam_area = lam_area
@@ -288,7 +280,7 @@ class Simulation:
 
     @staticmethod
     def _check_season(season) -> float:
-        s = _finite_float("season", season)
+        s = finite_float("season", season)
         if not 0.0 <= s <= 1.0:
             raise ValueError(f"season must be in [0, 1], got {season!r}")
         return s
@@ -434,7 +426,7 @@ class Simulation:
         b = getattr(wind, "bounds", None)
         if b is not None:
             try:
-                own = not np.allclose(np.asarray(b, float), _wind_default_bounds())
+                own = not np.allclose(np.asarray(b, float), DEFAULT_BOUNDS)
             except (TypeError, ValueError):
                 own = True
             if own:
@@ -510,7 +502,22 @@ class Simulation:
         return {i: f.copy() for i, f in self._pulls.items()}
 
     def tip_position(self, i: int) -> np.ndarray:
-        """Deformed world position of object ``i``'s tip node, (3,)."""
+        """Deformed world position of object ``i``'s tip node.
+
+        Parameters
+        ----------
+        i : int
+            Object index.
+
+        Returns
+        -------
+        numpy.ndarray, (3,) float
+
+        Raises
+        ------
+        ValueError
+            Unknown object index.
+        """
         i = self._check_object(i)
         return self._tip_positions(np.array([i]))[0]
 
@@ -532,12 +539,13 @@ class Simulation:
         i : int
             Object index.
         force_xyz : array_like of 3 floats
-            World force in newtons (finite).
+            World force in newtons: finite, magnitude at most :data:`MAX_PULL`.
 
         Raises
         ------
         ValueError
-            Unknown object index or a non-finite / malformed force (state unchanged).
+            Unknown object index, or a non-finite, malformed or too large force (state
+            unchanged).
         """
         i = self._check_object(i)
         try:
@@ -548,10 +556,24 @@ class Simulation:
             raise ValueError(f"force_xyz must be 3 finite numbers, got shape {np.shape(force_xyz)}")
         if not np.all(np.isfinite(f)):
             raise ValueError(f"force_xyz must be finite, got {f.tolist()}")
+        # Components first, so that the norm's squares cannot overflow.
+        if float(np.max(np.abs(f))) > MAX_PULL or float(np.linalg.norm(f)) > MAX_PULL:
+            raise ValueError(f"force_xyz must have a magnitude of at most {MAX_PULL:g} N, got {f.tolist()}")
         self._pulls[i] = f
 
     def release(self, i: int | None = None) -> None:
-        """Let go of object ``i`` (or of every held object when None)."""
+        """Let go of object ``i`` (or of every held object when None).
+
+        Parameters
+        ----------
+        i : int or None
+            Object index; None releases every held object.
+
+        Raises
+        ------
+        ValueError
+            Unknown object index.
+        """
         if i is None:
             self._pulls.clear()
             return
@@ -601,10 +623,11 @@ class Simulation:
         Raises
         ------
         ValueError
-            Non-finite or non-positive ``dt``, or invalid ``modes`` (f <= 0 or non-finite,
-            ζ < 0 or non-finite, wrong shape). The state is left unchanged.
+            Non-finite or non-positive ``dt``, invalid ``modes`` (f <= 0 or non-finite,
+            ζ < 0 or non-finite, wrong shape), or a wind whose ``sample`` returns the wrong
+            shape or non-finite values. The state is left unchanged.
         """
-        dt = _finite_float("dt", dt)
+        dt = finite_float("dt", dt)
         if not dt > 0:
             raise ValueError(f"dt must be > 0, got {dt!r}")
         f3, z3 = self._modes_arrays()
@@ -621,6 +644,8 @@ class Simulation:
             U = np.asarray(self._wind.sample(pts, t), dtype=float)
             if U.shape != (M, 3):
                 raise ValueError(f"wind.sample returned shape {U.shape}, expected {(M, 3)}")
+            if not np.isfinite(U).all():
+                raise ValueError("wind.sample returned non-finite velocities (NaN or inf)")
             mul(U.T, self._gain_area, out=Fw)
         else:
             Fw.fill(0.0)
@@ -711,17 +736,6 @@ def _unshared_refs() -> int:
 _UNSHARED_REFS = _unshared_refs()
 
 
-def _polygon_centroid(xy: np.ndarray) -> tuple[float, float]:
-    """Centroid of a simple polygon (K, 2); the vertex mean if its area is ~0."""
-    x, y = xy[:, 0], xy[:, 1]
-    xn, yn = np.roll(x, -1), np.roll(y, -1)
-    cr = x * yn - xn * y
-    a = 0.5 * cr.sum()
-    if abs(a) < 1e-15:
-        return float(x.mean()), float(y.mean())
-    return float(((x + xn) * cr).sum() / (6 * a)), float(((y + yn) * cr).sum() / (6 * a))
-
-
 def trace_tips(sim: Simulation, objects, duration: float, dt: float) -> tuple[np.ndarray, np.ndarray]:
     """Step ``sim`` for ``duration`` seconds and record the tip positions of ``objects``.
 
@@ -729,11 +743,11 @@ def trace_tips(sim: Simulation, objects, duration: float, dt: float) -> tuple[np
     ----------
     sim : Simulation
     objects : int or sequence of int
-        Object indices.
+        Object indices (integers in range).
     duration : float
-        Seconds to simulate (> 0).
+        Seconds to simulate (> 0, finite).
     dt : float
-        Step (> 0).
+        Step (> 0, finite).
 
     Returns
     -------
@@ -741,16 +755,34 @@ def trace_tips(sim: Simulation, objects, duration: float, dt: float) -> tuple[np
         Sample times, starting at the current time.
     tips : (T + 1, K, 3) float
         Tip positions (the first row before any step).
+
+    Raises
+    ------
+    ValueError
+        A non-integer or out-of-range object index, a non-finite or non-positive
+        ``duration`` or ``dt``, or more than :data:`MAX_TRACE_VALUES` values to record
+        (T = round(duration / dt) steps). Nothing is stepped then.
     """
-    objs = np.atleast_1d(np.asarray(objects))
-    for o in objs:
-        sim._check_object(int(o))
-    duration = _finite_float("duration", duration)
-    dt = _finite_float("dt", dt)
-    if duration <= 0 or dt <= 0:
-        raise ValueError("duration and dt must be > 0")
-    n = int(round(duration / dt))
-    objs = objs.astype(np.int64)
+    objs = np.atleast_1d(np.asarray(objects, dtype=object))
+    if objs.ndim != 1:
+        raise ValueError(f"objects must be an index or a flat sequence of indices, got shape {objs.shape}")
+    try:
+        objs = np.array([sim._check_object(o) for o in objs], dtype=np.int64)
+    except ValueError as e:
+        raise ValueError(f"objects: {e}") from None
+    duration = finite_float("duration", duration)
+    dt = finite_float("dt", dt)
+    if duration <= 0:
+        raise ValueError(f"duration must be > 0, got {duration!r}")
+    if dt <= 0:
+        raise ValueError(f"dt must be > 0, got {dt!r}")
+    steps = duration / dt
+    per_row = 3 * len(objs) + 1
+    if not steps * per_row <= MAX_TRACE_VALUES:  # also catches steps = inf
+        raise ValueError(
+            f"duration / dt = {steps:.3g} steps is too many to record for {len(objs)} object(s) "
+            f"(at most {MAX_TRACE_VALUES} values); use a shorter duration or a longer dt")
+    n = int(round(steps))
     out = np.empty((n + 1, len(objs), 3))
     times = np.empty(n + 1)
     out[0] = sim._tip_positions(objs)

@@ -30,6 +30,8 @@ from functools import lru_cache
 import numpy as np
 import scipy.fft
 
+from .checks import finite_float
+
 __all__ = ["fbm_noise", "WindField"]
 
 #: Default bounds ((x0, y0, z0), (x1, y1, z1)) in metres, until a Simulation fits the field.
@@ -58,18 +60,8 @@ _GRID_CLIP = 2.0**40
 # ----------------------------------------------------------------------------- validation
 
 
-def _finite(name: str, value) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number, got {value!r}") from None
-    if not math.isfinite(x):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return x
-
-
 def _in_range(name: str, value, lo: float, hi: float, what: str = "") -> float:
-    x = _finite(name, value)
+    x = finite_float(name, value)
     if not lo <= x <= hi:
         raise ValueError(f"{name} must be in [{lo:g}, {hi:g}]{what}, got {value!r}")
     return x
@@ -306,7 +298,7 @@ class WindField:
         self._c2 = None if c2 is None else self._check_c2(c2)
         b = _bounds(DEFAULT_BOUNDS if bounds is None else bounds)
         _check_extent(b)
-        self._check_profile(b, self._c1, self._c2)
+        self._constants(b, self._c1, self._c2)
         self._bounds = b
         self.direction = direction
         self.speed = speed
@@ -382,7 +374,7 @@ class WindField:
     @c1.setter
     def c1(self, value) -> None:
         c1 = None if value is None else _in_range("c1", value, 0.0, MAX_COEFF)
-        self._check_profile(self._bounds, c1, self._c2)
+        self._constants(self._bounds, c1, self._c2)
         self._c1 = c1
 
     @property
@@ -393,7 +385,7 @@ class WindField:
     @c2.setter
     def c2(self, value) -> None:
         c2 = None if value is None else self._check_c2(value)
-        self._check_profile(self._bounds, self._c1, c2)
+        self._constants(self._bounds, self._c1, c2)
         self._c2 = c2
 
     @property
@@ -421,7 +413,7 @@ class WindField:
 
     @c5.setter
     def c5(self, value) -> None:
-        self._c5 = _finite("c5", value)
+        self._c5 = finite_float("c5", value)
 
     @property
     def c6(self) -> float:
@@ -430,7 +422,7 @@ class WindField:
 
     @c6.setter
     def c6(self, value) -> None:
-        self._c6 = _finite("c6", value)
+        self._c6 = finite_float("c6", value)
 
     # -- bounds and the mean profile ---------------------------------------------------------
 
@@ -443,7 +435,7 @@ class WindField:
     def bounds(self, value) -> None:
         b = _bounds(value)
         _check_extent(b)
-        self._check_profile(b, self._c1, self._c2)
+        self._constants(b, self._c1, self._c2)
         self._bounds = b
 
     def fit(self, bounds) -> None:
@@ -480,7 +472,7 @@ class WindField:
 
     @staticmethod
     def _check_c2(value) -> float:
-        c2 = _finite("c2", value)
+        c2 = finite_float("c2", value)
         if not 1e-12 <= c2 <= 1e12:
             raise ValueError(f"c2 must be in [1e-12, 1e12] (1/m), got {value!r}")
         return c2
@@ -504,9 +496,6 @@ class WindField:
                 )
             c1 = 1.0 / log_top
         return c1, c2
-
-    def _check_profile(self, b, c1, c2) -> None:
-        self._constants(b, c1, c2)
 
     def _profile_constants(self) -> tuple[float, float]:
         return self._constants(self._bounds, self._c1, self._c2)
@@ -643,7 +632,7 @@ class WindField:
             raise ValueError(f"points must have shape (K, 3), got {np.shape(points)}")
         if not np.all(np.isfinite(p)):
             raise ValueError("points must be finite (found NaN or inf)")
-        t = _finite("t", t)
+        t = finite_float("t", t)
         k = p.shape[0]
         out = np.zeros((k, 3))
         if self.calm or k == 0:

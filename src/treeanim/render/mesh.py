@@ -47,6 +47,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.geometry import arc_length, lamina_frames
+from ..model.geometry import perpendicular as _perpendicular
+from ..model.geometry import unit as _unit
 from ..model.tree import BRANCH_SIDES, Tree
 
 MATERIAL_BARK = 0
@@ -146,19 +149,6 @@ def blend_rotations(m: np.ndarray) -> np.ndarray:
     return np.stack([c0, c1, np.cross(c0, c1)], axis=-1)
 
 
-def _unit(v: np.ndarray, fallback: np.ndarray | None = None) -> np.ndarray:
-    n = np.linalg.norm(v, axis=-1, keepdims=True)
-    out = v / np.where(n > 1e-12, n, 1.0)
-    if fallback is not None:
-        out = np.where(n > 1e-9, out, fallback)
-    return out
-
-
-def _perpendicular(v: np.ndarray) -> np.ndarray:
-    helper = np.where(np.abs(v[..., 1:2]) < 0.9, [0.0, 1.0, 0.0], [1.0, 0.0, 0.0])
-    return _unit(np.cross(v, helper))
-
-
 def _object_nodes(tree: Tree, objs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Flattened nodes of objects ``objs``: (global node, index within object, object)."""
     counts = tree.object_count[objs]
@@ -166,13 +156,6 @@ def _object_nodes(tree: Tree, objs: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     first = np.concatenate([[0], np.cumsum(counts)[:-1]])
     k = np.arange(total) - np.repeat(first, counts)
     return np.repeat(tree.object_start[objs], counts) + k, k, np.repeat(objs, counts)
-
-
-def arc_length(tree: Tree) -> np.ndarray:
-    """(N,) distance of each node from its object's base along the object, metres."""
-    seg = np.linalg.norm(np.diff(tree.rest_positions, axis=0), axis=1)
-    csum = np.concatenate([[0.0], np.cumsum(seg)])
-    return csum - np.repeat(csum[tree.object_start], tree.object_count)
 
 
 def _node_tangents(tree: Tree, nodes: np.ndarray, k: np.ndarray, obj: np.ndarray):
@@ -272,20 +255,6 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, caps: bool, 
                                   ring[ib, None] + s0], -1), obj[ib, None])
         parts.triangles(np.stack([np.broadcast_to(ct, (len(it), sides)), ring[it, None] + s0,
                                   ring[it, None] + s1], -1), obj[it, None])
-
-
-def lamina_frames(tree: Tree, leaves: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Rest frame of each leaf's lamina: (tip node, u, v, w), each (L,) / (L, 3).
-
-    v is the direction of the petiole's last segment, w the leaf's ``rest_w`` orthogonalised
-    against v, u = v × w.
-    """
-    P = tree.rest_positions
-    tipn = tree.object_start[leaves] + tree.object_count[leaves] - 1
-    v = _unit(P[tipn] - P[tipn - 1])
-    w = tree.rest_w[leaves]
-    w = _unit(w - np.sum(w * v, axis=1, keepdims=True) * v, _perpendicular(v))
-    return tipn, np.cross(v, w), v, w
 
 
 def _laminas(parts: _Parts, tree: Tree, leaves: np.ndarray, jitter: np.ndarray, key: np.ndarray) -> None:
