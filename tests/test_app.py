@@ -1,14 +1,16 @@
 """The viewer app in a real GLFW window (under Xvfb through pytest-xvfb): drawing, pulling,
-camera, panel, resizing, settings, screenshots, and the one-line failures without a display or
-without OpenGL 3.3."""
+camera, panel, resizing, settings, screenshots, real X input through xdotool, and the one-line
+failures without a display, without OpenGL 3.3 or with a tree the simulation refuses."""
 
 from __future__ import annotations
 
 import dataclasses
 import os
 import re
+import shutil
 import subprocess
 import sys
+import time
 import tomllib
 
 import glfw
@@ -16,9 +18,12 @@ import numpy as np
 import pytest
 
 import treeanim as ta
+from treeanim.app import window as window_module
+from treeanim.app.gui import Gui
 from treeanim.app.settings import physics_toml, preset_text, save_preset
 from treeanim.app.viewer import MAX_FRAME_DT, Viewer, run
 from treeanim.app.window import Window
+from treeanim.model.params import ModeRange
 
 W, H = 480, 360
 DT = 1.0 / 60.0
@@ -525,6 +530,23 @@ def test_preset_text_rewrites_unusual_layouts(tmp_path):
         physics_toml(dataclasses.replace(physics, twist_c0=0.0))
 
 
+def test_saved_preset_gets_plain_file_permissions(tmp_path):
+    tree = ta.load_preset("beam")
+    path = save_preset(tmp_path / "beam-mine.toml", tree, tree.physics)
+    umask = os.umask(0o022)
+    os.umask(umask)
+    assert path.stat().st_mode & 0o777 == 0o666 & ~umask, "created like any new file, not private (0600)"
+    assert [f.name for f in tmp_path.iterdir()] == ["beam-mine.toml"]
+    # A text the preset reader refuses is never moved into place, and leaves nothing behind.
+    p = tree.physics
+    fast = dataclasses.replace(p, summer=dataclasses.replace(p.summer, branch=ModeRange((1.0, 500.0), (0.1, 0.2))))
+    with pytest.raises(ValueError) as err:
+        save_preset(tmp_path / "bad.toml", tree, fast)
+    msg = str(err.value)
+    assert "physics.summer.branch.f" in msg and str(tmp_path / "bad.toml") in msg and ".part" not in msg
+    assert [f.name for f in tmp_path.iterdir()] == ["beam-mine.toml"]
+
+
 def test_presets_switch_in_the_viewer(viewer):
     v = viewer
     v.set_wind(speed=3.0)
@@ -536,12 +558,183 @@ def test_presets_switch_in_the_viewer(viewer):
     v.load_tree(ta.load_preset("small_cherry"))
 
 
+def test_pull_substeps_follow_the_tip_not_the_whole_pose(viewer, monkeypatch):
+    """Between a frame's sub-steps the grabbed point is followed through the tip alone: the
+    (N, 3) pose is built once a frame for the pull (its first sub-step) and once for drawing."""
+    v = viewer
+    obj, x, y = _branch_on_screen(v)
+    _press(v, x, y)
+    v.on_cursor_pos(x + 50, y - 20)
+    for _ in range(6):
+        v.frame(DT)
+    sim_type = type(v.sim)
+    positions = sim_type.positions
+    reads = []
+
+    def counted(sim):
+        reads.append(sim.time)
+        return positions.fget(sim)
+
+    monkeypatch.setattr(sim_type, "positions", property(counted))
+    try:
+        for _ in range(5):
+            reads.clear()
+            assert v.advance(MAX_FRAME_DT) == 3  # a slow frame: three sub-steps
+            assert len(reads) <= 2, f"the pose was built {len(reads)} times for 3 sub-steps"
+            # the followed point stays on the exact one (a few mm on a 2.5 m tree)
+            gap = np.linalg.norm(v.grab.target - v.anchor_point())
+            assert np.linalg.norm(v._grabbed_point(exact=False) - v.anchor_point()) < 0.1 * gap + 5e-3
+        assert v.sim.pulls and obj in v.sim.pulls
+    finally:
+        monkeypatch.undo()
+        v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+
+
+# ---------------------------------------------------------------------------- a tree the simulation refuses
+def _unsimulable(name="beam"):
+    """A preset's tree whose physics has no f/ζ range for its branches (Simulation: ValueError)."""
+    tree = ta.load_preset(name)
+    p = tree.physics
+    physics = dataclasses.replace(p, summer=dataclasses.replace(p.summer, branch=None),
+                                  winter=dataclasses.replace(p.winter, branch=None))
+    return dataclasses.replace(tree, physics=physics)
+
+
+def test_panel_load_shows_a_simulation_error_and_keeps_the_tree(viewer, monkeypatch):
+    v = viewer
+    sim, renderer = v.sim, v.renderer
+    monkeypatch.setattr(ta, "load_tree", lambda path: _unsimulable())
+    v.panel.path = "broken.toml"
+    v.on_key(glfw.KEY_O, 0, glfw.PRESS, glfw.MOD_CONTROL)  # Ctrl+O: Panel.load
+    assert v.messages[-1].startswith("error:") and "no f/zeta range" in v.messages[-1]
+    assert v.sim is sim and v.renderer is renderer and v.tree.name == "small_cherry"
+    assert not v.panel.load("broken.toml")
+    v.show_panel = True
+    assert v.frame(DT) and v.frame(DT)
+    assert v.ctx.error == "GL_NO_ERROR"
+
+
+def test_viewer_frees_its_gui_when_the_tree_fails(monkeypatch):
+    released = []
+    release = Gui.release
+
+    def spy(gui):
+        released.append(gui)
+        release(gui)
+
+    monkeypatch.setattr(Gui, "release", spy)
+    win = Window.open(160, 120, "treeanim failing viewer", samples=0)
+    try:
+        with pytest.raises(ValueError, match="no f/zeta range"):
+            Viewer(win, _unsimulable())
+        assert len(released) == 1 and released[0]._released
+        assert win.ctx.error == "GL_NO_ERROR"
+    finally:
+        win.close()
+
+
+def test_view_refuses_a_tree_the_simulation_refuses_in_one_line():
+    from treeanim.app.main import view
+
+    open_before = len(window_module._open_windows)
+    with pytest.raises(ValueError) as err:
+        view(_unsimulable(), size=(160, 120), frames=1)
+    msg = str(err.value)
+    assert "\n" not in msg and msg.startswith("cannot show beam:") and "no f/zeta range" in msg
+    with pytest.raises(ValueError, match="speed"):
+        view(ta.load_preset("beam"), size=(160, 120), frames=1, wind_speed=1e9)
+    assert len(window_module._open_windows) == open_before, "the window was closed again"
+
+
+# ---------------------------------------------------------------------------- real X input
+def _xdotool(*args) -> str:
+    exe = shutil.which("xdotool")
+    if exe is None:
+        pytest.fail("xdotool is not installed: run scripts/test, which installs it (Debian package xdotool)")
+    res = subprocess.run([exe, *map(str, args)], capture_output=True, text=True, timeout=30)
+    assert res.returncode == 0, f"xdotool {' '.join(map(str, args))} failed: {res.stderr.strip()}"
+    return res.stdout
+
+
+def _pump_until(v, done, what, timeout=10.0):
+    """Run the viewer's own main loop (GLFW polling, the callbacks of Window.connect) a frame
+    at a time until ``done()``: the X server delivers xdotool's events asynchronously."""
+    end = time.monotonic() + timeout
+    while True:
+        assert run(v, max_frames=1) == 1
+        if done():
+            return
+        if time.monotonic() > end:
+            raise AssertionError(f"{what}: the X event never reached the viewer")
+        glfw.wait_events_timeout(0.02)
+
+
+def test_real_x_input_orbits_zooms_and_presses_keys(viewer, tmp_path, monkeypatch):
+    """The window driven through the X server (xdotool's XTEST input), not by calling the
+    handlers: the pointer moves onto it, a left-drag on the sky orbits, the wheel zooms, 'h'
+    shows the panel and 's' writes a screenshot, all through GLFW and Window.connect."""
+    monkeypatch.chdir(tmp_path)
+    v = viewer
+    title = f"treeanim xdotool {os.getpid()}"
+    glfw.set_window_title(v.window.handle, title)
+    _pump_until(v, lambda: True, "a first frame")
+    ids = _xdotool("search", "--sync", "--onlyvisible", "--name", f"^{re.escape(title)}$").split()
+    assert len(ids) == 1, f"windows named {title!r}: {ids}"
+    wid = ids[0]
+    _xdotool("windowraise", wid)
+    _xdotool("windowfocus", "--sync", wid)
+    geometry = _xdotool("getwindowgeometry", "--shell", wid)
+    g = dict(line.split("=", 1) for line in geometry.split())
+    assert (int(g["WIDTH"]), int(g["HEIGHT"])) == (W, H), geometry
+    x, y = W - 10, 10  # empty sky, away from the tree
+    assert v.pick(x, y) is None
+    _xdotool("mousemove", "--window", wid, "--sync", x, y)
+    _pump_until(v, lambda: v._cursor == (x, y), "pointer motion")
+    az, el, d = v.camera.azimuth, v.camera.elevation, v.camera.distance
+    _xdotool("mousedown", 1)
+    _pump_until(v, lambda: v._mode == "orbit", "left button press")
+    assert v.grab is None
+    _xdotool("mousemove", "--window", wid, "--sync", x - 40, y + 20)
+    _pump_until(v, lambda: v._cursor == (x - 40, y + 20), "drag")
+    _xdotool("mouseup", 1)
+    _pump_until(v, lambda: v._mode is None, "left button release")
+    assert (v.camera.azimuth - az) % 360 == pytest.approx(14.0)
+    assert v.camera.elevation == pytest.approx(el + 7.0)
+    _xdotool("click", 4)  # wheel up: zoom in one notch
+    _pump_until(v, lambda: v.camera.distance != d, "wheel")
+    assert v.camera.distance == pytest.approx(d * 0.88)
+    assert not v.show_panel
+    _xdotool("key", "h")
+    _pump_until(v, lambda: v.show_panel, "key h")
+    _xdotool("key", "s")
+    _pump_until(v, lambda: list(tmp_path.glob("treeanim-*.png")), "key s")
+    assert v.screenshots and v.screenshots[-1].name.startswith("treeanim-")
+    assert not v.window.should_close and v.ctx.error == "GL_NO_ERROR"
+
+
 # ---------------------------------------------------------------------------- the command line
 def test_view_command_runs_frames(tmp_path, monkeypatch):
+    from treeanim.app.main import view
     from treeanim.cli import main
 
     monkeypatch.chdir(tmp_path)
+    shots = []
+    frame = Viewer.frame
+
+    def spy(self, dt=None):
+        drawn = frame(self, dt)
+        if drawn:
+            shots.append(self.read_pixels())
+        return drawn
+
+    monkeypatch.setattr(Viewer, "frame", spy)
     assert main(["view", "beam", "--size", "320x200", "--season", "0.5", "--wind", "3", "--frames", "3"]) == 0
+    assert len(shots) == 3, "the command drew exactly --frames frames"
+    for img in shots:
+        assert img.shape[2] == 3 and img.shape[:2] == (200, 320)
+        assert img.std() > 10, "a frame with nothing drawn in it"
+    assert view(ta.load_preset("beam"), size=(320, 200), frames=2) == 2
+    assert len(shots) == 5
 
 
 def _one_line_failure(env, *args):

@@ -305,6 +305,51 @@ def test_renderer_on_a_plain_context_and_release(tree):
         ctx.release()
 
 
+@pytest.mark.parametrize("fail_at", ["line program", "ground"])
+def test_renderer_frees_what_it_made_when_construction_fails(tree, monkeypatch, fail_at):
+    """A failure part-way through Renderer() (a shader that does not build, any later step)
+    leaves no GL object behind: everything made before it is released."""
+    import treeanim.render.renderer as renderer_module
+
+    ctx = create_egl_context()
+    made = []
+
+    def recording(make):
+        def wrapper(*a, **k):
+            obj = make(*a, **k)
+            made.append(obj)
+            return obj
+        return wrapper
+
+    for name in ("program", "buffer", "texture", "vertex_array"):
+        monkeypatch.setattr(ctx, name, recording(getattr(ctx, name)))
+    load_program = renderer_module.load_program
+
+    def failing_load(c, vertex, *rest):
+        if fail_at == "line program" and vertex == "line.vert":
+            raise RuntimeError("shader program line.vert + line.frag failed to build: (test)")
+        return load_program(c, vertex, *rest)
+
+    def failing_ground(self):
+        raise MemoryError("(test)")
+
+    monkeypatch.setattr(renderer_module, "load_program", failing_load)
+    if fail_at == "ground":
+        monkeypatch.setattr(Renderer, "_place_ground", failing_ground)
+    try:
+        with ctx:
+            with pytest.raises(RuntimeError if fail_at == "line program" else MemoryError):
+                Renderer(ctx, tree)
+            kinds = {type(o).__name__ for o in made}
+            assert kinds >= ({"Program"} if fail_at == "line program" else {"Program", "Buffer", "Texture",
+                                                                             "VertexArray"})
+            alive = [o for o in made if type(o.mglo).__name__ != "InvalidObject"]
+            assert not alive, f"left behind: {alive}"
+            assert ctx.error == "GL_NO_ERROR"
+    finally:
+        ctx.release()
+
+
 def test_missing_egl_is_a_clear_runtime_error(monkeypatch):
     def fail(*a, **k):
         raise Exception("eglGetDisplay failed\n(no display)")

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from conftest import beam_tree, grass_patch, small_tree
@@ -9,7 +11,6 @@ from conftest import beam_tree, grass_patch, small_tree
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.mesh import (
     MATERIAL_BARK,
-    MATERIAL_BLADE,
     MATERIAL_LAMINA,
     MATERIAL_PETIOLE,
     VERTEX_ATTRIBUTES,
@@ -19,6 +20,7 @@ from treeanim.render.mesh import (
     lamina_frames,
 )
 from treeanim.render.picking import Picker, pick
+from treeanim.render.shaders import shader_source
 
 
 def rot(axis, angle):
@@ -66,9 +68,25 @@ def test_per_kind_triangles_follow_the_papers_rule():
 
 
 def test_vertex_layout():
-    assert VERTEX_DTYPE.itemsize == 64
-    assert VERTEX_FORMAT == "4i 3f 3f 4f 2f"
-    assert VERTEX_ATTRIBUTES == ("in_ids", "in_offset", "in_normal", "in_extra", "in_uv")
+    # The moderngl format, the attribute names, the numpy vertex and the vertex shader's inputs
+    # describe the same interleaved layout, field by field, with no padding.
+    groups = VERTEX_FORMAT.split()
+    names = VERTEX_DTYPE.names
+    assert len(groups) == len(VERTEX_ATTRIBUTES) == len(names)
+    shader_inputs = dict((n, t) for t, n in re.findall(r"^\s*in\s+(\w+)\s+(\w+)\s*;", shader_source("tree.vert"),
+                                                         re.M))
+    offset = 0
+    for group, attr, name in zip(groups, VERTEX_ATTRIBUTES, names):
+        count, kind = int(group[:-1]), group[-1]
+        dt, field_offset = VERTEX_DTYPE.fields[name]
+        assert field_offset == offset, name
+        assert dt.shape == (count,) and dt.base.itemsize == 4, name
+        assert dt.base.kind == {"i": "i", "f": "f"}[kind], name
+        assert attr == f"in_{name}"
+        assert shader_inputs[attr] == {1: "", 2: "vec2", 3: "vec3", 4: "vec4"}[count].replace(
+            "vec", "ivec" if kind == "i" else "vec"), attr
+        offset += 4 * count
+    assert VERTEX_DTYPE.itemsize == offset
     mesh = build_mesh(small_tree())
     v = mesh.vertices
     assert set(np.unique(mesh.material)) == {MATERIAL_BARK, MATERIAL_PETIOLE, MATERIAL_LAMINA}
@@ -155,16 +173,18 @@ def test_joint_rings_follow_both_segments():
     assert np.allclose(pts[after] - positions[j + 2], mesh.vertices["offset"][after] @ R.T, atol=1e-6)
 
 
-def test_mesh_build_is_vectorised_fast():
-    """A tree with thousands of leaves builds in well under a second (no per-object loop)."""
-    import time
-
+def test_mesh_of_a_leafy_tree():
+    """The mesh of a tree with hundreds of leaves is complete (its build time is measured in
+    benchmarks/bench_mesh.py, not asserted here)."""
     tree = small_tree(leaves_per_twig=60)
-    t0 = time.perf_counter()
+    assert (tree.kind == "leaf").sum() == 15 * 60
     mesh = build_mesh(tree)
-    elapsed = time.perf_counter() - t0
-    assert mesh.triangle_count == int(tree.triangles_per_object().sum())
-    assert elapsed < 1.0, elapsed
+    assert np.array_equal(mesh.object_triangles, tree.triangles_per_object())
+    assert mesh.triangle_count == int(tree.triangles_per_object().sum()) == len(mesh.indices)
+    assert mesh.indices.max() < mesh.vertex_count
+    obj = mesh.object[mesh.indices]
+    assert np.all(obj == obj[:, :1])
+    assert np.array_equal(np.bincount(obj[:, 0], minlength=tree.n_objects), mesh.object_triangles)
 
 
 # ------------------------------------------------------------------------------ camera
@@ -193,9 +213,10 @@ def test_camera_frame_orbit_pan_zoom():
     xy = cam.project(rim, 400, 300)[:, :2]
     assert np.all((xy >= -1e-6) & (xy <= [400 + 1e-6, 300 + 1e-6]))
     assert (xy[:, 0].max() - xy[:, 0].min() > 0.8 * 400) or (xy[:, 1].max() - xy[:, 1].min() > 0.8 * 300)
-    eye = cam.eye
+    eye = cam.eye.copy()
     cam.orbit(90, 200)
     assert cam.elevation == 89.0 and np.isclose(np.linalg.norm(cam.eye - cam.target), cam.distance)
+    assert np.linalg.norm(cam.eye - eye) > 0.5 * cam.distance  # the eye went over the top
     cam.orbit(0, -200)
     assert cam.elevation == -89.0
     d = cam.distance
@@ -206,7 +227,6 @@ def test_camera_frame_orbit_pan_zoom():
     x0 = cam.project(p, 200, 100)[0, 0]
     cam.pan(10, 0, 100)
     assert np.isclose(cam.project(p, 200, 100)[0, 0] - x0, 10.0, atol=1e-3)
-    assert np.linalg.norm(eye) > 0
 
 
 # ------------------------------------------------------------------------------ picking

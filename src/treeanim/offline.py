@@ -4,10 +4,10 @@ pull-and-release tip traces (``treeanim trace``) and the Table 1 benchmark (``tr
 Everything renders through :class:`treeanim.render.offscreen.OffscreenRenderer` (EGL, Mesa
 llvmpipe where there is no GPU) and writes through imageio / imageio-ffmpeg.
 
-Files are written safely: a video goes to a hidden temporary file beside the target and is
-renamed over it once finished (or once interrupted, if at least one frame was encoded), and
-every PNG is written beside its name and renamed, so an interrupted or failed run leaves
-either nothing or a complete, playable file.
+Files are written safely (:mod:`treeanim.files`): a video goes to a hidden temporary file
+beside the target and is renamed over it once finished (or once interrupted, if at least one
+frame was encoded), and every PNG, CSV, plot and JSON file is written beside its name and
+renamed, so an interrupted or failed run leaves either nothing or a complete, playable file.
 """
 
 from __future__ import annotations
@@ -26,6 +26,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
+
+from .files import atomic_path, temp_beside
+from .files import write_text as write_text  # re-exported: the command line writes its JSON through it
 
 #: Image sides above this are refused (llvmpipe allows 16384, but memory runs out first).
 MAX_SIDE = 8192
@@ -89,10 +92,6 @@ class Target:
 
     kind: str
     path: Path
-
-    @property
-    def format(self) -> str:
-        return "png" if self.kind != "video" else self.path.suffix.lower()[1:]
 
 
 def check_folder(folder: Path, text: str) -> None:
@@ -194,34 +193,6 @@ def framed_camera(tree, width: int, height: int, azimuth: float = 0.0, elevation
 
 
 # ============================================================================ writers
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def _temp_beside(path: Path, suffix: str) -> Path:
-    """A new hidden file beside ``path`` (same folder, so a rename replaces ``path`` at once),
-    with the permissions a plain new file would get."""
-    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".part{suffix}", dir=path.parent or ".")
-    try:
-        os.fchmod(fd, 0o666 & ~_umask())
-    finally:
-        os.close(fd)
-    return Path(name)
-
-
-def write_text(path: Path, text: str) -> None:
-    """A text file written beside ``path`` and renamed over it."""
-    tmp = _temp_beside(Path(path), Path(path).suffix)
-    try:
-        tmp.write_text(text)
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
-
-
 def pad_even(img: np.ndarray) -> np.ndarray:
     """``img`` (H, W, 3) padded to even sides by repeating its last row / column (yuv420p
     video needs even sizes)."""
@@ -240,6 +211,23 @@ class VideoSink:
     through imageio-ffmpeg, via a temporary file renamed over ``path`` by :meth:`finish`.
 
     MP4 frames of odd width or height are padded to even by repeating the last row/column.
+
+    The temporary file comes from :func:`treeanim.files.temp_beside` rather than
+    :func:`~treeanim.files.atomic_path`: an interrupted render keeps the frames encoded so far
+    (:meth:`finish` renames them into place), which "remove on any error" would throw away.
+
+    Attributes
+    ----------
+    path : Path
+        The video's final name.
+    tmp : Path
+        The hidden temporary file ffmpeg writes to.
+    size : (int, int)
+        Width and height encoded (an MP4's odd sides padded to even).
+    count : int
+        Frames encoded so far.
+    broken : bool
+        ffmpeg failed: the file is dropped, never kept.
     """
 
     def __init__(self, path: Path, width: int, height: int, fps: float) -> None:
@@ -260,7 +248,7 @@ class VideoSink:
                                             "[b][p]paletteuse=dither=bayer:bayer_scale=4", "-loop", "0"])
         else:
             raise InputError(f"unknown video format {self.path.suffix!r}")
-        self.tmp = _temp_beside(self.path, self.path.suffix.lower())
+        self.tmp = temp_beside(self.path, self.path.suffix.lower())
         try:
             self._gen = imageio_ffmpeg.write_frames(str(self.tmp), self.size, fps=float(fps), macro_block_size=1,
                                                     ffmpeg_log_level="error", **kw)
@@ -270,6 +258,20 @@ class VideoSink:
             raise
 
     def write(self, img: np.ndarray) -> None:
+        """Encode one frame.
+
+        Parameters
+        ----------
+        img : (height, width, 3) uint8
+            The frame, row 0 at the top, of the size given to the constructor (an MP4's odd
+            side is padded here).
+
+        Raises
+        ------
+        Exception
+            Whatever ffmpeg's writer raised; the sink is then :attr:`broken` and its file is
+            not kept.
+        """
         if self.format == "mp4":
             img = pad_even(img)
         try:
@@ -317,13 +319,8 @@ def write_png(path: Path, img: np.ndarray) -> None:
     """One PNG, written beside ``path`` and renamed over it (never a half-written file)."""
     import imageio.v3 as iio
 
-    tmp = _temp_beside(Path(path), ".png")
-    try:
+    with atomic_path(path, ".png") as tmp:
         iio.imwrite(tmp, img, extension=".png")
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 class FrameSink:
@@ -338,6 +335,7 @@ class FrameSink:
         self.format = "png"
 
     def write(self, img: np.ndarray) -> None:
+        """Write ``img`` ((height, width, 3) uint8, row 0 at the top) as the next frame file."""
         write_png(self.path / FRAME_NAME.format(self.count), img)
         self.count += 1
 
@@ -349,6 +347,14 @@ class FrameSink:
         return n
 
     def finish(self) -> bool:
+        """End the run: a folder this sink created is removed again if no frame went into it.
+
+        Returns
+        -------
+        bool
+            Whether any frame was written (the frames are kept either way; each file is
+            complete as soon as :meth:`write` returns).
+        """
         if self.count == 0 and self.created:
             try:
                 self.path.rmdir()
@@ -424,6 +430,26 @@ class RenderJob:
 
 @dataclass
 class RenderResult:
+    """What :func:`run_render` did.
+
+    Attributes
+    ----------
+    frames : int
+        Frames written (1 for a still).
+    total : int
+        Frames the job asked for.
+    kept : bool
+        Whether the output was kept (False: nothing was written, nothing is left behind).
+    interrupted : bool
+        Whether Ctrl-C stopped the run early (the frames so far are kept).
+    path : Path
+        The video, still or folder.
+    size : (int, int)
+        Width and height of the frames written (an MP4's odd sides padded to even).
+    bytes : int
+        Size of what was kept, in bytes (a folder: its frame files).
+    """
+
     frames: int
     total: int
     kept: bool
@@ -529,9 +555,23 @@ class TraceResult:
 def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float) -> TraceResult:
     """Pull object ``obj``'s tip with ``force`` (N, world) for ``hold`` seconds (the held object
     sits at its static deflection; the rest of the tree settles), let go, and record the tip
-    for ``seconds`` at ``rate`` samples per second."""
+    for ``seconds`` at ``rate`` samples per second.
+
+    Raises
+    ------
+    InputError
+        ``seconds`` or ``rate`` not finite and positive, or so small that fewer than 2 samples
+        would follow the release (checked before anything is simulated).
+    """
     from .physics.simulation import trace_tips
 
+    for name, value in (("--seconds", seconds), ("--rate", rate)):
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"{name} {value:g}: expected a positive number")
+    samples = int(round(seconds * rate)) + 1  # trace_tips records the release and every step after it
+    if samples < 2:
+        raise InputError(f"--seconds {seconds:g} at --rate {rate:g} Hz gives {samples} sample after release; "
+                         f"a trace needs at least 2 samples")
     dt = 1.0 / rate
     tree = sim.tree
     tip = int(tree.object_start[obj] + tree.object_count[obj] - 1)
@@ -547,14 +587,9 @@ def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float) ->
 
 def write_trace_csv(path: Path, trace: TraceResult) -> None:
     """``t,x,y,z`` (seconds after release, world metres), written beside ``path`` and renamed."""
-    tmp = _temp_beside(Path(path), ".csv")
-    try:
-        data = np.column_stack([trace.times, trace.tips])
+    data = np.column_stack([trace.times, trace.tips])
+    with atomic_path(path, ".csv") as tmp:
         np.savetxt(tmp, data, delimiter=",", header="t,x,y,z", comments="", fmt=["%.6f", "%.9f", "%.9f", "%.9f"])
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
 
 
 def plot_trace(path: Path, trace: TraceResult, title: str = "") -> None:
@@ -597,20 +632,17 @@ def plot_trace(path: Path, trace: TraceResult, title: str = "") -> None:
            f"ζ = {z_[0]:.3f}, {z_[1]:.3f}, {z_[2]:.3f}")
     ax.set_title((title + "\n" if title else "") + sub, fontsize=9)
     fig.tight_layout()
-    tmp = _temp_beside(Path(path), Path(path).suffix.lower())
+    suffix = Path(path).suffix.lower()
     try:
-        fig.savefig(tmp, format=Path(path).suffix.lower()[1:])
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+        with atomic_path(path, suffix) as tmp:
+            fig.savefig(tmp, format=suffix[1:])
     finally:
         plt.close(fig)
 
 
 def zero_crossing_frequency(t: np.ndarray, x: np.ndarray) -> float:
     """Frequency (Hz) of an oscillating signal from its mean zero-crossing interval."""
-    x = np.asarray(x, float) - 0.0
+    x = np.asarray(x, float)
     s = np.signbit(x)
     i = np.flatnonzero(s[1:] != s[:-1])
     if len(i) < 3:
@@ -658,7 +690,11 @@ def bench_row(key: str, off, width: int, height: int, frames: int, steps: int, w
     preset, season = BENCH_ROWS.get(key, (key, 0.0))
     tree = ta.load_preset(preset)
     stats = tree.stats(season)
-    sim = ta.Simulation(tree, wind=ta.WindField(speed=wind, seed=0), season=season, seed=0)
+    try:
+        wind_field = ta.WindField(speed=wind, seed=0)
+    except ValueError as e:
+        raise InputError(f"--wind {wind:g}: {' '.join(str(e).split())}") from None
+    sim = ta.Simulation(tree, wind=wind_field, season=season, seed=0)
     for _ in range(5):
         sim.step(dt)
     sim_ms = []
@@ -702,10 +738,24 @@ def bench_row(key: str, off, width: int, height: int, frames: int, steps: int, w
 def run_bench(keys, width: int = 1280, height: int = 720, frames: int = 20, steps: int = 200, samples: int = 4,
               wind: float = 5.0, quiet: bool = False) -> dict:
     """The Table 1 benchmark over ``keys`` (see :data:`BENCH_ROWS`): a dict with the machine,
-    the GL renderer and one row per key."""
+    the GL renderer and one row per key.
+
+    Raises
+    ------
+    InputError
+        ``wind`` outside 0 … :data:`treeanim.physics.wind.MAX_SPEED` (checked before the GL
+        context is made or any tree is loaded).
+    GLUnavailable
+        No OpenGL context to render with.
+    """
     import datetime
 
     from tqdm import tqdm
+
+    from .physics.wind import MAX_SPEED
+
+    if not (math.isfinite(wind) and 0.0 <= wind <= MAX_SPEED):
+        raise InputError(f"--wind {wind:g}: expected a wind speed from 0 to {MAX_SPEED:g} m/s")
 
     started = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
     machine = machine_info()
@@ -724,7 +774,8 @@ def run_bench(keys, width: int = 1280, height: int = 720, frames: int = 20, step
     return {
         "date": started,
         "machine": machine,
-        "gl_renderer": info.get("GL_RENDERER"), "gl_version": info.get("GL_VERSION"), "gl_vendor": info.get("GL_VENDOR"),
+        "gl_renderer": info.get("GL_RENDERER"), "gl_version": info.get("GL_VERSION"),
+        "gl_vendor": info.get("GL_VENDOR"),
         "size": [width, height], "samples": samples_used, "wind": wind,
         "paper_machine": "Core2 Duo 2.8 GHz, GeForce 9500 GT (2012)",
         "rows": rows,

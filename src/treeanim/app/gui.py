@@ -106,21 +106,55 @@ class Gui:
 
     # ------------------------------------------------------------------ input
     def mouse_pos(self, x: float, y: float) -> None:
+        """The cursor moved.
+
+        Parameters
+        ----------
+        x, y : float
+            Position in screen units (window coordinates, origin at the top left).
+        """
         self.io.add_mouse_pos_event(float(x), float(y))
 
     def mouse_left(self) -> None:
-        """The cursor left the window."""
+        """The cursor left the window (ImGui hovers nothing until the next :meth:`mouse_pos`)."""
         self.io.add_mouse_pos_event(-3.4e38, -3.4e38)
 
     def mouse_button(self, button: int, down: bool) -> None:
+        """A mouse button went down or up.
+
+        Parameters
+        ----------
+        button : int
+            GLFW button (``glfw.MOUSE_BUTTON_LEFT``, ``_RIGHT``, ``_MIDDLE``; others are ignored).
+        down : bool
+            True when pressed, False when released.
+        """
         b = _BUTTONS.get(button)
         if b is not None:
             self.io.add_mouse_button_event(b, bool(down))
 
     def scroll(self, dx: float, dy: float) -> None:
+        """The wheel (or a touchpad) scrolled.
+
+        Parameters
+        ----------
+        dx, dy : float
+            Notches, as GLFW reports them (``dy > 0``: away from the user, scrolls up).
+        """
         self.io.add_mouse_wheel_event(float(dx), float(dy))
 
     def key(self, key: int, action: int, mods: int) -> None:
+        """A key went down, repeated or up.
+
+        Parameters
+        ----------
+        key : int
+            GLFW key code (keys ImGui has no use for only update the modifiers).
+        action : int
+            ``glfw.PRESS``, ``glfw.REPEAT`` or ``glfw.RELEASE``.
+        mods : int
+            GLFW modifier bits (``glfw.MOD_CONTROL`` ...) held at the time.
+        """
         io = self.io
         io.add_key_event(imgui.Key.mod_ctrl, bool(mods & glfw.MOD_CONTROL))
         io.add_key_event(imgui.Key.mod_shift, bool(mods & glfw.MOD_SHIFT))
@@ -131,9 +165,18 @@ class Gui:
             io.add_key_event(k, action != glfw.RELEASE)
 
     def char(self, codepoint: int) -> None:
+        """A character was typed (text fields take their text from here, not from :meth:`key`).
+
+        Parameters
+        ----------
+        codepoint : int
+            Unicode code point.
+        """
         self.io.add_input_character(int(codepoint))
 
     def focus(self, focused: bool) -> None:
+        """The window gained (True) or lost (False) the keyboard focus (on losing it ImGui
+        forgets the keys it thought held)."""
         self.io.add_focus_event(bool(focused))
 
     @property

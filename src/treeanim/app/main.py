@@ -21,6 +21,10 @@ def view(tree, *, season: float = 0.0, wind_speed: float = 5.0, size: tuple[int,
     ------
     ViewerUnavailable
         No display, no GLFW, no OpenGL 3.3, or the viewer's libraries cannot load (one line).
+    ValueError
+        The tree cannot be simulated or shown as asked (e.g. its physics has no f/ζ range for
+        a kind the tree has, or a wind speed out of range): one line naming the tree; the
+        window is closed again and nothing is left behind.
     """
     check_display()  # before loading GLFW, OpenGL and imgui: the clearest message
     try:
@@ -31,7 +35,10 @@ def view(tree, *, season: float = 0.0, wind_speed: float = 5.0, size: tuple[int,
                                 f"{HEADLESS_HINT}") from None
     win = Window.open(*size, title or f"treeanim — {tree.name}", samples=samples)
     try:
-        viewer = Viewer(win, tree, season=season, wind_speed=wind_speed)
+        try:
+            viewer = Viewer(win, tree, season=season, wind_speed=wind_speed)
+        except ValueError as e:
+            raise ValueError(f"cannot show {getattr(tree, 'name', 'the tree')}: {' '.join(str(e).split())}") from None
         try:
             return run(viewer, max_frames=frames)
         finally:

@@ -176,17 +176,24 @@ class Panel:
         return out
 
     def load(self, path: str | None = None) -> bool:
-        """Load a preset file (default :attr:`path`) and show its tree."""
+        """Load a preset file (default :attr:`path`) and show its tree.
+
+        Returns
+        -------
+        bool
+            Whether the tree is shown. A file that cannot be read or parsed (PresetError), or a
+            tree the simulation refuses (ValueError, e.g. no f/ζ range for a kind the tree
+            has), is reported in the panel's status line; the current tree stays.
+        """
         import treeanim as ta
 
         v = self.viewer
         target = path or self.path
         try:
-            tree = ta.load_tree(target)
-        except ta.PresetError as e:
+            v.load_tree(ta.load_tree(target))
+        except (ValueError, OSError) as e:  # PresetError is a ValueError
             v.say(f"error: {' '.join(str(e).split())}")
             return False
-        v.load_tree(tree)
         v.say(f"loaded {target}")
         return True
 

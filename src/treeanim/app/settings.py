@@ -3,9 +3,9 @@
 A saved file is a preset like those in ``assets/presets/``: the original preset's text with
 its shape tables (trunk, levels, leaves, lamina, grass, beam) and comments kept as they were,
 the top-level ``seed`` set, and the ``[physics]`` tables replaced by the current values. It is
-checked with the preset reader before it replaces anything, and written atomically (a
-temporary file in the same folder, then ``os.replace``), so an interrupted save never leaves a
-half-written preset. ``treeanim.load_tree(path)`` loads it.
+checked with the preset reader before it replaces anything, and written atomically
+(:func:`treeanim.files.atomic_path`: a temporary file in the same folder, then a rename), so an
+interrupted save never leaves a half-written preset. ``treeanim.load_tree(path)`` loads it.
 """
 
 from __future__ import annotations
@@ -13,11 +13,11 @@ from __future__ import annotations
 import math
 import os
 import re
-import tempfile
 import tomllib
 from importlib import resources
 from pathlib import Path
 
+from ..files import atomic_path
 from ..model.errors import PresetError
 from ..model.params import SCALAR_KEYS, PhysicsParams
 from ..model.tree import KINDS, Tree
@@ -161,28 +161,20 @@ def save_preset(path, tree: Tree, physics: PhysicsParams, seed: int | None = Non
     if not folder.is_dir():
         raise ValueError(f"{path}: folder {folder} does not exist")
     text = preset_text(original_preset_text(tree), physics, tree.seed if seed is None else seed)
+    from ..model.presets import read_spec
+
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=folder)
+        with atomic_path(path, ".toml") as tmp:
+            with open(tmp, "w", encoding="utf-8") as f:
+                f.write(text)
+                f.flush()
+                os.fsync(f.fileno())
+            try:
+                read_spec(tmp)
+            except PresetError as e:
+                raise ValueError(str(e).replace(str(tmp), str(path))) from None
     except OSError as e:
         raise ValueError(f"{path}: cannot write in {folder} ({e.strerror or e})") from None
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        from ..model.presets import read_spec
-
-        try:
-            read_spec(tmp)
-        except PresetError as e:
-            raise ValueError(str(e).replace(tmp, str(path))) from None
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
     return path
 
 

@@ -82,6 +82,12 @@ class Grab:
         Largest force, N.
     force : (3,) float
         The current (low-passed) pull force, N.
+    ratio : float
+        Metres the grabbed point moves per metre the object's tip moves while bent by a tip
+        force (the ratio of their compliances): between a frame's sub-steps the grabbed point
+        is followed through :meth:`Simulation.tip_position` instead of the whole pose.
+    frame_anchor, frame_tip : (3,) float or None
+        The grabbed point and the tip at the frame's first sub-step (exact, from the pose).
     """
 
     object: int
@@ -94,6 +100,9 @@ class Grab:
     k: float
     f_max: float
     force: np.ndarray
+    ratio: float = 1.0
+    frame_anchor: np.ndarray | None = None
+    frame_tip: np.ndarray | None = None
 
 
 class ViewCamera(OrbitCamera):
@@ -228,10 +237,14 @@ class Viewer:
                                  seed=self.seed)
         self._season = float(season)
         self.gui = Gui(window.handle, scale=window.content_scale)
-        from .panel import Panel
+        try:
+            from .panel import Panel
 
-        self.panel = Panel(self)
-        self.load_tree(tree)
+            self.panel = Panel(self)
+            self.load_tree(tree)
+        except BaseException:  # e.g. a ValueError from the Simulation: free the Gui (and any renderer)
+            self.release()
+            raise
 
     # ------------------------------------------------------------------ the tree
     @property
@@ -323,9 +336,9 @@ class Viewer:
         n = min(n, int(math.ceil(MAX_FRAME_DT * self.time_scale / h)) + 1)
         self._acc = min(max(self._acc - n * h, -0.25 * h), h)
         sim = self.sim
-        for _ in range(n):
+        for j in range(n):
             if self.grab is not None:
-                self._update_pull(h)
+                self._update_pull(h, exact=j == 0)
             sim.step(h)
             if self.traced is not None:
                 self.trace.push(sim.tip_position(self.traced))
@@ -525,12 +538,14 @@ class Viewer:
         anchor = a[k] + s[k] * e[k]
         point = np.asarray(hit.point, float)
         G = max(self.compliance(obj, k, float(s[k]), point - anchor), 1e-12)
+        G_tip = max(self.compliance(obj, len(nodes) - 2, 1.0), 1e-12)
         spring = PULL_GAIN / G
         length = float(np.sum(np.linalg.norm(np.diff(tree.rest_positions[nodes], axis=0), axis=1)))
         length += float(tree.lamina_length[obj])
         self.grab = Grab(object=obj, node=int(nodes[k]), s=float(s[k]), offset=point - anchor,
                          plane_point=point.copy(), plane_normal=self.camera.forward.copy(), target=point.copy(),
-                         k=spring, f_max=spring * PULL_MAX_LENGTHS * length, force=np.zeros(3))
+                         k=spring, f_max=spring * PULL_MAX_LENGTHS * length, force=np.zeros(3),
+                         ratio=G / G_tip)
         self.trace.clear()
         self.traced = obj
         self.trace.push(sim.tip_position(obj))
@@ -544,9 +559,20 @@ class Viewer:
         P = self.sim.positions
         return P[g.node] + g.s * (P[g.node + 1] - P[g.node]) + g.offset
 
-    def _update_pull(self, h: float) -> None:
+    def _grabbed_point(self, exact: bool) -> np.ndarray:
+        """Where the grabbed point is: exact from the pose when ``exact`` (a frame's first
+        sub-step, whose pose the last frame drew, so it is built already), else followed from
+        the frame's exact point by the tip's motion since (one tip, not N nodes, a sub-step)."""
         g = self.grab
-        raw = g.k * (g.target - self.anchor_point())
+        tip = self.sim.tip_position(g.object)
+        if exact or g.frame_anchor is None:
+            g.frame_anchor, g.frame_tip = self.anchor_point(), tip
+            return g.frame_anchor
+        return g.frame_anchor + g.ratio * (tip - g.frame_tip)
+
+    def _update_pull(self, h: float, exact: bool = True) -> None:
+        g = self.grab
+        raw = g.k * (g.target - self._grabbed_point(exact))
         mag = float(np.linalg.norm(raw))
         if mag > g.f_max:
             raw *= g.f_max / mag

@@ -174,6 +174,7 @@ class Window:
 
     @property
     def should_close(self) -> bool:
+        """Whether the user (or :meth:`request_close`) asked the window to close."""
         return bool(glfw.window_should_close(self.handle))
 
     def request_close(self) -> None:
@@ -182,6 +183,7 @@ class Window:
 
     @property
     def fullscreen(self) -> bool:
+        """Whether the window covers a monitor (see :meth:`toggle_fullscreen`)."""
         return glfw.get_window_monitor(self.handle) is not None and bool(glfw.get_window_monitor(self.handle))
 
     def toggle_fullscreen(self) -> None:
@@ -220,14 +222,29 @@ class Window:
             setter(h, fn)
 
     def swap(self) -> None:
+        """Show the frame drawn into the back buffer (waits for the display's refresh when the
+        window was opened with ``vsync``)."""
         glfw.swap_buffers(self.handle)
 
     @staticmethod
     def poll() -> None:
+        """Process the input and window events waiting now, without blocking.
+
+        Notes
+        -----
+        GLFW calls the callbacks set by :meth:`connect` from within this call, on this thread.
+        """
         glfw.poll_events()
 
     @staticmethod
     def wait(timeout: float) -> None:
+        """Sleep until an event arrives or ``timeout`` passes, then process the events.
+
+        Parameters
+        ----------
+        timeout : float
+            Longest wait, seconds (> 0).
+        """
         glfw.wait_events_timeout(timeout)
 
     @staticmethod

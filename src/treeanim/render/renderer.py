@@ -97,46 +97,53 @@ class Renderer:
         self.scene = scene if scene is not None else Scene()
         self._applied_scene: tuple | None = None
         self._released = False
-
-        self.tree_prog = load_program(ctx, "tree.vert", "tree.frag")
-        self.bg_prog = load_program(ctx, "background.vert", "background.frag")
-        self.line_prog = load_program(ctx, "line.vert", "line.frag", "line_geom.glsl")
-
-        # --- static mesh
-        self.vbo = self.ibo = self.vao = None
-        if self.mesh.triangle_count:
-            self.vbo = ctx.buffer(self.mesh.vertices.tobytes())
-            self.ibo = ctx.buffer(self.mesh.indices.tobytes())
-            self.vao = ctx.vertex_array(self.tree_prog, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRIBUTES)],
-                                        index_buffer=self.ibo, index_element_size=4)
-        self._n_indices = 3 * self.mesh.triangle_count
-
-        # --- per-frame textures
-        N, M = tree.n_nodes, tree.n_objects
-        rows = max(1, math.ceil(3 * N / TEXTURE_WIDTH))
-        self._node_staging = np.zeros((rows * TEXTURE_WIDTH, 4), np.float32)
-        self._node_rows = self._node_staging.reshape(-1)[: 12 * N].reshape(N, 12)
-        self.node_texture = ctx.texture((TEXTURE_WIDTH, rows), 4, dtype="f4")
-        orows = max(1, math.ceil(M / TEXTURE_WIDTH))
-        self._object_staging = np.zeros((orows * TEXTURE_WIDTH, 4), np.float32)
-        self.object_texture = ctx.texture((TEXTURE_WIDTH, orows), 4, dtype="f4")
-        for tex in (self.node_texture, self.object_texture):
-            tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            tex.repeat_x = tex.repeat_y = False
-        for prog in (self.tree_prog, self.line_prog):
-            self._uniform(prog, "u_nodes", 0)
-        self._uniform(self.tree_prog, "u_objects", 1)
-
-        # --- sky and ground: one full-screen triangle
-        self.bg_vao = ctx.vertex_array(self.bg_prog, [])
-        self._place_ground()
-
+        # Every GL object starts as None, so that release() can free whatever was made before a
+        # failure part-way through (a shader that does not compile, an out-of-memory buffer).
+        self.tree_prog = self.bg_prog = self.line_prog = None
+        self.vbo = self.ibo = self.vao = self.bg_vao = None
+        self.node_texture = self.object_texture = None
         self._lines: dict[int, _Lines] = {}
-        self._present: np.ndarray | None = None  # None: derived from the season at draw time
-        self._present_season: float | None = None
-        self._highlight = np.zeros(M, bool)
-        self._objects_dirty = True
-        self.update(tree.rest_positions, np.broadcast_to(np.eye(3), (N, 3, 3)))
+        try:
+            self.tree_prog = load_program(ctx, "tree.vert", "tree.frag")
+            self.bg_prog = load_program(ctx, "background.vert", "background.frag")
+            self.line_prog = load_program(ctx, "line.vert", "line.frag", "line_geom.glsl")
+
+            # --- static mesh
+            if self.mesh.triangle_count:
+                self.vbo = ctx.buffer(self.mesh.vertices.tobytes())
+                self.ibo = ctx.buffer(self.mesh.indices.tobytes())
+                self.vao = ctx.vertex_array(self.tree_prog, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRIBUTES)],
+                                            index_buffer=self.ibo, index_element_size=4)
+            self._n_indices = 3 * self.mesh.triangle_count
+
+            # --- per-frame textures
+            N, M = tree.n_nodes, tree.n_objects
+            rows = max(1, math.ceil(3 * N / TEXTURE_WIDTH))
+            self._node_staging = np.zeros((rows * TEXTURE_WIDTH, 4), np.float32)
+            self._node_rows = self._node_staging.reshape(-1)[: 12 * N].reshape(N, 12)
+            self.node_texture = ctx.texture((TEXTURE_WIDTH, rows), 4, dtype="f4")
+            orows = max(1, math.ceil(M / TEXTURE_WIDTH))
+            self._object_staging = np.zeros((orows * TEXTURE_WIDTH, 4), np.float32)
+            self.object_texture = ctx.texture((TEXTURE_WIDTH, orows), 4, dtype="f4")
+            for tex in (self.node_texture, self.object_texture):
+                tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
+                tex.repeat_x = tex.repeat_y = False
+            for prog in (self.tree_prog, self.line_prog):
+                self._uniform(prog, "u_nodes", 0)
+            self._uniform(self.tree_prog, "u_objects", 1)
+
+            # --- sky and ground: one full-screen triangle
+            self.bg_vao = ctx.vertex_array(self.bg_prog, [])
+            self._place_ground()
+
+            self._present: np.ndarray | None = None  # None: derived from the season at draw time
+            self._present_season: float | None = None
+            self._highlight = np.zeros(M, bool)
+            self._objects_dirty = True
+            self.update(tree.rest_positions, np.broadcast_to(np.eye(3), (N, 3, 3)))
+        except BaseException:
+            self.release()
+            raise
 
     # ------------------------------------------------------------------ helpers
     @staticmethod
