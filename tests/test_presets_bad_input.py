@@ -123,6 +123,7 @@ def test_empty_grass_refused(tmp_path):
     (["render", "beam", "--start", "1e5", "--seconds", "100", "--out", "a.mp4"], "at most"),
     (["trace", "beam", "--pull", "1,0,0", "--hold", "1e308", "--out", "a.csv"], "--hold"),
     (["bench", "--wind", "5000"], "--wind"),
+    (["trace", "beam", "--pull", "1,0,0", "--rate", "0.01", "--seconds", "1", "--out", "a.csv"], "at least 2 samples"),
     (["view", "beam", "--size", "0x3"], "at least 1 pixel"),
     (["bogus"], "invalid choice"),
 ])

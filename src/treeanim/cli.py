@@ -302,7 +302,10 @@ def cmd_trace(args) -> int:
     if not 0 <= args.object < tree.n_objects:
         raise UsageError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
     check_frames(args.hold + args.seconds, args.rate)
-    tr = offline.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
+    try:
+        tr = offline.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
+    except offline.InputError as e:
+        raise UsageError(str(e)) from None
     offline.write_trace_csv(out, tr)
     if plot is not None:
         offline.plot_trace(plot, tr, title=f"{tree.name}: pull {','.join(f'{v:g}' for v in args.pull)} N, "
