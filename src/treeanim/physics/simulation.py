@@ -13,7 +13,7 @@ from ..model.geometry import lamina_frames, object_lengths, polygon_centroid, se
 from ..model.params import PhysicsParams
 from ..model.tree import KINDS, Tree
 from .bending import BendingPlan, matrix_to_quat, rest_frames
-from .checks import finite_float
+from .checks import finite_float, finite_vector3
 from .hierarchy import CompositionPlan
 from .modal import ModalDraws, ModalParameters, derive_modes, mean_diameters
 from .oscillator import euler_step, exact_coefficients, exact_step
@@ -548,14 +548,7 @@ class Simulation:
             unchanged).
         """
         i = self._check_object(i)
-        try:
-            f = np.array(force_xyz, dtype=float).reshape(-1)
-        except (TypeError, ValueError):
-            raise ValueError(f"force_xyz must be 3 finite numbers, got {force_xyz!r}") from None
-        if f.shape != (3,):
-            raise ValueError(f"force_xyz must be 3 finite numbers, got shape {np.shape(force_xyz)}")
-        if not np.all(np.isfinite(f)):
-            raise ValueError(f"force_xyz must be finite, got {f.tolist()}")
+        f = finite_vector3("force_xyz", force_xyz)
         # Components first, so that the norm's squares cannot overflow.
         if float(np.max(np.abs(f))) > MAX_PULL or float(np.linalg.norm(f)) > MAX_PULL:
             raise ValueError(f"force_xyz must have a magnitude of at most {MAX_PULL:g} N, got {f.tolist()}")

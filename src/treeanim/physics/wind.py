@@ -30,7 +30,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.fft
 
-from .checks import finite_float
+from .checks import finite_float, finite_vector3
 
 __all__ = ["fbm_noise", "WindField"]
 
@@ -78,18 +78,6 @@ def _integer(name: str, value, lo: int, hi: int | None = None) -> int:
         upper = f" and at most {hi}" if hi is not None else ""
         raise ValueError(f"{name} must be at least {lo}{upper}, got {n}")
     return n
-
-
-def _vector3(name: str, value) -> np.ndarray:
-    try:
-        v = np.array(value, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be three finite numbers, got {value!r}") from None
-    if v.shape != (3,):
-        raise ValueError(f"{name} must be three numbers (x, y, z), got shape {v.shape}")
-    if not np.all(np.isfinite(v)):
-        raise ValueError(f"{name} must be finite, got {value!r}")
-    return v
 
 
 def _bounds(value, name: str = "bounds") -> np.ndarray:
@@ -319,7 +307,7 @@ class WindField:
 
     @direction.setter
     def direction(self, value) -> None:
-        d = _vector3("direction", value)
+        d = finite_vector3("direction", value)
         big = np.abs(d).max()
         if big == 0.0:
             self._direction, self._frame = d, np.zeros((3, 3))
