@@ -124,10 +124,12 @@ def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
                    help="seed of the wind and the modal noise (default 0)")
 
 
-def add_scene_options(p: argparse.ArgumentParser, seconds: float = 5.0, fps: float = 30.0) -> None:
+def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, fps: float = 30.0,
+                      seconds_help: str | None = None) -> None:
     """Options shared by the offline commands: the preset, timing, wind, season and pulls."""
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
-    p.add_argument("--seconds", type=_positive(float), default=seconds, help=f"duration in seconds (default {seconds:g})")
+    p.add_argument("--seconds", type=_positive(float), default=seconds,
+                   help=seconds_help or f"duration in seconds (default {seconds:g})")
     p.add_argument("--fps", type=_positive(float), default=fps, help=f"frames per second (default {fps:g})")
     add_wind_options(p)
     p.add_argument("--pull", type=_pull, action="append", default=[], metavar="OBJECT:FX,FY,FZ@T0-T1",
@@ -435,11 +437,9 @@ def build_parser() -> argparse.ArgumentParser:
         description="Simulate and render offscreen (EGL): a video (.mp4 H.264, or .gif), a folder of PNG frames "
         "(frame_00000.png, ...), or one .png still of the state after --seconds. Ctrl-C stops after the current "
         "frame and keeps a playable file of what was rendered.")
-    add_scene_options(p)
-    for a in p._actions:
-        if a.dest == "seconds":  # a still's default differs from a clip's
-            a.default = None
-            a.help = "clip length in seconds (default 5); for a .png, the time simulated before the still (default 2)"
+    add_scene_options(p, seconds=None,  # a still's default differs from a clip's
+                      seconds_help="clip length in seconds (default 5); for a .png, the time simulated before "
+                      "the still (default 2)")
     p.add_argument("--out", required=True,
                    help="clip.mp4 | clip.gif | frames/ (a folder of PNG frames) | still.png")
     p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH", help="image size (default 1280x720)")
