@@ -10,32 +10,22 @@ The public API (DESIGN §9)::
 Names are imported lazily so that ``import treeanim`` (and the command line) stays fast.
 """
 
-from importlib import import_module
+from ._lazy import lazy_exports
 
 __version__ = "0.1.0"
 
 _EXPORTS = {
-    "Tree": "treeanim.model.tree",
-    "Lamina": "treeanim.model.tree",
-    "PresetError": "treeanim.model.errors",
-    "list_presets": "treeanim.model.presets",
-    "load_preset": "treeanim.model.presets",
-    "load_tree": "treeanim.model.presets",
-    "WindField": "treeanim.physics.wind",
-    "fbm_noise": "treeanim.physics.wind",
-    "Simulation": "treeanim.physics.simulation",
+    "Tree": "model.tree",
+    "Lamina": "model.tree",
+    "PresetError": "model.errors",
+    "list_presets": "model.presets",
+    "load_preset": "model.presets",
+    "load_tree": "model.presets",
+    "WindField": "physics.wind",
+    "fbm_noise": "physics.wind",
+    "Simulation": "physics.simulation",
 }
 
 __all__ = sorted(_EXPORTS)
 
-
-def __getattr__(name):
-    if name in _EXPORTS:
-        value = getattr(import_module(_EXPORTS[name]), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'treeanim' has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(list(globals()) + __all__)
+__getattr__, __dir__ = lazy_exports(__name__, globals(), _EXPORTS)

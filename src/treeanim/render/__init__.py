@@ -5,7 +5,7 @@ Names are imported lazily (``from treeanim.render import Renderer``), so importi
 GL-free module (e.g. ``treeanim.render.mesh``) does not pull in the others.
 """
 
-from importlib import import_module
+from treeanim._lazy import lazy_exports
 
 _EXPORTS = {
     "TreeMesh": "mesh",
@@ -28,14 +28,4 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
-
-def __getattr__(name):
-    if name in _EXPORTS:
-        value = getattr(import_module(f"{__name__}.{_EXPORTS[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__():
-    return sorted(list(globals()) + __all__)
+__getattr__, __dir__ = lazy_exports(__name__, globals(), _EXPORTS)
