@@ -15,6 +15,10 @@ For each preset it runs ``--warmup`` steps, then times ``--steps`` steps of 1/60
 Each is reported as the median wall time, its 90th percentile, and the median CPU time of the
 thread (``cpu``), which a busy shared machine disturbs much less than the wall clock.
 
+Each preset is timed twice: with the paper's model (``load_path=False``, each object on its
+own) and with the load path (the default, DESIGN §12), whose ratio to the paper's step is the
+last column (issue #10: at most 1.3).
+
 Targets (issue #4): large_cherry <= 3 ms, grassland <= 2 ms, small_cherry <= 1 ms per step.
 Where a preset cannot be loaded (presets not installed) a synthetic tree of the same size is
 timed instead, and the row says so.
@@ -86,11 +90,11 @@ def load(name: str):
         return synthetic(name), True
 
 
-def bench(tree, steps: int, warmup: int, speed: float, dt: float) -> dict:
+def bench(tree, steps: int, warmup: int, speed: float, dt: float, load_path: bool = True) -> dict:
     from treeanim.physics.simulation import Simulation
     from treeanim.physics.wind import WindField
 
-    sim = Simulation(tree, wind=WindField(speed=speed, seed=1))
+    sim = Simulation(tree, wind=WindField(speed=speed, seed=1), load_path=load_path)
     for _ in range(warmup):
         sim.step(dt)
     clock = time.perf_counter
@@ -129,16 +133,21 @@ def main(argv=None) -> None:
     print(f"# {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
           f"numpy {np.__version__}, one thread, wind {args.speed} m/s, dt {args.dt:.4g} s, "
           f"{args.steps} steps")
-    print(f"{'preset':<24}{'objects':>8}{'nodes':>8}{'step ms':>10}{'p90':>7}{'cpu':>7}"
-          f"{'step+pose ms':>14}{'p90':>7}{'cpu':>7}{'target':>8}")
+    print(f"{'preset':<32}{'objects':>8}{'nodes':>8}{'step ms':>10}{'p90':>7}{'cpu':>7}"
+          f"{'step+pose ms':>14}{'p90':>7}{'cpu':>7}{'target':>8}{'×paper':>8}")
     for name in args.presets:
         tree, synth = load(name)
-        r = bench(tree, args.steps, args.warmup, args.speed, args.dt)
-        label = name + (" (synthetic)" if synth else "")
-        target = TARGETS_MS.get(name)
-        print(f"{label:<24}{tree.n_objects:>8}{tree.n_nodes:>8}{r['step']:>10.2f}{r['step_p90']:>7.2f}"
-              f"{r['step_cpu']:>7.2f}{r['pose']:>14.2f}{r['pose_p90']:>7.2f}{r['pose_cpu']:>7.2f}"
-              f"{(f'{target:.1f}' if target else '-'):>8}" + ("" if r["finite"] else "  NON-FINITE!"))
+        paper_cpu = None
+        for model in ("paper", "load path"):
+            r = bench(tree, args.steps, args.warmup, args.speed, args.dt, load_path=model == "load path")
+            label = f"{name}{' (synthetic)' if synth else ''}, {model}"
+            target = TARGETS_MS.get(name)
+            ratio = "" if paper_cpu is None else f"{r['step_cpu'] / paper_cpu:.2f}"
+            paper_cpu = r["step_cpu"]
+            print(f"{label:<32}{tree.n_objects:>8}{tree.n_nodes:>8}{r['step']:>10.2f}{r['step_p90']:>7.2f}"
+                  f"{r['step_cpu']:>7.2f}{r['pose']:>14.2f}{r['pose_p90']:>7.2f}{r['pose_cpu']:>7.2f}"
+                  f"{(f'{target:.1f}' if target else '-'):>8}{ratio:>8}" + ("" if r["finite"] else "  NON-FINITE!"),
+                  flush=True)
 
 
 if __name__ == "__main__":

@@ -354,8 +354,8 @@ class BendingPlan:
         """
         return [ei_max * np.maximum(d / self.d_max, 0.0) ** exponent for d in self.taper]
 
-    def bend(self, Fu: np.ndarray, Fw: np.ndarray, gamma: np.ndarray, k: list[np.ndarray],
-             predict: float = 0.0) -> None:
+    def bend(self, Fu: np.ndarray | None, Fw: np.ndarray | None, gamma: np.ndarray, k: list[np.ndarray],
+             predict: float = 0.0, blocks: list[tuple] | None = None) -> None:
         """Bend every object in its local rest frame; update ``q``, ``o`` and ``phi``.
 
         In the local frame (u, v, w) the force of Eq. 6 is (L′_w, 0, L′_u), the twist is a
@@ -363,8 +363,9 @@ class BendingPlan:
 
         Parameters
         ----------
-        Fu, Fw : (M,) float
-            u and w components of the force on each object (L′_w and L′_u), in ``order``.
+        Fu, Fw : (M,) float or None
+            u and w components of the force on each object (L′_w and L′_u), in ``order``;
+            segment i feels F·(n − i)/n at the lever |sᵢ| (Eq. 7). None with ``blocks``.
         gamma : (M,) float
             Twist per segment about v (Eq. 11), in ``order``; applied as Rot(v, −γ).
         k : list of (K_i,) float
@@ -373,6 +374,10 @@ class BendingPlan:
             The solver starts from ρ·θ₀ with ρ = φ/θ₀ extrapolated as ρ + predict·(ρ −
             ρ_previous): 0 restarts from the last fractions, dt/dt_prev extrapolates linearly
             in time (a better start, fewer iterations).
+        blocks : list of (fu, fv, fw, a), optional
+            Instead of Eq. 7's fractions of one force: per block i, the force on each
+            segment (local components, (K_i,) each) and a = |Fᵢ|·ℓᵢ, the moment it exerts at
+            its lever ℓᵢ (Eq. 8's |Fᵢ||sᵢ|). Used by the load path.
         """
         # Start of the angle solve: the bend as a fraction ρ = φ/θ₀ of the angle to the force
         # (nearly constant from step to step even where θ₀ moves), extrapolated linearly.
@@ -393,19 +398,29 @@ class BendingPlan:
         sv = th
         sv *= cv
         np.negative(sv, out=sv)
-        Fmag = np.hypot(Fu, Fw)  # |F| per object
+        if blocks is None:
+            Fmag = np.hypot(Fu, Fw)  # |F| per object
+            fmax = Fmag.max(initial=0.0)
+        else:
+            fmax = np.sqrt(3.0) * max((max(c.max(initial=0.0), -c.min(initial=0.0)) for bl in blocks for c in bl[:3]),
+                                      default=0.0)
         # |N| <= |F||s|: below the bound the plain sum of squares cannot overflow.
-        safe = not (Fmag.max(initial=0.0) * self.max_seg > _SQUARE_SAFE)
+        safe = not (fmax * self.max_seg > _SQUARE_SAFE)
         prev = None
         prev_o = None
         for i, K in enumerate(self.counts):
             a, b = self.offsets[i], self.offsets[i + 1]
             s = self.seg[i]
-            fu = mul(Fu[:K], self.frac[i], out=ws.get("fu", (K,)))  # Eq. 7
-            fw = mul(Fw[:K], self.frac[i], out=ws.get("fw", (K,)))
+            if blocks is None:
+                fu = mul(Fu[:K], self.frac[i], out=ws.get("fu", (K,)))  # Eq. 7
+                fw = mul(Fw[:K], self.frac[i], out=ws.get("fw", (K,)))
+                fv = None
+                amag = mul(Fmag[:K], self.frac_len[i], out=ws.get("amag", (K,)))  # a = |Fᵢ||sᵢ|
+            else:
+                fu, fv, fw, amag = blocks[i]
             tmp = ws.get("tmp", (K,))
             if i == 0:
-                # s′ = Rot(v, −γ) s₀ = s₀ = (0, l, 0):  N = s′ × F = (l·F_w, 0, −l·F_u), s′·F = 0
+                # s′ = Rot(v, −γ) s₀ = s₀ = (0, l, 0):  N = s′ × F = (l·F_w, 0, −l·F_u), s′·F = l·F_v
                 sp = s
                 l = s[1]
                 n0 = mul(l, fw)
@@ -418,8 +433,12 @@ class BendingPlan:
                     np.sqrt(nn, out=nn)
                 else:
                     nn = np.hypot(n0, n2)
-                dot = np.zeros(K)
-                theta0 = np.full(K, 0.5 * np.pi)
+                if fv is None:
+                    dot = np.zeros(K)
+                    theta0 = np.full(K, 0.5 * np.pi)
+                else:
+                    dot = mul(l, fv)
+                    theta0 = np.arctan2(nn, dot)
             else:
                 # T = Rot(v, −γ) ⊗ C_{i−1}:  cv·C + sv·(−C_y, C_z, C_w, −C_x)
                 C = prev[:, :K]
@@ -435,6 +454,9 @@ class BendingPlan:
                 n1 -= mul(sx, fw, out=tmp)
                 n2 = mul(sy, fu)
                 np.negative(n2, out=n2)
+                if fv is not None:
+                    n0 -= mul(sz, fv, out=tmp)
+                    n2 += mul(sx, fv, out=tmp)
                 if safe:
                     nn = mul(n0, n0)
                     nn += mul(n1, n1, out=tmp)
@@ -444,13 +466,13 @@ class BendingPlan:
                     nn = np.hypot(np.hypot(n0, n1), n2)
                 dot = mul(sx, fu)
                 dot += mul(sz, fw, out=tmp)
+                if fv is not None:
+                    dot += mul(sy, fv, out=tmp)
                 theta0 = np.arctan2(nn, dot)
-            amag = mul(Fmag[:K], self.frac_len[i], out=ws.get("amag", (K,)))  # a = |Fᵢ||sᵢ|
             phi, t = solve_bend_angle(nn, dot, k[i], theta0, mul(rho_start[a:b], theta0),
                                       a=amag)  # Eqs. 8–9
             # No bend where the force is zero or (anti)parallel to the segment.
-            amag *= 1e-12
-            ok = nn > amag
+            ok = nn > mul(amag, 1e-12, out=ws.get("eps", (K,)))
             phi *= ok
             t *= ok
             inv = np.maximum(nn, 1e-300)  # 1/|N|; where no bend, t = 0 zeroes its uses
@@ -495,10 +517,13 @@ class BendingPlan:
             mul(sp, c_phi, out=oo)
             oo[0] += mul(fu, s_phi, out=tmp)
             oo[2] += mul(fw, s_phi, out=tmp)
-            if i > 0:
+            if fv is not None:
+                oo[1] += mul(fv, s_phi, out=tmp)
+            if i > 0 or fv is not None:
                 s_phi /= self.seg_len2[i]
                 s_phi *= dot
                 oo -= mul(sp, s_phi, out=ws.get("v3", (3, K)))
+            if i > 0:
                 oo += prev_o[:, :K]  # accumulate along the object
             prev = dst
             prev_o = oo

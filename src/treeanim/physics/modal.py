@@ -107,12 +107,14 @@ def mean_diameters(tree: Tree) -> np.ndarray:
     return np.add.reduceat(tree.node_diameter, tree.object_start) / tree.object_count
 
 
-def descendant_counts(tree: Tree) -> tuple[np.ndarray, np.ndarray]:
+def descendant_counts(tree: Tree, present: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Descendant sub-branches and descendant leaves of every object (all generations).
 
     Parameters
     ----------
     tree : Tree
+    present : (M,) bool, optional
+        Count only these leaves (those still on the tree at a season); default all.
 
     Returns
     -------
@@ -124,6 +126,8 @@ def descendant_counts(tree: Tree) -> tuple[np.ndarray, np.ndarray]:
     nl = np.zeros(M, np.int64)
     is_b = (tree.kind == "branch").astype(np.int64)
     is_l = (tree.kind == "leaf").astype(np.int64)
+    if present is not None:
+        is_l *= np.asarray(present, bool)
     # Children come after parents and levels are sorted: accumulate deepest level first.
     for sl in reversed(tree.level_slices()):
         idx = np.arange(sl.start, sl.stop)
@@ -144,7 +148,8 @@ def _map_linear(x: np.ndarray, lo: float, hi: float, uniform: np.ndarray) -> np.
     return lo + (x - xmin) * ((hi - lo) / span)
 
 
-def derive_modes(tree: Tree, params: PhysicsParams, season: float, draws: ModalDraws) -> ModalParameters:
+def derive_modes(tree: Tree, params: PhysicsParams, season: float, draws: ModalDraws,
+                 present: np.ndarray | None = None) -> ModalParameters:
     """Modal parameters of every object at ``season`` (Eqs. 20–22).
 
     Parameters
@@ -157,6 +162,9 @@ def derive_modes(tree: Tree, params: PhysicsParams, season: float, draws: ModalD
         0 (summer) .. 1 (winter); interpolates the ranges.
     draws : ModalDraws
         The seeded random numbers.
+    present : (M,) bool, optional
+        Eq. 21 counts only these leaves (the ones still on the tree); default all, as the
+        paper's model does.
 
     Returns
     -------
@@ -170,7 +178,7 @@ def derive_modes(tree: Tree, params: PhysicsParams, season: float, draws: ModalD
     """
     M = tree.n_objects
     fprime = mean_diameters(tree) / object_lengths(tree) ** 2  # Eq. 20
-    nb, nl = descendant_counts(tree)
+    nb, nl = descendant_counts(tree, present)
     r = nb + nl / 6.0  # Eq. 21
     f = np.empty(M)
     zeta = np.empty(M)

@@ -9,12 +9,14 @@ from collections.abc import Iterable
 
 import numpy as np
 
-from ..model.geometry import lamina_frames, object_lengths, polygon_centroid, segment_lengths
+from ..model.geometry import arc_length, lamina_frames, object_lengths, polygon_centroid, segment_lengths
 from ..model.params import PhysicsParams
 from ..model.tree import KINDS, Tree
+from .aero import Drag
 from .bending import BendingPlan, matrix_to_quat, rest_frames
 from .checks import finite_float, finite_vector3
 from .hierarchy import CompositionPlan
+from .loadpath import LoadPath
 from .modal import ModalDraws, ModalParameters, derive_modes, mean_diameters
 from .oscillator import euler_step, exact_coefficients, exact_step
 from .rotation import Workspace, qrot
@@ -42,13 +44,15 @@ def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
     """Raise ValueError naming the field if ``p`` cannot drive a simulation of these kinds."""
     if not isinstance(p, PhysicsParams):
         raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
-    positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness")
+    positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness", "youngs_modulus",
+                "leaf_youngs_modulus", "air_density", "reconfiguration_speed")
     for name in positive:
         x = finite_float(f"physics.{name}", getattr(p, name))
         if x <= 0:
             raise ValueError(f"physics.{name} must be > 0, got {x!r}")
     for name in ("stiffness_exponent", "twist_c0", "leaf_twist_c0", "leaf_zeta_w_scale",
-                 "leaf_zeta_v_scale", "wind_gain_branch", "wind_gain_leaf", "wind_gain_blade"):
+                 "leaf_zeta_v_scale", "wind_gain_branch", "wind_gain_leaf", "wind_gain_blade",
+                 "drag_branch", "drag_leaf", "drag_blade", "reconfiguration"):
         x = finite_float(f"physics.{name}", getattr(p, name))
         if x < 0:
             raise ValueError(f"physics.{name} must be >= 0, got {x!r}")
@@ -88,6 +92,13 @@ class Simulation:
     coupling : bool
         Base excitation: every object also feels −(acceleration of its base node) × its mass,
         so a swinging trunk shakes its twigs. False restores the paper's independent objects.
+    load_path : bool
+        True (default): the tree is one structure (DESIGN §12, :mod:`~treeanim.physics.loadpath`):
+        every object carries its children's loads down to the trunk, drag is quadratic in the
+        air-relative wind with foliage reconfiguration (:mod:`~treeanim.physics.aero`), joints
+        are as stiff as a tapered cantilever of the preset's Young's modulus, and pulls build
+        up critically damped. False: the paper's model exactly (each object feels only the
+        linear load on its own area), as the notes below describe.
 
     Attributes
     ----------
@@ -143,7 +154,7 @@ class Simulation:
     """
 
     def __init__(self, tree: Tree, wind=None, season: float = 0.0, seed: int = 0,
-                 integrator: str = "exact", coupling: bool = True):
+                 integrator: str = "exact", coupling: bool = True, load_path: bool = True):
         if not isinstance(tree, Tree):
             raise ValueError(f"tree must be a treeanim Tree, got {type(tree).__name__}")
         if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
@@ -152,6 +163,7 @@ class Simulation:
         self._seed = int(seed)
         self._integrator = self._check_integrator(integrator)
         self._coupling = bool(coupling)
+        self._load_path = bool(load_path)
         season = self._check_season(season)
         kinds = [k for k in KINDS if np.any(tree.kind == k)]
         self._kinds = kinds
@@ -164,10 +176,10 @@ class Simulation:
 
         self._physics = tree.physics
         self._season = season
-        self._derive_physics()
-        self._derive_modes()
         self._present = tree.leaves_present(season)
         self._present.setflags(write=False)
+        self._derive_physics()
+        self._derive_modes()
 
         self._pulls: dict[int, np.ndarray] = {}
         self._pos_buf = self._rot_buf = None
@@ -198,6 +210,7 @@ class Simulation:
         p0pn = X[tip] - X[start]
         r = np.einsum("ij,ij->i", u, p0pn)  # Eq. 3: r = u · P0Pn
         lam_area = np.zeros(M)
+        load_point = X[tip].copy()  # where each object's own load acts (load path)
         if tree.lamina is not None and np.any(leaf):
             leaves = np.flatnonzero(leaf)
             unit_area = float(tree.lamina.area)
@@ -208,6 +221,7 @@ class Simulation:
             tipn, lu, lv, _ = lamina_frames(tree, leaves)
             centroid = X[tipn] + L * (cx * lu + cy * lv)
             r[leaves] = np.linalg.norm(centroid - X[start[leaves]], axis=1)
+            load_point[leaves] = centroid
         self._lever = r
         self._area = length * dmean + lam_area
         # Volumes: tapered segments (frusta ≈ cylinders of the mean diameter).
@@ -233,6 +247,20 @@ class Simulation:
         o = self._bplan.order
         self._neg_half_pi_over_n_ord = -0.5 * np.pi / self._nseg[o]
         self._rest_bounds = (X.min(axis=0), X.max(axis=0))
+        # The load path (DESIGN §12): its plan, the drag, and each object's true middle (half
+        # its arc length, on segment j at fraction t) where it samples the wind.
+        self._lp = LoadPath(tree, frames, self._bplan, load_point)
+        self._drag = Drag(kind, np.where(leaf, lam_area, length * dmean))
+        arc = arc_length(tree)
+        half = 0.5 * length
+        below = np.add.reduceat((arc <= np.repeat(half, count)).astype(np.int64), start)
+        j = np.clip(below - 1, 0, count - 2)
+        t = np.clip((half - arc[start + j]) / np.maximum(seg[start + j], 1e-300), 0.0, 1.0)
+        self._mid_a = self._bplan.ofs_of_node[start + j]
+        self._mid_b = self._bplan.ofs_of_node[start + j + 1]
+        self._mid_t = t
+        self._leaves = np.flatnonzero(leaf)
+        self._leaf_tip_flat = self._bplan.flat_of_node[tip[leaf]]
 
     def _derive_physics(self) -> None:
         """Stiffness, gains, masses and twist constants from ``self._physics``."""
@@ -253,9 +281,22 @@ class Simulation:
         k_root[self._bplan.order] = self._k[0]
         self._c0k = c0 / np.maximum(k_root, 1e-300)
         self._c0k_ord = self._c0k[self._bplan.order]
+        if self._load_path:
+            self._derive_load_path()
+
+    def _derive_load_path(self) -> None:
+        """The load path's drag, stiffness and twist constants (physics and present leaves)."""
+        p = self._physics
+        self._drag.derive(p, self._present)
+        E = np.where(self._tree.kind == "branch", p.youngs_modulus, p.leaf_youngs_modulus)
+        self._lp.derive(E, p.stiffness_exponent, self._drag.half_rho_cda, self._drag.foliage)
+        # Eq. 11's saturating twist, with the torsional stiffness k_t of the object: the small
+        # twist is T/k_t, the largest a quarter turn (γ = π/2 (1 − exp(−(2/π) T/k_t))).
+        self._lp_c0k_ord = (2.0 / np.pi / self._lp.k_twist)[self._bplan.order]
 
     def _derive_modes(self) -> None:
-        m = derive_modes(self._tree, self._physics, self._season, self._draws)
+        present = self._present if self._load_path else None  # Eq. 21 with the leaves still on
+        m = derive_modes(self._tree, self._physics, self._season, self._draws, present)
         if hasattr(self, "_modes"):
             # Keep the user's references valid: overwrite in place when possible.
             cur = self._modes
@@ -323,6 +364,8 @@ class Simulation:
         f3, z3 = fa.T.copy(), za.T.copy()
         self._mode_snap = (f, z, fa.copy(), za.copy(), f3, z3)
         self._coef_cache.clear()
+        w = 2.0 * np.pi * f3
+        self._w2, self._two_zeta_w = w * w, 2.0 * z3 * w  # ω² and 2ζω of every mode
         return f3, z3
 
     # ------------------------------------------------------------------ properties
@@ -355,10 +398,12 @@ class Simulation:
     def season(self, value) -> None:
         s = self._check_season(value)
         self._season = s
-        self._derive_modes()
         present = self._tree.leaves_present(s)
         present.setflags(write=False)
         self._present = present
+        self._derive_modes()
+        if self._load_path:
+            self._derive_load_path()
 
     @property
     def present(self) -> np.ndarray:
@@ -590,21 +635,26 @@ class Simulation:
         # The rest pose as the composition computes it (equal to the rest positions up to
         # round-off), so that a tree at rest sees exactly zero base velocity.
         bp = self._bplan
-        self._cplan.compose_structural(bp.q, bp.o, Fw, self._P)
-        self._frame, self._base = self._cplan.object_frames(Fw, self._P)
-        self._sample_pos = self._base + qrot(self._frame, bp.o[:, self._sample_ofs])
+        self._frame, self._base, self._sample_pos = np.empty((4, M)), np.empty((3, M)), np.empty((3, M))
+        self._compose()
         U = len(self._att_nodes)
         self._att_x = self._P[:, self._att_nodes].copy()
         self._att_v = np.zeros((3, U))
         self._att_a = np.zeros((3, U + 1))  # column U: zero, for roots
         self._dt_prev = None
+        self._g_prev = np.zeros((3, M))  # the oscillators' last inputs (load path)
+        self._sample_prev = self._sample_pos.copy()
+        self._sample_vel = np.zeros((3, M))
         self._pulls.clear()
         self._pos_out = None
         self._rot_out = None
         self._fn = None
 
     def step(self, dt: float) -> None:
-        """Advance the simulation by ``dt`` seconds (DESIGN §6).
+        """Advance the simulation by ``dt`` seconds (DESIGN §6; §12 with the load path).
+
+        One step is a pipeline of stages: wind → aerodynamic loads → (load path and)
+        oscillators → bending → hierarchy.
 
         Parameters
         ----------
@@ -624,21 +674,48 @@ class Simulation:
         if not dt > 0:
             raise ValueError(f"dt must be > 0, got {dt!r}")
         f3, z3 = self._modes_arrays()
-        M = self._M
-        t = self._time
+        U = self._wind_at_samples(self._time)
+        if self._load_path:
+            self._step_load_path(U, f3, z3, dt)
+        else:
+            self._step_paper(U, f3, z3, dt)
+        self._dt_prev = dt
+        self._time += dt
+        self._pos_out = None
+        self._rot_out = None
+        self._fn = None
 
-        # 1–2. World force on each object: wind (Eq. 19 × area × gain), pulls, base excitation.
+    # ------------------------------------------------------------------ stages
+    def _wind_at_samples(self, t: float) -> np.ndarray | None:
+        """Stage 1: the wind (M, 3) at every object's sample point (previous pose), or None."""
+        if self._wind is None:
+            return None
+        pts = self._ws.get("pts", (self._M, 3))
+        pts[...] = self._sample_pos.T
+        U = np.asarray(self._wind.sample(pts, t), dtype=float)
+        if U.shape != (self._M, 3):
+            raise ValueError(f"wind.sample returned shape {U.shape}, expected {(self._M, 3)}")
+        if not np.isfinite(U).all():
+            raise ValueError("wind.sample returned non-finite velocities (NaN or inf)")
+        return U
+
+    def _oscillator_coefficients(self, f3: np.ndarray, z3: np.ndarray, dt: float) -> tuple:
+        """The exact integrator's coefficients for ``dt`` (cached while the modes are unchanged)."""
+        coef = self._coef_cache.get(dt)
+        if coef is None:
+            if len(self._coef_cache) > 8:
+                self._coef_cache.clear()
+            coef = self._coef_cache[dt] = exact_coefficients(f3, z3, dt)
+        return coef
+
+    def _step_paper(self, U, f3: np.ndarray, z3: np.ndarray, dt: float) -> None:
+        """The paper's step (DESIGN §6): linear loads on each object's own area, Eqs. 2–12."""
+        M = self._M
         ws = self._ws
         mul = np.multiply
+        # 2. World force on each object: wind (Eq. 19 × area × gain), pulls, base excitation.
         Fw = ws.get("Fw", (3, M))
-        if self._wind is not None:
-            pts = ws.get("pts", (M, 3))
-            pts[...] = self._sample_pos.T
-            U = np.asarray(self._wind.sample(pts, t), dtype=float)
-            if U.shape != (M, 3):
-                raise ValueError(f"wind.sample returned shape {U.shape}, expected {(M, 3)}")
-            if not np.isfinite(U).all():
-                raise ValueError("wind.sample returned non-finite velocities (NaN or inf)")
+        if U is not None:
             mul(U.T, self._gain_area, out=Fw)
         else:
             Fw.fill(0.0)
@@ -658,12 +735,7 @@ class Simulation:
         mul(self._lever, L[2], out=g[1])  # g_v = r·L_w
         g[2] = L[0]  # g_w = L_u
         if self._integrator == "exact":
-            coef = self._coef_cache.get(dt)
-            if coef is None:
-                if len(self._coef_cache) > 8:
-                    self._coef_cache.clear()
-                coef = self._coef_cache[dt] = exact_coefficients(f3, z3, dt)
-            exact_step(self._p, self._pd, g, coef)
+            exact_step(self._p, self._pd, g, self._oscillator_coefficients(f3, z3, dt))
         else:
             euler_step(self._p, self._pd, g, f3, z3, dt)
         if self._pulls:  # held objects sit at the static deflection of their load (§8)
@@ -673,30 +745,47 @@ class Simulation:
 
         # 4. Force in the local rest frame (Eq. 6): (L′_w, 0, L′_u); twist (Eq. 11).
         po = np.take(self._p, self._bplan.order, axis=1, out=ws.get("po", (3, M)))
-        lv = po[1]
+        gamma = self._twist(po[1], self._c0k_ord)
+        # 5. Bend every object in its local rest frame (Eqs. 7–10).
+        bp = self._bplan
+        bp.bend(po[2], po[0], gamma, self._k, predict=self._predict(dt))
+        self._compose()
+        self._paper_base_motion(dt)
+
+    def _twist(self, lv: np.ndarray, c0k: np.ndarray) -> np.ndarray:
+        """Eq. 11 per segment, in bending order: γ = 0.5π·sgn(L′_v)(1 − exp(−c0k·|L′_v|))/n."""
         gamma = np.abs(lv)
-        gamma *= self._c0k_ord
+        gamma *= c0k
         gamma *= -1.0
         np.expm1(gamma, out=gamma)
         gamma *= np.sign(lv)
         gamma *= self._neg_half_pi_over_n_ord
+        return gamma
 
-        # 5. Bend every object in its local rest frame (Eqs. 7–10).
-        bp = self._bplan
-        ratio = 0.0 if self._dt_prev is None else min(dt / self._dt_prev, 2.0)
-        bp.bend(po[2], po[0], gamma, self._k, predict=ratio)
+    def _predict(self, dt: float) -> float:
+        """The bending solver's extrapolation ratio dt/dt_prev (0 on the first step)."""
+        return 0.0 if self._dt_prev is None else min(dt / self._dt_prev, 2.0)
 
-        # 6. Compose the hierarchy (Eq. 12): structural nodes, then per-object frames.
+    def _compose(self) -> None:
+        """Stage 6: compose the hierarchy (Eq. 12), then the objects' frames and sample points."""
+        bp, ws, M = self._bplan, self._ws, self._M
         P = self._P
         self._cplan.compose_structural(bp.q, bp.o, self._Fw, P)  # Eq. 12
         self._cplan.object_frames(self._Fw, P, out=(self._frame, self._base))
-        so = np.take(bp.o, self._sample_ofs, axis=1, out=ws.get("so", (3, M)))
+        if self._load_path:  # the true middle: half the arc length along the bent object
+            so = np.take(bp.o, self._mid_b, axis=1, out=ws.get("so", (3, M)))
+            so -= np.take(bp.o, self._mid_a, axis=1, out=ws.get("so2", (3, M)))
+            so *= self._mid_t
+            so += np.take(bp.o, self._mid_a, axis=1, out=ws.get("so2", (3, M)))
+        else:
+            so = np.take(bp.o, self._sample_ofs, axis=1, out=ws.get("so", (3, M)))
         qrot(self._frame, so, out=self._sample_pos, ws=ws)
         self._sample_pos += self._base
 
-        # Base accelerations for the next step's excitation, low-passed (finite at any dt).
+    def _paper_base_motion(self, dt: float) -> None:
+        """Base accelerations for the next step's excitation, low-passed (finite at any dt)."""
         if len(self._att_nodes):
-            x = P[:, self._att_nodes]
+            x = self._P[:, self._att_nodes]
             vel = (x - self._att_x) / dt
             h = dt if self._dt_prev is None else 0.5 * (dt + self._dt_prev)
             a_raw = (vel - self._att_v) / h
@@ -705,11 +794,96 @@ class Simulation:
             acc += alpha * (a_raw - acc)
             self._att_x = x
             self._att_v = vel
-        self._dt_prev = dt
-        self._time = t + dt
-        self._pos_out = None
-        self._rot_out = None
-        self._fn = None
+
+    def _step_load_path(self, U, f3: np.ndarray, z3: np.ndarray, dt: float) -> None:
+        """The whole-tree step (DESIGN §12): aerodynamic loads → load path with the
+        oscillators (Eqs. 2–5) → bending (Eqs. 7–11 generalised) → hierarchy (Eq. 12)."""
+        F_own, c_air = self._aero_loads(U)
+        F_pull = self._pull_loads()
+        g_extra = self._base_excitation(f3, z3)
+        advance = self._level_advance(f3, z3, dt, c_air)
+        g = self._g_prev
+        dE, node = self._lp.inward(F_own, F_pull, g_extra, advance, g)
+        self._L = g.copy()
+        F_tip = F_pull
+        F_tip += dE
+        blocks = self._lp.segment_forces(F_own, F_tip, node)
+        bp = self._bplan
+        gamma = self._twist(self._p[1, bp.order], self._lp_c0k_ord)
+        bp.bend(None, None, gamma, self._lp.k_blocks, predict=self._predict(dt), blocks=blocks)
+        self._sample_prev[...] = self._sample_pos
+        self._compose()
+        self._sample_vel = (self._sample_pos - self._sample_prev) / dt
+
+    def _aero_loads(self, U) -> tuple[np.ndarray, np.ndarray]:
+        """Stage 2 (load path): drag of the air-relative wind, local, and the air's damping
+        coefficient on each object's mode (N·s/m)."""
+        rel = -self._sample_vel if U is None else U.T - self._sample_vel
+        lam_q = np.take(self._bplan.q, self._leaf_tip_flat, axis=1)
+        F, speed = self._drag.loads(rel, self._frame, lam_q)
+        lp = self._lp
+        c_air = lp.Q_wood + lp.Q_foliage * self._drag.reconfigured(speed, np.ones(self._M, bool))
+        c_air *= speed
+        return F, c_air
+
+    def _pull_loads(self) -> np.ndarray:
+        """(3, M) the pulls at the objects' load points, local (carried frames)."""
+        F = np.zeros((3, self._M))
+        if self._pulls:
+            held = np.fromiter(self._pulls, dtype=np.int64)
+            world = np.array([self._pulls[i] for i in held]).T
+            F[:, held] = qrot(self._frame[:, held], world, conj=True)
+        return F
+
+    def _base_excitation(self, f3: np.ndarray, z3: np.ndarray) -> np.ndarray:
+        """(3, M) oscillator inputs −m_eff·a of the moving bases (``coupling``), with the
+        effective mass m_eff = K/(2πf)² of each bending mode."""
+        g = np.zeros((3, self._M))
+        if not self._coupling:
+            return g
+        w2 = self._w2
+        acc = self._g_prev - self._p  # p̈ = ω²(g − p) − 2ζω ṗ (Eq. 2 in load units)
+        acc *= w2
+        acc -= self._two_zeta_w * self._pd
+        a_u, a_w = self._lp.base_acceleration(acc)
+        K = self._lp.K
+        np.multiply(-K / w2[0], a_w, out=g[0])  # mode u moves along w
+        np.multiply(-K / w2[2], a_u, out=g[2])
+        return g
+
+    def _level_advance(self, f3: np.ndarray, z3: np.ndarray, dt: float, c_air: np.ndarray):
+        """Stage 3 (load path): ``advance(sl, g)`` for :meth:`LoadPath.inward` — the
+        oscillators of a slice of objects over the step (Eqs. 2–5), the air's damping
+        (split off, implicit: ṗ /= 1 + ω²c·dt/K), held objects critically damped (§8)."""
+        exact = self._integrator == "exact"
+        coef = self._oscillator_coefficients(f3, z3, dt) if exact else None
+        K = self._lp.K
+        held = np.fromiter(self._pulls, dtype=np.int64) if self._pulls else None
+        p, pd = self._p, self._pd
+
+        def advance(sl: slice, g: np.ndarray) -> np.ndarray:
+            ps, pds = p[:, sl], pd[:, sl]
+            mine = None
+            if held is not None:
+                mine = held[(held >= sl.start) & (held < sl.stop)]
+                saved = (p[:, mine].copy(), pd[:, mine].copy())
+            if exact:
+                exact_step(ps, pds, g, tuple(c[:, sl] for c in coef))
+            else:
+                euler_step(ps, pds, g, f3[:, sl], z3[:, sl], dt)
+            damp = c_air[sl] * dt
+            damp /= K[sl]
+            for row in (0, 2):
+                pds[row] /= 1.0 + self._w2[row, sl] * damp
+            if mine is not None and len(mine):
+                zc = np.maximum(z3[:, mine], 1.0)
+                zc[1] = z3[1, mine]
+                pm, pdm = saved
+                exact_step(pm, pdm, g[:, mine - sl.start], exact_coefficients(f3[:, mine], zc, dt))
+                p[:, mine], pd[:, mine] = pm, pdm
+            return ps
+
+        return advance
 
 
 def _unshared_refs() -> int:

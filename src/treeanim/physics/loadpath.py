@@ -1,0 +1,417 @@
+"""The load path (DESIGN §12): every object carries the loads of everything that grows on it.
+
+In the paper each object feels only the wind on its own area (Eq. 19), so the crown's drag
+never reaches the trunk. Here:
+
+* an object's load is its own drag plus the force and moment each child transmits at its
+  attach node, accumulated from the outermost level inward (one vectorised pass per level);
+* each object's three oscillators (Eqs. 2–5) filter its **total** load: modes u and w the
+  equivalent force at the object's load point, E = (base moment) / lever, mode v the torsion
+  about v. A child transmits its elastic reaction — its static load plus the dynamic excess
+  of its oscillators, E′ − E, at its load point — so the trunk sways at its own f and ζ under
+  the crown's gusts, and a swinging limb shakes its parent;
+* a load at node j bends segments 0 … j−1 only (Eq. 7 generalised): joint i turns under the
+  moment of everything beyond it, solved by Eq. 8 for the equivalent force at the lever ℓᵢ
+  from the joint to the object's load point;
+* joint stiffness kᵢ = ℓᵢ² / ∫_seg ℓ(x)²/EI(x) dx with EI = E π D⁴/64 (Eq. 10's D⁴ with a
+  physical modulus), so a chain of hinges deflects at its load point as the continuous tapered
+  cantilever does, however many segments the object has;
+* base excitation: each object's base moves with its parent's modal acceleration (the
+  translation and rotation at the attach node, from the parent's oscillator state at the start
+  of the step — no finite differences, no lag), and the object feels −m_eff·a with the
+  effective mass m_eff = K/(2πf)² of its own mode (K its stiffness at the load point).
+
+Loads travel down the tree in rest-world coordinates — the frame in which every object's rest
+frame is constant — as forces and first moments about the origin (S = X × F), so a child's
+load reaches its parent by a plain sum; the oscillators' inputs and the bending take them in
+each object's own rest frame (u, v, w), called *local*. Levers are rest offsets, so the
+geometric non-linearity stays in Eq. 8, as in the paper.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .rotation import Workspace
+
+__all__ = ["LoadPath", "TWIST_RATIO"]
+
+#: EI/GJ of wood and of petioles and blades: they twist this many times more readily than a
+#: beam of equal bending and torsional stiffness (green wood's shear modulus is ~E/16; petioles
+#: have twist-to-bend ratios of 2–10, Vogel 1992).
+TWIST_RATIO = 8.0
+#: Simpson's rule on four sub-intervals: the points along a segment and their weights.
+_T = np.linspace(0.0, 1.0, 5)
+_W = np.array([1.0, 4.0, 2.0, 4.0, 1.0]) / 12.0
+
+
+def _cross(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """Cross products of (3, K) column stacks (``out`` must not alias ``a`` or ``b``)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape)) if out is None else out
+    np.multiply(a[1], b[2], out=out[0])
+    out[0] -= a[2] * b[1]
+    np.multiply(a[2], b[0], out=out[1])
+    out[1] -= a[0] * b[2]
+    np.multiply(a[0], b[1], out=out[2])
+    out[2] -= a[1] * b[0]
+    return out
+
+
+def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Column-wise dot products of (3, K) stacks."""
+    d = a[0] * b[0]
+    d += a[1] * b[1]
+    d += a[2] * b[2]
+    return d
+
+
+def _grouped(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(order sorting ``keys``, the unique keys, the start of each key's run in that order)."""
+    perm = np.argsort(keys, kind="stable")
+    uniq, starts = np.unique(keys[perm], return_index=True)
+    return perm, uniq, starts
+
+
+class LoadPath:
+    """Index arrays, levers and stiffnesses of the load path, and its per-step stages.
+
+    Parameters
+    ----------
+    tree : Tree
+    frames : (M, 3, 3) float
+        Rest frames, columns (u, v, w) (:func:`treeanim.physics.bending.rest_frames`).
+    bplan : BendingPlan
+        For the flat segment order of the bending pass.
+    load_point : (M, 3) float
+        Where each object's own load acts, world rest: the lamina's centroid for a leaf,
+        the tip for branches and blades.
+    """
+
+    def __init__(self, tree, frames: np.ndarray, bplan, load_point: np.ndarray):
+        X = np.asarray(tree.rest_positions, float)
+        start, count = np.asarray(tree.object_start), np.asarray(tree.object_count)
+        parent, attach = np.asarray(tree.parent), np.asarray(tree.attach_node)
+        self.M, self.N = M, N = len(start), len(X)
+        R0 = np.asarray(frames, float)
+        self.axes = np.ascontiguousarray(R0.transpose(2, 1, 0))  # axes[c] = (3, M) rest u, v, w
+        Xb = X[start]
+
+        def local(obj, pts):  # world rest points → local offsets from the object's base
+            return np.einsum("kji,kj->ik", R0[obj], pts - Xb[obj])
+
+        self.Xb = np.ascontiguousarray(Xb.T)
+        self.Xl = np.ascontiguousarray(np.asarray(load_point, float).T)
+        self.x_load = local(np.arange(M), self.Xl.T)
+        # Flat segments in the bending pass's order (block i: segment i of bplan.order[:K_i]).
+        S = bplan.n_flat
+        seg_obj = np.concatenate([bplan.order[:K] for K in bplan.counts]) if S else np.zeros(0, int)
+        seg_i = np.concatenate([np.full(K, i) for i, K in enumerate(bplan.counts)]) if S else np.zeros(0, int)
+        node = start[seg_obj] + seg_i
+        self.seg_obj, self.seg_node = seg_obj, node
+        self.order = bplan.order
+        self.blocks = list(zip(bplan.offsets[:-1], bplan.offsets[1:]))
+        xj = local(seg_obj, X[node])
+        s = local(seg_obj, X[node + 1]) - xj
+        self.h = np.linalg.norm(s, axis=0)
+        s_hat = s / np.maximum(self.h, 1e-300)
+        self.seg_vec = s
+        self.lever_vec = self.x_load[:, seg_obj] - xj  # joint → load point
+        self.lever = np.maximum(np.linalg.norm(self.lever_vec, axis=0), 1e-12)
+        self.lever0 = np.maximum(np.linalg.norm(self.x_load, axis=0), 1e-12)
+
+        # Own load beyond joint i: a fraction W of it, with first moment A × F about the joint.
+        # Branches and blades spread it over their segments by frontal area; a leaf's acts on
+        # its lamina, beyond every joint of the petiole.
+        diam = np.asarray(tree.node_diameter, float)
+        self.d0, self.d1 = diam[node], diam[node + 1]
+        area = 0.5 * (self.d0 + self.d1) * self.h
+        w = area / np.maximum(np.bincount(seg_obj, area, M)[seg_obj], 1e-300)
+        W = self._suffix(w[None], node, start, count)[0]
+        A = self._suffix(w * (xj + 0.5 * s), node, start, count) - W * xj
+        leafseg = tree.kind[seg_obj] == "leaf"
+        W[leafseg] = 1.0
+        A[:, leafseg] = self.lever_vec[:, leafseg]
+        A0 = np.empty((3, M))
+        A0[:, bplan.order] = A[:, :M]  # block 0 holds segment 0 of every object
+        self.Xo = self.Xb + self._to_world(A0)  # where the own load's moment acts
+        # The equivalent force of Eq. 8 at the lever ℓ for the own load Fo (share W, first
+        # moment A × Fo) and the load-point load Ft (lever vector B):
+        # (F·ŝ)ŝ + (M × ŝ)/ℓ = Fo·α + (Fo·ŝ)·dA + Ft·β + (Ft·ŝ)·dB.
+        lev = self.lever
+        self.s_hat = s_hat
+        self.alpha = _dot(A, s_hat) / lev
+        self.dA = W * s_hat - A / lev
+        self.beta = _dot(self.lever_vec, s_hat) / lev
+        self.dB = s_hat - self.lever_vec / lev
+
+        # Children and the nodes they sit on.
+        nonroot = np.flatnonzero(parent >= 0)
+        self.nonroot, self.par = nonroot, parent[nonroot]
+        self.attach_idx = attach[nonroot] - start[self.par]
+        self.Xatt = np.ascontiguousarray(X[attach[nonroot]].T)
+        att_nodes, slot = np.unique(attach[nonroot], return_inverse=True)
+        self.att_nodes = att_nodes
+        has_kids = np.zeros(M, bool)
+        has_kids[self.par] = True
+        owner = np.searchsorted(start, att_nodes, side="right") - 1  # the object of each slot
+        self.slot = slot  # each non-root object's attach slot
+        self.levels = []
+        for sl in tree.level_slices():
+            lo, hi = np.searchsorted(nonroot, [sl.start, sl.stop])
+            if hi - lo not in (0, sl.stop - sl.start):
+                raise ValueError("a hierarchy level mixes roots and children")  # never built so
+            perm, uniq, starts = _grouped(slot[lo:hi])
+            if np.array_equal(perm, np.arange(hi - lo)):
+                perm = None  # already grouped by attach node: no gather
+            own = np.flatnonzero((owner >= sl.start) & (owner < sl.stop))  # slots of this level
+            kobj, kstart = np.unique(owner[own], return_index=True)
+            self.levels.append((sl, hi > lo, perm, uniq, starts, kobj, own, kstart))
+        self.slot_owner = owner
+        self.Xslot = np.ascontiguousarray(X[att_nodes].T)
+        self.r_load = self.Xl - self.Xb
+        # Segments of objects with children: what the children put beyond each joint, as
+        # suffix sums over the object's attach slots.
+        self.k_flat = np.flatnonzero(has_kids[seg_obj])
+        ko = seg_obj[self.k_flat]
+        first = np.searchsorted(owner, ko)  # first slot of the object
+        last = np.searchsorted(owner, ko, side="right")
+        self.k_hi = np.maximum(np.searchsorted(att_nodes, node[self.k_flat], side="right"), first)
+        self.k_end = last
+        self.Xj_k = np.ascontiguousarray(X[node[self.k_flat]].T)
+        self.axes_k = self.axes[:, :, ko]
+        self.start, self.count = start, count
+        self.diam_max = float(diam.max()) if N else 1.0
+        self.kind = tree.kind
+        self.ws = Workspace()
+
+    def _to_world(self, x: np.ndarray, objs=slice(None)) -> np.ndarray:
+        """Local (3, K) vectors of objects ``objs`` in rest-world coordinates."""
+        u, v, w = self.axes[0][:, objs], self.axes[1][:, objs], self.axes[2][:, objs]
+        return u * x[0] + v * x[1] + w * x[2]
+
+    @staticmethod
+    def _suffix(v: np.ndarray, node: np.ndarray, start: np.ndarray, count: np.ndarray) -> np.ndarray:
+        """Per segment, the sum of ``v`` over it and the segments after it in its object.
+
+        ``v`` is (k, S) in flat order; ``node`` the segments' joint nodes."""
+        N = int(start[-1] + count[-1]) if len(start) else 0
+        by_node = np.zeros((v.shape[0], N + 1))
+        by_node[:, node] = v
+        rc = np.cumsum(by_node[:, ::-1], axis=1)[:, ::-1]  # rc[:, a] = Σ_{b >= a}
+        tip_next = np.repeat(start + count, count)[node]  # first node after the object
+        return rc[:, node] - rc[:, np.minimum(tip_next, N)]
+
+    # ------------------------------------------------------------------ stiffness
+    def derive(self, E: np.ndarray, exponent: float, air: np.ndarray, foliage: np.ndarray) -> None:
+        """Stiffnesses, shapes and the air's damping participation from the material.
+
+        Parameters
+        ----------
+        E : (M,) float
+            Young's modulus of each object (Pa).
+        exponent : float
+            m of Eq. 10: EI = E π D_max⁴/64 · (D/D_max)^m (4: a solid round section).
+        air : (M,) float
+            ½ρ C A of every object (N·s²/m², zero where absent).
+        foliage : (M,) bool
+            Whose drag reconfigures (leaves, blades).
+        """
+        so = self.seg_obj
+        Es = E[so]
+        ei0 = np.pi / 64.0 * self.diam_max**4
+
+        def EI(t):
+            d = self.d0 + t * (self.d1 - self.d0)
+            return Es * ei0 * np.maximum(d / self.diam_max, 1e-12) ** exponent
+
+        integral = np.zeros_like(self.h)
+        for t, wt in zip(_T, _W):  # ∫_seg ℓ(x)² / EI(x) dx, Simpson
+            r = self.lever_vec - t * self.seg_vec
+            integral += wt * np.einsum("ij,ij->j", r, r) / EI(t)
+        integral *= self.h
+        self.k = self.lever**2 / np.maximum(integral, 1e-300)
+        self.k_blocks = [self.k[a:b] for a, b in self.blocks]
+        compliance = np.bincount(so, integral, self.M)  # load-point deflection per newton
+        self.K = 1.0 / np.maximum(compliance, 1e-300)
+        self.k_twist = 1.0 / np.maximum(np.bincount(so, self.h * TWIST_RATIO / EI(0.5), self.M), 1e-300)
+        # Where a child's base sits on its parent's deflection: translation ψ and rotation χ per
+        # unit deflection of the parent's load point (φᵢ = ℓᵢ/kᵢ per newton there).
+        phi = self.lever / self.k
+        N = self.N
+        c1 = np.zeros(N + 1)
+        c2 = np.zeros(N + 1)
+        arc = np.zeros(N + 1)
+        arc[self.seg_node + 1] = self.h
+        arc = np.cumsum(arc)  # arc length, with jumps between objects that cancel below
+        c1[self.seg_node + 1] = phi
+        c2[self.seg_node + 1] = phi * arc[self.seg_node]
+        c1, c2 = np.cumsum(c1), np.cumsum(c2)
+        a = self.att_nodes
+        s0 = self.start[self.slot_owner]
+        p1 = c1[a] - c1[s0]
+        p2 = c2[a] - c2[s0]
+        Kp = self.K[self.slot_owner]
+        self.psi = Kp * (arc[a] * p1 - p2)  # per attach slot
+        self.chi = Kp * p1
+        # The air's damping on each object's mode: its own ½ρCA (a leaf's at its load point,
+        # a branch's spread along it, ~1/4 participation) plus its children's subtrees at ψ².
+        own = air * np.where(self.kind == "leaf", 1.0, 0.25)
+        Qw, Qf = np.where(foliage, 0.0, own), np.where(foliage, own, 0.0)
+        sub_w, sub_f = np.where(foliage, 0.0, air), np.where(foliage, air, 0.0)
+        for sl, transmits, *_ in reversed(self.levels):
+            if not transmits:
+                continue
+            kids = np.arange(sl.start, sl.stop)
+            par = self.par[np.searchsorted(self.nonroot, kids)]
+            psi2 = self.psi[self.slot[np.searchsorted(self.nonroot, kids)]] ** 2
+            np.add.at(Qw, par, psi2 * sub_w[kids])
+            np.add.at(Qf, par, psi2 * sub_f[kids])
+            np.add.at(sub_w, par, sub_w[kids])
+            np.add.at(sub_f, par, sub_f[kids])
+        self.Q_wood, self.Q_foliage = Qw, Qf
+
+    # ------------------------------------------------------------------ per step
+    def base_acceleration(self, p_acc: np.ndarray) -> np.ndarray:
+        """(2, M) local (u, w) acceleration of each object's load point as its base moves.
+
+        Parameters
+        ----------
+        p_acc : (3, M) float
+            d²L′/dt² of every oscillator now (rows u, v, w), from its state at the start of
+            the step (no lag): the load point accelerates by (p̈_w, 0, p̈_u)/K, local (mode w
+            bends along u, mode u along w). A child's base follows its parent's attach node:
+            ψ times that translation, plus the rotation χ (v × δ̈) there, carried outward
+            level by level.
+        """
+        u, v, w = self.axes
+        M = self.M
+        a_base = np.zeros((3, M))
+        alpha = np.zeros((3, M))
+        for sl, transmits, perm, uniq, starts, kobj, own, kstart in self.levels:  # roots first
+            if transmits:  # bases at the slots computed for the level above
+                sk = self.slot[sl.start - self.nonroot[0]:sl.stop - self.nonroot[0]]
+                np.take(a_slot, sk, axis=1, out=a_base[:, sl])
+                np.take(w_slot, sk, axis=1, out=alpha[:, sl])
+            if len(own):  # this level's attach nodes: translation ψ δ̈ and rotation χ (v × δ̈)
+                o = self.slot_owner[own]
+                d2 = u[:, o] * (p_acc[2, o] / self.K[o])
+                d2 += w[:, o] * (p_acc[0, o] / self.K[o])
+                a_slot = np.zeros((3, len(self.att_nodes)))
+                w_slot = np.zeros((3, len(self.att_nodes)))
+                a_slot[:, own] = a_base[:, o] + _cross(alpha[:, o], self.Xslot[:, own] - self.Xb[:, o])
+                a_slot[:, own] += self.psi[own] * d2
+                w_slot[:, own] = alpha[:, o] + self.chi[own] * _cross(v[:, o], d2)
+        a = a_base + _cross(alpha, self.r_load)
+        return np.stack([_dot(u, a), _dot(w, a)])
+
+    def inward(self, F_own: np.ndarray, F_tip: np.ndarray, g_extra: np.ndarray, advance,
+               g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Accumulate the loads from the outermost level inward, advancing each level's
+        oscillators as soon as its total load is known (Eqs. 2–5 on the load path).
+
+        Parameters
+        ----------
+        F_own : (3, M) float
+            Each object's own load (drag), local.
+        F_tip : (3, M) float
+            Loads at the load points (pulls), local.
+        g_extra : (3, M) float
+            Added to the oscillators' inputs only (base excitation): not transmitted.
+        advance : callable
+            ``advance(sl, g)`` steps the oscillators of object slice ``sl`` under the (3, n)
+            input g (rows u, v, w) and returns their outputs L′ (3, n).
+        g : (3, M) float
+            Filled with the oscillators' inputs.
+
+        Returns
+        -------
+        dE : (3, M) float
+            The dynamic excess E′ − E of every object at its load point, local (v row zero).
+        slots : (6, A) float
+            What the children transmit at each attach node (``att_nodes``), rest-world:
+            force and first moment about the origin.
+        """
+        M = self.M
+        u, v, w = self.axes
+        F_sub = self._to_world(F_own)  # rest-world force and first moment S = X × F of subtrees
+        S_sub = _cross(self.Xo, F_sub)
+        held = np.flatnonzero(F_tip.any(axis=0))
+        if len(held):
+            Ft = self._to_world(F_tip[:, held], held)
+            F_sub[:, held] += Ft
+            S_sub[:, held] += _cross(self.Xl[:, held], Ft)
+        slots = np.zeros((6, len(self.att_nodes)))
+        dE = np.zeros((3, M))
+        for sl, transmits, perm, uniq, starts, kobj, own, kstart in reversed(self.levels):
+            if len(own):
+                sums = np.add.reduceat(slots[:, own], kstart, axis=1)
+                F_sub[:, kobj] += sums[:3]
+                S_sub[:, kobj] += sums[3:]
+            Fs, Ss = F_sub[:, sl], S_sub[:, sl]
+            M0 = Ss - _cross(self.Xb[:, sl], Fs)  # moment about the base
+            L0 = self.lever0[sl]
+            us, vs, ws_ = u[:, sl], v[:, sl], w[:, sl]
+            E_u = _dot(ws_, M0)  # M = ℓ v × E: M_u = ℓE_w, M_w = −ℓE_u
+            E_u /= -L0
+            E_w = _dot(us, M0)
+            E_w /= L0
+            T = _dot(vs, M0)
+            gl = g[:, sl]
+            np.add(E_w, g_extra[0, sl], out=gl[0])  # mode u bends along w
+            np.add(T, g_extra[1, sl], out=gl[1])
+            np.add(E_u, g_extra[2, sl], out=gl[2])  # mode w bends along u
+            out = advance(sl, gl)
+            d = dE[:, sl]
+            np.subtract(out[2], E_u, out=d[0])
+            np.subtract(out[0], E_w, out=d[2])
+            if transmits:  # to the parents: the static load plus the dynamic excess
+                dF = us * d[0]
+                dF += ws_ * d[2]
+                tr = np.empty((6, sl.stop - sl.start))
+                np.add(Fs, dF, out=tr[:3])
+                _cross(self.Xl[:, sl], dF, out=tr[3:])
+                tr[3:] += Ss
+                T -= out[1]
+                tr[3:] -= vs * T  # the torsion's excess
+                if perm is not None:
+                    tr = tr[:, perm]
+                slots[:, uniq] += np.add.reduceat(tr, starts, axis=1)
+        return dE, slots
+
+    def segment_forces(self, F_own: np.ndarray, F_tip: np.ndarray, slots: np.ndarray) -> list[tuple]:
+        """Per bending block, the equivalent force on each segment and its moment at the lever.
+
+        Joint i carries the moment Mᵢ of everything beyond it: its share of the object's own
+        load, the loads at the load point ``F_tip`` (pulls and the dynamic excess) and the
+        children at nodes after i. Eq. 8 then solves for the equivalent force
+        Fᵢ = (F·ŝ)ŝ + (Mᵢ × ŝ)/ℓᵢ at the lever ℓᵢ, whose moment at rest is Mᵢ.
+
+        Returns
+        -------
+        list of (fu, fv, fw, a)
+            For :meth:`BendingPlan.bend`'s ``blocks``.
+        """
+        ws = self.ws
+        S = len(self.seg_obj)
+        Fo = np.take(F_own, self.seg_obj, axis=1, out=ws.get("Fo", (3, S)))
+        Ft = np.take(F_tip, self.seg_obj, axis=1, out=ws.get("Ft", (3, S)))
+        sh = self.s_hat
+        Feq = np.multiply(Fo, self.alpha, out=ws.get("Feq", (3, S)))
+        tmp = ws.get("tmp", (3, S))
+        Feq += np.multiply(self.dA, _dot(Fo, sh), out=tmp)
+        Feq += np.multiply(Ft, self.beta, out=tmp)
+        Feq += np.multiply(self.dB, _dot(Ft, sh), out=tmp)
+        if len(self.k_flat):  # children beyond the joint, rest-world → local
+            rc = np.zeros((6, slots.shape[1] + 1))
+            rc[:, :-1] = np.cumsum(slots[:, ::-1], axis=1)[:, ::-1]
+            beyond = rc[:, self.k_hi] - rc[:, self.k_end]
+            F = beyond[:3]
+            Mi = beyond[3:] - _cross(self.Xj_k, F)
+            u, v, w = self.axes_k
+            Fl = np.stack([_dot(u, F), _dot(v, F), _dot(w, F)])
+            Ml = np.stack([_dot(u, Mi), _dot(v, Mi), _dot(w, Mi)])
+            shk = sh[:, self.k_flat]
+            Feq[:, self.k_flat] += _dot(Fl, shk) * shk + _cross(Ml, shk) / self.lever[self.k_flat]
+        a = np.sqrt(_dot(Feq, Feq))
+        a *= self.lever
+        return [(Feq[0, lo:hi], Feq[1, lo:hi], Feq[2, lo:hi], a[lo:hi]) for lo, hi in self.blocks]
