@@ -64,10 +64,11 @@ class PhysicsParams:
         Thickness of a leaf lamina (and of a grass blade) in metres, for its mass.
     leaf_twist_c0 : float
         ``twist_c0`` for leaves (their petioles twist more readily than wood).
-    youngs_modulus, leaf_youngs_modulus : float
-        Load path only (DESIGN §12): Young's modulus E (Pa) of the wood, and of petioles and
-        grass blades; a section of diameter D has EI = E π D⁴/64 (with ``stiffness_exponent``
-        m: EI = E π D_max⁴/64 · (D/D_max)^m).
+    leaf_youngs_modulus : float
+        Load path only (DESIGN §12): Young's modulus E (Pa) of petioles and grass blades; a
+        section of diameter D has EI = E π D⁴/64 (with ``stiffness_exponent`` m:
+        EI = E π D_max⁴/64 · (D/D_max)^m). Branches need no modulus: their stiffness follows
+        from their modal frequency and the mass they carry.
     air_density : float
         ρ of the air (kg/m³), for the drag ½ρ C A |U_rel| U_rel (load path).
     drag_branch, drag_leaf, drag_blade : float
@@ -102,15 +103,14 @@ class PhysicsParams:
     wind_gain_branch: float = 3.0
     wind_gain_leaf: float = 0.5
     wind_gain_blade: float = 3.0
-    wood_density: float = 700.0
+    wood_density: float = 900.0
     leaf_density: float = 500.0
     lamina_thickness: float = 3.0e-4
     leaf_twist_c0: float = 0.5
-    youngs_modulus: float = 6.0e9
     leaf_youngs_modulus: float = 1.0e9
     air_density: float = 1.2
-    drag_branch: float = 1.2
-    drag_leaf: float = 1.0
+    drag_branch: float = 0.4
+    drag_leaf: float = 0.2
     drag_blade: float = 1.0
     reconfiguration: float = 0.7
     reconfiguration_speed: float = 4.0

@@ -366,8 +366,10 @@ class BendingPlan:
         Fu, Fw : (M,) float or None
             u and w components of the force on each object (L′_w and L′_u), in ``order``;
             segment i feels F·(n − i)/n at the lever |sᵢ| (Eq. 7). None with ``blocks``.
-        gamma : (M,) float
-            Twist per segment about v (Eq. 11), in ``order``; applied as Rot(v, −γ).
+        gamma : (M,) or (n_flat,) float
+            Twist per segment about v (Eq. 11), in ``order``: one value per object (every
+            segment twists alike, the paper) or one per flat segment (the load path, where
+            each joint twists under its own torsion); applied as Rot(v, −γ).
         k : list of (K_i,) float
             Stiffness per block, from :meth:`stiffness`.
         predict : float
@@ -408,8 +410,10 @@ class BendingPlan:
         safe = not (fmax * self.max_seg > _SQUARE_SAFE)
         prev = None
         prev_o = None
+        per_segment = len(gamma) == self.n_flat
         for i, K in enumerate(self.counts):
             a, b = self.offsets[i], self.offsets[i + 1]
+            tw = slice(a, b) if per_segment else slice(0, K)
             s = self.seg[i]
             if blocks is None:
                 fu = mul(Fu[:K], self.frac[i], out=ws.get("fu", (K,)))  # Eq. 7
@@ -445,8 +449,8 @@ class BendingPlan:
                 T = ws.get("T", (4, K))
                 np.take(C, _SWAP, axis=0, out=T)
                 T *= _SWAP_SIGN
-                T *= sv[:K]
-                T += mul(C, cv[:K], out=ws.get("T2", (4, K)))
+                T *= sv[tw]
+                T += mul(C, cv[tw], out=ws.get("T2", (4, K)))
                 sp = qrot(T, s, out=ws.get("sp", (3, K)), ws=ws)
                 sx, sy, sz = sp
                 n0 = mul(sy, fw)
@@ -492,7 +496,7 @@ class BendingPlan:
             dst = self.q[:, a:b]
             if i == 0:
                 # C₀ = q_bend ⊗ Rot(v, −γ), with q_bend = (b0, b1, 0, b3), Rot = (cv, 0, sv, 0)
-                c_, s_ = cv[:K], sv[:K]
+                c_, s_ = cv[tw], sv[tw]
                 mul(b0, c_, out=dst[0])
                 mul(b1, c_, out=dst[1])
                 dst[1] -= mul(b3, s_, out=tmp)

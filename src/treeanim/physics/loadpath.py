@@ -139,6 +139,7 @@ class LoadPath:
         # (F·ŝ)ŝ + (M × ŝ)/ℓ = Fo·α + (Fo·ŝ)·dA + Ft·β + (Ft·ŝ)·dB.
         lev = self.lever
         self.s_hat = s_hat
+        self.A = A
         self.alpha = _dot(A, s_hat) / lev
         self.dA = W * s_hat - A / lev
         self.beta = _dot(self.lever_vec, s_hat) / lev
@@ -202,19 +203,25 @@ class LoadPath:
         return rc[:, node] - rc[:, np.minimum(tip_next, N)]
 
     # ------------------------------------------------------------------ stiffness
-    def derive(self, E: np.ndarray, exponent: float, air: np.ndarray, foliage: np.ndarray) -> None:
-        """Stiffnesses, shapes and the air's damping participation from the material.
+    def derive(self, E: np.ndarray, exponent: float, air: np.ndarray, foliage: np.ndarray,
+               mass: np.ndarray, modal: np.ndarray) -> None:
+        """Stiffness shapes, the modal masses and the air's damping participation.
 
         Parameters
         ----------
         E : (M,) float
-            Young's modulus of each object (Pa).
+            Young's modulus of each object (Pa); for the ``modal`` objects only its shape along
+            the object matters (:meth:`tune` scales their stiffness).
         exponent : float
             m of Eq. 10: EI = E π D_max⁴/64 · (D/D_max)^m (4: a solid round section).
         air : (M,) float
             ½ρ C A of every object (N·s²/m², zero where absent).
         foliage : (M,) bool
             Whose drag reconfigures (leaves, blades).
+        mass : (M,) float
+            Each object's own mass (kg, zero where absent).
+        modal : (M,) bool
+            Objects whose stiffness :meth:`tune` sets from their modal frequency and mass.
         """
         so = self.seg_obj
         Es = E[so]
@@ -229,14 +236,14 @@ class LoadPath:
             r = self.lever_vec - t * self.seg_vec
             integral += wt * np.einsum("ij,ij->j", r, r) / EI(t)
         integral *= self.h
-        self.k = self.lever**2 / np.maximum(integral, 1e-300)
-        self.k_blocks = [self.k[a:b] for a, b in self.blocks]
-        compliance = np.bincount(so, integral, self.M)  # load-point deflection per newton
-        self.K = 1.0 / np.maximum(compliance, 1e-300)
-        self.k_twist = 1.0 / np.maximum(np.bincount(so, self.h * TWIST_RATIO / EI(0.5), self.M), 1e-300)
+        self.k_E = self.lever**2 / np.maximum(integral, 1e-300)
+        self.K_E = 1.0 / np.maximum(np.bincount(so, integral, self.M), 1e-300)  # at the load point
+        # Each joint twists under the torsion it carries, by ∫dx/GJ over its segment (GJ = EI/TWIST_RATIO).
+        self.twist_compliance = self.h * TWIST_RATIO / EI(0.5)
+        self.modal = np.asarray(modal, bool)
         # Where a child's base sits on its parent's deflection: translation ψ and rotation χ per
         # unit deflection of the parent's load point (φᵢ = ℓᵢ/kᵢ per newton there).
-        phi = self.lever / self.k
+        phi = self.lever / self.k_E
         N = self.N
         c1 = np.zeros(N + 1)
         c2 = np.zeros(N + 1)
@@ -250,25 +257,51 @@ class LoadPath:
         s0 = self.start[self.slot_owner]
         p1 = c1[a] - c1[s0]
         p2 = c2[a] - c2[s0]
-        Kp = self.K[self.slot_owner]
+        Kp = self.K_E[self.slot_owner]
         self.psi = Kp * (arc[a] * p1 - p2)  # per attach slot
         self.chi = Kp * p1
-        # The air's damping on each object's mode: its own ½ρCA (a leaf's at its load point,
-        # a branch's spread along it, ~1/4 participation) plus its children's subtrees at ψ².
-        own = air * np.where(self.kind == "leaf", 1.0, 0.25)
+        # The air's damping and the mass on each object's mode: its own (a leaf's at its load
+        # point, a branch's spread along it, ~1/4 participation) plus its children's subtrees
+        # at ψ², the square of the share of the mode's deflection their bases move by.
+        share = np.where(self.kind == "leaf", 1.0, 0.25)
+        own = air * share
         Qw, Qf = np.where(foliage, 0.0, own), np.where(foliage, own, 0.0)
         sub_w, sub_f = np.where(foliage, 0.0, air), np.where(foliage, air, 0.0)
+        m_modal, sub_m = mass * share, np.array(mass, float)
         for sl, transmits, *_ in reversed(self.levels):
             if not transmits:
                 continue
             kids = np.arange(sl.start, sl.stop)
-            par = self.par[np.searchsorted(self.nonroot, kids)]
-            psi2 = self.psi[self.slot[np.searchsorted(self.nonroot, kids)]] ** 2
-            np.add.at(Qw, par, psi2 * sub_w[kids])
-            np.add.at(Qf, par, psi2 * sub_f[kids])
-            np.add.at(sub_w, par, sub_w[kids])
-            np.add.at(sub_f, par, sub_f[kids])
+            j = np.searchsorted(self.nonroot, kids)
+            par = self.par[j]
+            psi2 = self.psi[self.slot[j]] ** 2
+            for acc, sub in ((Qw, sub_w), (Qf, sub_f), (m_modal, sub_m)):
+                np.add.at(acc, par, psi2 * sub[kids])
+                np.add.at(sub, par, sub[kids])
         self.Q_wood, self.Q_foliage = Qw, Qf
+        self.m_modal = m_modal
+        self.tune(None)
+
+    def tune(self, w2: np.ndarray | None) -> None:
+        """Set the stiffness of the ``modal`` objects from their modes: K = m·ω², with m the
+        modal mass (own and carried) and ω² = ω_u·ω_w of the bending modes, so a branch's
+        static lean and its sway frequency agree (the Table 1 frequencies stay what they are).
+        Their twist keeps the modulus-based torsional stiffness: wood twists little.
+
+        Parameters
+        ----------
+        w2 : (3, M) float or None
+            (2πf)² of every mode (rows u, v, w); None keeps the modulus-based stiffness.
+        """
+        scale = np.ones(self.M)
+        if w2 is not None:
+            target = self.m_modal * np.sqrt(w2[0] * w2[2])
+            scale[self.modal] = target[self.modal] / self.K_E[self.modal]
+            scale = np.maximum(scale, 1e-300)
+        seg = scale[self.seg_obj]
+        self.k = self.k_E * seg
+        self.k_blocks = [self.k[a:b] for a, b in self.blocks]
+        self.K = self.K_E * scale
 
     # ------------------------------------------------------------------ per step
     def base_acceleration(self, p_acc: np.ndarray) -> np.ndarray:
@@ -326,7 +359,8 @@ class LoadPath:
         Returns
         -------
         dE : (3, M) float
-            The dynamic excess E′ − E of every object at its load point, local (v row zero).
+            The dynamic excess of every object: E′ − E at its load point (rows u, w, local)
+            and the torsion's, L′_v − T (row v, N·m).
         slots : (6, A) float
             What the children transmit at each attach node (``att_nodes``), rest-world:
             force and first moment about the origin.
@@ -364,6 +398,7 @@ class LoadPath:
             d = dE[:, sl]
             np.subtract(out[2], E_u, out=d[0])
             np.subtract(out[0], E_w, out=d[2])
+            np.subtract(out[1], T, out=d[1])
             if transmits:  # to the parents: the static load plus the dynamic excess
                 dF = us * d[0]
                 dF += ws_ * d[2]
@@ -371,25 +406,32 @@ class LoadPath:
                 np.add(Fs, dF, out=tr[:3])
                 _cross(self.Xl[:, sl], dF, out=tr[3:])
                 tr[3:] += Ss
-                T -= out[1]
-                tr[3:] -= vs * T  # the torsion's excess
+                tr[3:] += vs * d[1]  # the torsion's excess
                 if perm is not None:
                     tr = tr[:, perm]
                 slots[:, uniq] += np.add.reduceat(tr, starts, axis=1)
         return dE, slots
 
-    def segment_forces(self, F_own: np.ndarray, F_tip: np.ndarray, slots: np.ndarray) -> list[tuple]:
-        """Per bending block, the equivalent force on each segment and its moment at the lever.
+    def segment_forces(self, F_own: np.ndarray, F_tip: np.ndarray, dT: np.ndarray,
+                       slots: np.ndarray) -> tuple[list[tuple], np.ndarray]:
+        """Per bending block, the equivalent force on each segment and its moment at the lever;
+        per segment, the twist.
 
         Joint i carries the moment Mᵢ of everything beyond it: its share of the object's own
         load, the loads at the load point ``F_tip`` (pulls and the dynamic excess) and the
         children at nodes after i. Eq. 8 then solves for the equivalent force
-        Fᵢ = (F·ŝ)ŝ + (Mᵢ × ŝ)/ℓᵢ at the lever ℓᵢ, whose moment at rest is Mᵢ.
+        Fᵢ = (F·ŝ)ŝ + (Mᵢ × ŝ)/ℓᵢ at the lever ℓᵢ, whose moment at rest is Mᵢ. The torsion
+        Tᵢ = Mᵢ·ŝ (plus the object's dynamic excess ``dT``) twists segment i by Eq. 11's
+        saturating law with the segment's own torsional compliance cᵢ:
+        γᵢ = ½π·sgn Tᵢ·(1 − exp(−(2/π)·cᵢ|Tᵢ|)), so a small twist is cᵢTᵢ, the largest a
+        quarter turn.
 
         Returns
         -------
-        list of (fu, fv, fw, a)
+        blocks : list of (fu, fv, fw, a)
             For :meth:`BendingPlan.bend`'s ``blocks``.
+        gamma : (n_flat,) float
+            Twist of every segment, in the bending pass's flat order.
         """
         ws = self.ws
         S = len(self.seg_obj)
@@ -401,6 +443,9 @@ class LoadPath:
         Feq += np.multiply(self.dA, _dot(Fo, sh), out=tmp)
         Feq += np.multiply(Ft, self.beta, out=tmp)
         Feq += np.multiply(self.dB, _dot(Ft, sh), out=tmp)
+        torsion = np.take(dT, self.seg_obj)
+        torsion += _dot(_cross(self.A, Fo, out=tmp), sh)
+        torsion += _dot(_cross(self.lever_vec, Ft, out=tmp), sh)
         if len(self.k_flat):  # children beyond the joint, rest-world → local
             rc = np.zeros((6, slots.shape[1] + 1))
             rc[:, :-1] = np.cumsum(slots[:, ::-1], axis=1)[:, ::-1]
@@ -412,6 +457,14 @@ class LoadPath:
             Ml = np.stack([_dot(u, Mi), _dot(v, Mi), _dot(w, Mi)])
             shk = sh[:, self.k_flat]
             Feq[:, self.k_flat] += _dot(Fl, shk) * shk + _cross(Ml, shk) / self.lever[self.k_flat]
+            torsion[self.k_flat] += _dot(Ml, shk)
         a = np.sqrt(_dot(Feq, Feq))
         a *= self.lever
-        return [(Feq[0, lo:hi], Feq[1, lo:hi], Feq[2, lo:hi], a[lo:hi]) for lo, hi in self.blocks]
+        gamma = np.abs(torsion)
+        gamma *= self.twist_compliance
+        gamma *= -2.0 / np.pi
+        np.expm1(gamma, out=gamma)
+        gamma *= np.sign(torsion)
+        gamma *= -0.5 * np.pi
+        blocks = [(Feq[0, lo:hi], Feq[1, lo:hi], Feq[2, lo:hi], a[lo:hi]) for lo, hi in self.blocks]
+        return blocks, gamma

@@ -31,6 +31,10 @@ INTEGRATORS = ("exact", "euler")
 #: the finite-difference acceleration finite and smooth at any dt and delays it by ~10 ms.
 ACCEL_TAU = 0.01
 
+#: E (Pa) that shapes a branch's stiffness along its length before :meth:`LoadPath.tune` sets
+#: its magnitude from the branch's frequency and mass (any value gives the same tree).
+NOMINAL_WOOD_MODULUS = 6e9
+
 #: Largest pull force accepted (N): far beyond any hand on a tree (the bending stays finite
 #: and keeps lengths far above it; the cap keeps absurd inputs out).
 MAX_PULL = 1e9
@@ -44,7 +48,7 @@ def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
     """Raise ValueError naming the field if ``p`` cannot drive a simulation of these kinds."""
     if not isinstance(p, PhysicsParams):
         raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
-    positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness", "youngs_modulus",
+    positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness",
                 "leaf_youngs_modulus", "air_density", "reconfiguration_speed")
     for name in positive:
         x = finite_float(f"physics.{name}", getattr(p, name))
@@ -285,14 +289,14 @@ class Simulation:
             self._derive_load_path()
 
     def _derive_load_path(self) -> None:
-        """The load path's drag, stiffness and twist constants (physics and present leaves)."""
+        """The load path's drag, stiffness shapes and masses (physics and present leaves)."""
         p = self._physics
         self._drag.derive(p, self._present)
-        E = np.where(self._tree.kind == "branch", p.youngs_modulus, p.leaf_youngs_modulus)
-        self._lp.derive(E, p.stiffness_exponent, self._drag.half_rho_cda, self._drag.foliage)
-        # Eq. 11's saturating twist, with the torsional stiffness k_t of the object: the small
-        # twist is T/k_t, the largest a quarter turn (γ = π/2 (1 − exp(−(2/π) T/k_t))).
-        self._lp_c0k_ord = (2.0 / np.pi / self._lp.k_twist)[self._bplan.order]
+        branch = self._tree.kind == "branch"
+        E = np.where(branch, NOMINAL_WOOD_MODULUS, p.leaf_youngs_modulus)
+        self._lp.derive(E, p.stiffness_exponent, self._drag.half_rho_cda, self._drag.foliage,
+                        self._mass * self._present, branch)
+        self._mode_snap = None  # the branches' stiffness follows the modes: re-tune on the next step
 
     def _derive_modes(self) -> None:
         present = self._present if self._load_path else None  # Eq. 21 with the leaves still on
@@ -366,6 +370,8 @@ class Simulation:
         self._coef_cache.clear()
         w = 2.0 * np.pi * f3
         self._w2, self._two_zeta_w = w * w, 2.0 * z3 * w  # ω² and 2ζω of every mode
+        if self._load_path:
+            self._lp.tune(self._w2)
         return f3, z3
 
     # ------------------------------------------------------------------ properties
@@ -806,24 +812,33 @@ class Simulation:
         dE, node = self._lp.inward(F_own, F_pull, g_extra, advance, g)
         self._L = g.copy()
         F_tip = F_pull
-        F_tip += dE
-        blocks = self._lp.segment_forces(F_own, F_tip, node)
-        bp = self._bplan
-        gamma = self._twist(self._p[1, bp.order], self._lp_c0k_ord)
-        bp.bend(None, None, gamma, self._lp.k_blocks, predict=self._predict(dt), blocks=blocks)
+        F_tip[0] += dE[0]
+        F_tip[2] += dE[2]
+        blocks, gamma = self._lp.segment_forces(F_own, F_tip, dE[1], node)
+        self._bplan.bend(None, None, gamma, self._lp.k_blocks, predict=self._predict(dt), blocks=blocks)
         self._sample_prev[...] = self._sample_pos
         self._compose()
         self._sample_vel = (self._sample_pos - self._sample_prev) / dt
 
     def _aero_loads(self, U) -> tuple[np.ndarray, np.ndarray]:
-        """Stage 2 (load path): drag of the air-relative wind, local, and the air's damping
-        coefficient on each object's mode (N·s/m)."""
-        rel = -self._sample_vel if U is None else U.T - self._sample_vel
+        """Stage 2 (load path): the drag, local, and the air's damping on each object's mode.
+
+        The drag of the air-relative wind, F(U − v), is split as F(U) − c·v: the drag of the
+        wind itself, here, and the damping c = ∂F/∂v = ρ C A |U − v| (2 × ½ρCA|U_rel|, on the
+        object's mode and, through Q, on what it carries), which the oscillators take
+        implicitly (:meth:`_level_advance`) — stable however light a twig and strong the wind.
+        """
         lam_q = np.take(self._bplan.q, self._leaf_tip_flat, axis=1)
-        F, speed = self._drag.loads(rel, self._frame, lam_q)
+        if U is None:
+            F, rel = np.zeros((3, self._M)), -self._sample_vel
+        else:
+            F, _ = self._drag.loads(U.T, self._frame, lam_q)
+            rel = U.T - self._sample_vel
+        speed = np.sqrt(np.einsum("ij,ij->j", rel, rel))
         lp = self._lp
-        c_air = lp.Q_wood + lp.Q_foliage * self._drag.reconfigured(speed, np.ones(self._M, bool))
-        c_air *= speed
+        c_air = lp.Q_foliage * self._drag.reconfigured(speed, np.ones(self._M, bool))
+        c_air += lp.Q_wood
+        c_air *= 2.0 * speed
         return F, c_air
 
     def _pull_loads(self) -> np.ndarray:
@@ -837,7 +852,8 @@ class Simulation:
 
     def _base_excitation(self, f3: np.ndarray, z3: np.ndarray) -> np.ndarray:
         """(3, M) oscillator inputs −m_eff·a of the moving bases (``coupling``), with the
-        effective mass m_eff = K/(2πf)² of each bending mode."""
+        effective mass m_eff = K/(2πf)² of each bending mode (a branch's modal mass, since
+        its K follows from it; for leaves and blades at most their modal mass)."""
         g = np.zeros((3, self._M))
         if not self._coupling:
             return g
@@ -847,8 +863,11 @@ class Simulation:
         acc -= self._two_zeta_w * self._pd
         a_u, a_w = self._lp.base_acceleration(acc)
         K = self._lp.K
-        np.multiply(-K / w2[0], a_w, out=g[0])  # mode u moves along w
-        np.multiply(-K / w2[2], a_u, out=g[2])
+        m = self._lp.m_modal
+        g[0] = np.minimum(K / w2[0], m)
+        g[0] *= -a_w  # mode u moves along w
+        g[2] = np.minimum(K / w2[2], m)
+        g[2] *= -a_u
         return g
 
     def _level_advance(self, f3: np.ndarray, z3: np.ndarray, dt: float, c_air: np.ndarray):
