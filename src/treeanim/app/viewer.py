@@ -29,7 +29,7 @@ import glfw
 import numpy as np
 
 from ..model.tree import Tree
-from ..physics.simulation import Simulation
+from ..physics.simulation import MAX_PULL, Simulation
 from ..physics.wind import WindField
 from ..render.camera import OrbitCamera
 from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
@@ -500,27 +500,6 @@ class Viewer:
         t = float((g.plane_point - o) @ g.plane_normal) / denom
         return o + max(t, 0.0) * d
 
-    def compliance(self, obj: int, k: int, s: float, offset=(0.0, 0.0, 0.0)) -> float:
-        """Metres a point moves per newton of a tip force across object ``obj``, by the
-        linearised bending of DESIGN §5 (small angles, the rest pose).
-
-        The point is carried by segment ``k`` at ``s`` (0 … 1) along it, plus ``offset`` (a
-        point on a leaf's lamina lies beyond the petiole's tip)."""
-        tree = self.sim.tree
-        p = self.sim.physics
-        nodes = tree.object_nodes(obj)
-        X = tree.rest_positions[nodes]
-        D = tree.node_diameter[nodes]
-        seg = np.diff(X, axis=0)
-        L = np.linalg.norm(seg, axis=1)
-        n = len(L)
-        dmax = float(np.max(tree.node_diameter))
-        stiff = p.ei_max * (0.5 * (D[:-1] + D[1:]) / dmax) ** p.stiffness_exponent
-        phi = (n - np.arange(n)) / n * L / np.maximum(stiff, 1e-30)
-        anchor = X[k] + s * seg[k] + np.asarray(offset, float)
-        lever = np.linalg.norm(anchor - X[: k + 1], axis=1)
-        return float(np.sum(phi[: k + 1] * lever))
-
     def start_pull(self, x: float, y: float) -> bool:
         """Grab the object under (x, y), if any. Returns whether something was grabbed."""
         hit = self.pick(x, y)
@@ -537,8 +516,8 @@ class Viewer:
         k = int(np.argmin(dist))
         anchor = a[k] + s[k] * e[k]
         point = np.asarray(hit.point, float)
-        G = max(self.compliance(obj, k, float(s[k]), point - anchor), 1e-12)
-        G_tip = max(self.compliance(obj, len(nodes) - 2, 1.0), 1e-12)
+        G = max(sim.compliance(obj, k, float(s[k]), point - anchor), 1e-12)
+        G_tip = max(sim.compliance(obj, len(nodes) - 2, 1.0), 1e-12)
         spring = PULL_GAIN / G
         length = float(np.sum(np.linalg.norm(np.diff(tree.rest_positions[nodes], axis=0), axis=1)))
         length += float(tree.lamina_length[obj])
@@ -574,8 +553,9 @@ class Viewer:
         g = self.grab
         raw = g.k * (g.target - self._grabbed_point(exact))
         mag = float(np.linalg.norm(raw))
-        if mag > g.f_max:
-            raw *= g.f_max / mag
+        f_max = min(g.f_max, MAX_PULL)  # what Simulation.pull accepts, whatever the spring says
+        if mag > f_max:
+            raw *= f_max / mag
         g.force += (h / (PULL_TAU + h)) * (raw - g.force)
         self.sim.pull(g.object, g.force)
 

@@ -59,7 +59,8 @@ class PhysicsParams:
     wind_gain_branch, wind_gain_leaf, wind_gain_blade : float
         Drag gain per kind (N·s/m³): load = gain × exposed area × wind velocity.
     wood_density, leaf_density : float
-        kg/m³, for the base-excitation inertia (DESIGN §6 step 3).
+        kg/m³, for the base-excitation inertia (DESIGN §6 step 3) and, in the load path, the
+        modal mass that sets a branch's stiffness (K = m·ω²).
     lamina_thickness : float
         Thickness of a leaf lamina (and of a grass blade) in metres, for its mass.
     leaf_twist_c0 : float
@@ -73,7 +74,10 @@ class PhysicsParams:
         ρ of the air (kg/m³), for the drag ½ρ C A |U_rel| U_rel (load path).
     drag_branch, drag_leaf, drag_blade : float
         Drag coefficients (load path): C_d of a branch across the flow, C_n of a lamina's normal
-        force, C_d of a grass blade.
+        force, C_d of a grass blade. Effective values for objects inside a crown: summed
+        one by one, twigs and leaves that shelter each other would catch 3–5 times the drag of
+        the crown they form (leaf area index), so branches and leaves take a quarter to a
+        third of an isolated cylinder's (1.2) and plate's (1.0) coefficient.
     reconfiguration, reconfiguration_speed : float
         Foliage streamlining (load path): above ``reconfiguration_speed`` U₀ (m/s) the drag of
         leaves and blades grows as U^(2 − r) with r = ``reconfiguration`` (Vogel's exponent
@@ -103,14 +107,14 @@ class PhysicsParams:
     wind_gain_branch: float = 3.0
     wind_gain_leaf: float = 0.5
     wind_gain_blade: float = 3.0
-    wood_density: float = 900.0
+    wood_density: float = 700.0
     leaf_density: float = 500.0
     lamina_thickness: float = 3.0e-4
     leaf_twist_c0: float = 0.5
     leaf_youngs_modulus: float = 1.0e9
     air_density: float = 1.2
-    drag_branch: float = 0.4
-    drag_leaf: float = 0.2
+    drag_branch: float = 0.3
+    drag_leaf: float = 0.15
     drag_blade: float = 1.0
     reconfiguration: float = 0.7
     reconfiguration_speed: float = 4.0

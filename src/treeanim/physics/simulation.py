@@ -577,6 +577,34 @@ class Simulation:
         o = self._bplan.o[:, self._bplan.ofs_of_node[self._tip_node[objs]]]
         return (self._base[:, objs] + qrot(self._frame[:, objs], o)).T
 
+    def compliance(self, i: int, k: int, s: float, offset=(0.0, 0.0, 0.0)) -> float:
+        """Metres a point of object ``i`` moves per newton of a force on it (small bends, rest
+        pose), for a pull controller's spring.
+
+        The point is carried by segment ``k`` at ``s`` (0 … 1) along it, plus ``offset`` (a
+        point on a leaf's lamina lies beyond the petiole's tip). The paper's model sums Eq. 10's
+        hinges; the load path scales the compliance 1/K at the object's load point by the
+        cube of the point's share of the lever (a cantilever's x³ law).
+        """
+        i = self._check_object(int(i))
+        tree = self._tree
+        nodes = tree.object_nodes(i)
+        X = tree.rest_positions[nodes]
+        seg = np.diff(X, axis=0)
+        anchor = X[k] + s * seg[k] + np.asarray(offset, float)
+        if self._load_path:
+            self._modes_arrays()  # the stiffness follows the modes
+            share = np.linalg.norm(anchor - X[0]) / max(float(self._lp.lever0[i]), 1e-12)
+            return float(min(share, 4.0) ** 3 / self._lp.K[i])
+        p = self._physics
+        D = tree.node_diameter[nodes]
+        L = np.linalg.norm(seg, axis=1)
+        n = len(L)
+        stiff = p.ei_max * (0.5 * (D[:-1] + D[1:]) / float(np.max(tree.node_diameter))) ** p.stiffness_exponent
+        phi = (n - np.arange(n)) / n * L / np.maximum(stiff, 1e-30)  # Eq. 7's fractions at Eq. 10's k
+        lever = np.linalg.norm(anchor - X[: k + 1], axis=1)
+        return float(np.sum(phi[: k + 1] * lever))
+
     # ------------------------------------------------------------------ interaction
     def pull(self, i: int, force_xyz) -> None:
         """Hold object ``i`` with a constant world force (N) at its tip (DESIGN §8).

@@ -1,0 +1,133 @@
+"""The load path (issue #10, DESIGN §12): whole-tree mechanics measured from the public API."""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import treeanim as ta
+
+DATA = Path(__file__).parent / "data"
+
+
+class Uniform:
+    """A steady, uniform wind (m/s)."""
+
+    def __init__(self, U):
+        self.U = np.asarray(U, float)
+
+    def sample(self, points, t):
+        return np.tile(self.U, (len(points), 1))
+
+
+@pytest.fixture(scope="module")
+def cherry():
+    return ta.load_preset("small_cherry")
+
+
+def limb_lean(tree, speed, season=0.0, seconds=6.0, dt=1 / 30, **kw):
+    """Mean downwind (+x) displacement of the trunk and main-limb tips (levels 1–2) over the
+    second half of ``seconds`` in a steady wind, as a fraction of the tree's height."""
+    sim = ta.Simulation(tree, wind=Uniform((speed, 0.0, 0.0)), season=season, **kw)
+    objs = np.flatnonzero((tree.kind == "branch") & (tree.level <= 2))
+    tips = tree.object_start[objs] + tree.object_count[objs] - 1
+    n = int(round(seconds / dt))
+    acc = []
+    for k in range(n):
+        sim.step(dt)
+        if k >= n // 2:
+            acc.append(np.mean(sim.positions[tips, 0] - tree.rest_positions[tips, 0]))
+    return float(np.mean(acc)) / float(np.ptp(tree.rest_positions[:, 1]))
+
+
+def test_limbs_lean_visibly_and_faster_than_linearly_with_wind_speed(cherry):
+    lean = {U: limb_lean(cherry, U) for U in (5.0, 15.0)}
+    assert 0.005 < lean[5.0] < 0.08, "a breeze sways the limbs by centimetres, not millimetres or metres"
+    assert lean[15.0] > 3.3 * lean[5.0], "drag is quadratic: 3× the wind leans more than 3× as far"
+    paper = limb_lean(cherry, 15.0, load_path=False)
+    assert lean[15.0] > 20 * paper, "the crown's drag reaches the trunk and the limbs"
+
+
+def test_summer_crown_leans_more_than_the_bare_winter_tree(cherry):
+    summer, winter = limb_lean(cherry, 30.0, 0.0), limb_lean(cherry, 30.0, 1.0)
+    assert summer > 1.2 * winter > 0
+    assert summer > 0.03, "a gale leans the crown several percent of the height (Fig. 11)"
+
+
+def test_pulling_a_limb_moves_the_trunk(cherry):
+    limb = int(np.flatnonzero(cherry.level == 2)[0])
+    trunk_tip = cherry.object_start[0] + cherry.object_count[0] - 1
+    moved = {}
+    for load_path in (True, False):
+        sim = ta.Simulation(cherry, load_path=load_path)
+        sim.pull(limb, (0.0, 0.0, 100.0))
+        for _ in range(120):
+            sim.step(1 / 60)
+        moved[load_path] = sim.positions[trunk_tip] - cherry.rest_positions[trunk_tip]
+    assert np.linalg.norm(moved[False]) < 1e-12  # the paper: a pull stays on its object
+    assert moved[True][2] > 1e-3, "the trunk bends towards the pull by millimetres or more"
+
+
+def test_a_new_pull_builds_up_without_a_jump(cherry):
+    limb = int(np.flatnonzero(cherry.level == 3)[0])
+    tip = cherry.object_start[limb] + cherry.object_count[limb] - 1
+    sim = ta.Simulation(cherry)
+    sim.pull(limb, (0.0, 0.0, 5.0))
+    path = []
+    for _ in range(180):
+        sim.step(1 / 60)
+        path.append(np.linalg.norm(sim.positions[tip] - cherry.rest_positions[tip]))
+    final = path[-1]
+    assert final > 0.01
+    assert path[0] < 0.1 * final, "the first 1/60 s step is a small part of the way"
+    assert np.max(np.diff(path)) < 0.1 * final, "no frame jumps a tenth of the deflection"
+    assert max(path) < 1.05 * final, "held, it approaches critically damped: no overshoot"
+
+
+def swing_amplitudes(tree, obj, speed, seconds=4.0, dt=1 / 60):
+    """Pull ``obj`` across the wind, release it, and return |tip − its late mean| per step."""
+    sim = ta.Simulation(tree, wind=Uniform((speed, 0.0, 0.0)) if speed else None)
+    tip = tree.object_start[obj] + tree.object_count[obj] - 1
+    for _ in range(120):
+        sim.step(dt)  # settle in the wind first
+    sim.pull(obj, (0.0, 0.0, 3.0))
+    for _ in range(120):
+        sim.step(dt)
+    sim.release()
+    z = []
+    for _ in range(int(seconds / dt)):
+        sim.step(dt)
+        z.append(sim.positions[tip, 2])
+    z = np.array(z)
+    return np.abs(z - z[len(z) // 2:].mean())
+
+
+def test_moving_air_damps_a_released_limb_faster_than_calm_air(cherry):
+    obj = int(np.flatnonzero((cherry.kind == "branch") & (cherry.level == 3))[0])
+    calm = swing_amplitudes(cherry, obj, 0.0)
+    windy = swing_amplitudes(cherry, obj, 10.0)
+    n = len(calm)
+    late = slice(n // 3, 2 * n // 3)  # after the first swing, before it has died out
+    assert windy[late].max() / windy[:20].max() < 0.8 * calm[late].max() / calm[:20].max()
+
+
+def _reference_module():
+    spec = importlib.util.spec_from_file_location("make_paper_reference", DATA / "make_paper_reference.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_load_path_off_reproduces_the_paper_model_bit_for_bit():
+    """``load_path=False`` gives the poses the paper model gave before the load path (recorded
+    at commit 4ed910f by tests/data/make_paper_reference.py)."""
+    ref = np.load(DATA / "paper_reference.npz")
+    mod = _reference_module()
+    for name, scenario in mod.SCENARIOS.items():
+        pos, rot = mod.run(*scenario, load_path=False)
+        np.testing.assert_array_equal(pos, ref[f"{name}/positions"], err_msg=name)
+        if f"{name}/rotations" in ref:
+            np.testing.assert_array_equal(rot, ref[f"{name}/rotations"], err_msg=name)
