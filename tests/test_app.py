@@ -344,6 +344,7 @@ def test_panel_apply_sets_physics_season_and_time(viewer):
     assert p.apply("c3", 0.8) and v.sim.wind.c3 == 0.8
     assert p.apply("integrator", "euler") and v.sim.integrator == "euler"
     assert p.apply("coupling", False) and not v.sim.coupling
+    assert p.apply("load_path", False) and not v.sim.load_path
     assert p.apply("time_scale", 0.25) and v.time_scale == 0.25
     assert not p.apply("turbulence", 7.0)  # refused by the wind field: shown, not raised
     assert v.messages[-1].startswith("error: turbulence")
@@ -354,6 +355,8 @@ def test_panel_apply_sets_physics_season_and_time(viewer):
         assert v.frame(DT)
     p.apply("integrator", "exact")
     p.apply("coupling", True)
+    p.apply("load_path", True)
+    assert v.sim.load_path
     p.apply("season", 0.0)
 
 

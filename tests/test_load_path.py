@@ -131,3 +131,19 @@ def test_load_path_off_reproduces_the_paper_model_bit_for_bit():
         np.testing.assert_array_equal(pos, ref[f"{name}/positions"], err_msg=name)
         if f"{name}/rotations" in ref:
             np.testing.assert_array_equal(rot, ref[f"{name}/rotations"], err_msg=name)
+
+
+def test_switching_the_model_restarts_from_rest_and_both_run(cherry):
+    sim = ta.Simulation(cherry, wind=Uniform((10.0, 0.0, 0.0)))
+    for _ in range(10):
+        sim.step(1 / 30)
+    t = sim.time
+    sim.load_path = False
+    assert not sim.load_path and sim.time == t
+    np.testing.assert_allclose(sim.positions, cherry.rest_positions, atol=1e-12)
+    for _ in range(10):
+        sim.step(1 / 30)
+    sim.load_path = True
+    for _ in range(10):
+        sim.step(1 / 30)
+    assert np.isfinite(sim.positions).all() and sim.load_path

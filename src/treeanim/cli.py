@@ -134,6 +134,8 @@ def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, f
     add_wind_options(p)
     p.add_argument("--pull", type=_pull, action="append", default=[], metavar="OBJECT:FX,FY,FZ@T0-T1",
                    help="pull OBJECT's tip with a world force in newtons from T0 to T1 s, then let go; repeatable")
+    p.add_argument("--paper", action="store_true",
+                   help="the paper's model: every object on its own, linear drag (default: the load path)")
 
 
 def check_frames(seconds: float, fps: float) -> int:
@@ -155,7 +157,8 @@ def make_simulation(args):
         wind = None
         if args.wind > 0:
             wind = ta.WindField(direction=args.wind_dir, speed=args.wind, turbulence=args.turbulence, seed=args.seed)
-        sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed)
+        sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed,
+                            load_path=not getattr(args, "paper", False))
     except ValueError as e:
         raise UsageError(str(e)) from None
     return tree, sim

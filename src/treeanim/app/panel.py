@@ -116,7 +116,7 @@ class Panel:
         Names: ``preset`` (a shipped preset's name), ``season``, ``wind_speed``, ``wind_angle``
         (degrees about +y), ``turbulence``, ``beta_u``, ``beta_vw``, ``c3``, ``c4``, ``ei_max``,
         ``f:KIND`` and ``zeta:KIND`` ((min, max) of the edited season's table), ``time_scale``,
-        ``integrator``, ``coupling``, ``paused``, ``show_trace``, ``show_frames``, ``show_wind``.
+        ``integrator``, ``coupling``, ``load_path``, ``paused``, ``show_trace``, ``show_frames``, ``show_wind``.
         """
         v = self.viewer
         sim = v.sim
@@ -152,6 +152,8 @@ class Panel:
                 sim.integrator = value
             elif name == "coupling":
                 sim.coupling = bool(value)
+            elif name == "load_path":
+                sim.load_path = bool(value)
             elif name in ("paused", "show_trace", "show_frames", "show_wind"):
                 setattr(v, name, bool(value))
             else:
@@ -333,6 +335,8 @@ class Panel:
             if changed:
                 self.apply("integrator", INTEGRATORS[idx])
             self._check("coupling", "coupling", sim.coupling)
+            imgui.same_line()
+            self._check("load path", "load_path", sim.load_path)
             imgui.same_line()
             if imgui.button("Resume" if v.paused else "Pause"):
                 self.apply("paused", not v.paused)

@@ -231,6 +231,7 @@ class Viewer:
         self._fb = tuple(window.framebuffer_size)
         self._integrator = "exact"
         self._coupling = True
+        self._load_path = True
         self.sim: Simulation | None = None
         self.renderer: Renderer | None = None
         self._wind = _clone_wind(None, speed=float(wind_speed), direction=wind_direction(wind_angle_deg),
@@ -257,16 +258,17 @@ class Viewer:
         return self.sim.wind
 
     def load_tree(self, tree: Tree) -> None:
-        """Show ``tree``: a new simulation (same wind, season, integrator and coupling), renderer
+        """Show ``tree``: a new simulation (same wind, season, integrator, coupling and model), renderer
         and picker; the camera frames it."""
         if self.sim is not None:
             self._season = self.sim.season
             self._integrator = self.sim.integrator
             self._coupling = self.sim.coupling
+            self._load_path = self.sim.load_path
             self._wind = self.sim.wind
         self._end_drag()
         sim = Simulation(tree, wind=_clone_wind(self._wind), season=self._season, seed=self.seed,
-                         integrator=self._integrator, coupling=self._coupling)
+                         integrator=self._integrator, coupling=self._coupling, load_path=self._load_path)
         renderer = Renderer(self.ctx, tree)
         if self.renderer is not None:
             self.renderer.release()

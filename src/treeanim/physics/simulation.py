@@ -458,6 +458,25 @@ class Simulation:
         self._coupling = bool(on)
 
     @property
+    def load_path(self) -> bool:
+        """Whether the tree is one structure (DESIGN §12) or the paper's independent objects
+        (settable; switching restarts from rest, keeping time, season and physics)."""
+        return self._load_path
+
+    @load_path.setter
+    def load_path(self, on: bool) -> None:
+        on = bool(on)
+        if on == self._load_path:
+            return
+        self._load_path = on
+        if on:
+            self._derive_load_path()
+        self._derive_modes()
+        time = self._time
+        self.reset()
+        self._time = time
+
+    @property
     def wind(self):
         """The wind field or None (settable; a wind on its default bounds is fitted to the tree)."""
         return self._wind
