@@ -94,8 +94,10 @@ class Simulation:
     integrator : {'exact', 'euler'}
         Oscillator integrator (:mod:`treeanim.physics.oscillator`).
     coupling : bool
-        Base excitation: every object also feels −(acceleration of its base node) × its mass,
-        so a swinging trunk shakes its twigs. False restores the paper's independent objects.
+        Base excitation in the paper's model: every object also feels −(acceleration of its
+        base node) × its mass, so a swinging trunk shakes its twigs. False restores the paper's
+        independent objects. The load path always couples (its loads go down the tree, so the
+        motion must come back up: one without the other feeds energy into a gusty crown).
     load_path : bool
         True (default): the tree is one structure (DESIGN §12, :mod:`~treeanim.physics.loadpath`):
         every object carries its children's loads down to the trunk, drag is quadratic in the
@@ -696,6 +698,7 @@ class Simulation:
         self._att_a = np.zeros((3, U + 1))  # column U: zero, for roots
         self._dt_prev = None
         self._g_prev = np.zeros((3, M))  # the oscillators' last inputs (load path)
+        self._c_air = np.zeros(M)  # the air's damping of the last step (load path)
         self._sample_prev = self._sample_pos.copy()
         self._sample_vel = np.zeros((3, M))
         self._pulls.clear()
@@ -855,6 +858,7 @@ class Simulation:
         F_pull = self._pull_loads()
         g_extra = self._base_excitation(f3, z3)
         advance = self._level_advance(f3, z3, dt, c_air)
+        self._c_air = c_air
         g = self._g_prev
         dE, node = self._lp.inward(F_own, F_pull, g_extra, advance, g)
         self._L = g.copy()
@@ -898,16 +902,21 @@ class Simulation:
         return F
 
     def _base_excitation(self, f3: np.ndarray, z3: np.ndarray) -> np.ndarray:
-        """(3, M) oscillator inputs −m_eff·a of the moving bases (``coupling``), with the
+        """(3, M) oscillator inputs −m_eff·a of the moving bases (always on in the load path:
+        loads go down the tree and motion comes back up, or a gust sets it ringing), with the
         effective mass m_eff = K/(2πf)² of each bending mode (a branch's modal mass, since
         its K follows from it; for leaves and blades at most their modal mass)."""
         g = np.zeros((3, self._M))
-        if not self._coupling:
-            return g
         w2 = self._w2
-        acc = self._g_prev - self._p  # p̈ = ω²(g − p) − 2ζω ṗ (Eq. 2 in load units)
+        # p̈ = ω²(g − p) − (2ζω + ω²c/K) ṗ: Eq. 2 in load units, with the air's damping c of
+        # the last step (in a gale it holds a light twig back far more than its own ζ does)
+        acc = self._g_prev - self._p
         acc *= w2
-        acc -= self._two_zeta_w * self._pd
+        damp = self._c_air / self._lp.K
+        damp = damp * w2
+        damp[1] = 0.0  # (the air damps the bending modes only)
+        damp += self._two_zeta_w
+        acc -= damp * self._pd
         a_u, a_w = self._lp.base_acceleration(acc)
         K = self._lp.K
         m = self._lp.m_modal
