@@ -9,6 +9,16 @@ from treeanim.model.build import ObjectSpec, assemble
 from treeanim.model.tree import Lamina
 
 
+class Uniform:
+    """A steady uniform wind U (m/s) everywhere (only ``sample`` is needed)."""
+
+    def __init__(self, U):
+        self.U = np.asarray(U, float)
+
+    def sample(self, points, t):
+        return np.tile(self.U, (len(points), 1))
+
+
 def ovate_lamina(k: int = 24, curl: float = 0.12) -> Lamina:
     """An ovate, pointed leaf outline (midrib length 1), fan-triangulated from its base."""
     s = np.linspace(0.0, 1.0, k // 2 + 1)

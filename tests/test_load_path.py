@@ -9,18 +9,9 @@ import numpy as np
 import pytest
 
 import treeanim as ta
+from conftest import Uniform
 
 DATA = Path(__file__).parent / "data"
-
-
-class Uniform:
-    """A steady, uniform wind (m/s)."""
-
-    def __init__(self, U):
-        self.U = np.asarray(U, float)
-
-    def sample(self, points, t):
-        return np.tile(self.U, (len(points), 1))
 
 
 @pytest.fixture(scope="module")

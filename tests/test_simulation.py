@@ -7,6 +7,7 @@ import pytest
 from scipy.optimize import curve_fit
 
 import treeanim as ta
+from conftest import Uniform
 from treeanim.model.build import ObjectSpec, assemble
 from treeanim.model.geometry import lamina_frames, polygon_centroid
 from treeanim.model.params import PhysicsParams
@@ -18,16 +19,6 @@ def straight_beam(n=8, length=2.0):
     pts = np.stack([np.zeros(n + 1), np.linspace(0, length, n + 1), np.zeros(n + 1)], 1)
     return assemble([ObjectSpec(pts, np.linspace(0.08, 0.03, n + 1), "branch", 1, w=np.array([0.0, 0.0, 1.0]))],
                     name="straight", physics=PhysicsParams(ei_max=200.0))
-
-
-class Uniform:
-    """A steady uniform wind (only ``sample`` is needed)."""
-
-    def __init__(self, U):
-        self.U = np.asarray(U, float)
-
-    def sample(self, points, t):
-        return np.tile(self.U, (len(points), 1))
 
 
 def fit_damped(t, x):

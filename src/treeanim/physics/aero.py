@@ -1,7 +1,10 @@
 """Aerodynamic loads beyond the paper (DESIGN §12): quadratic drag on the air-relative wind.
 
 The paper drives every object with a load linear in the wind (Eq. 19 × a gain). Here the load
-is the drag of real air, ½ρ C A |U_rel| U_rel, with U_rel the wind relative to the moving object:
+is the drag of real air, ½ρ C A |U_rel| U_rel, with U_rel the wind relative to the moving object.
+The simulation splits it as F(U) − c·v: :meth:`Drag.loads` gives the drag of the wind U itself,
+and the damping c = ρ C A |U_rel| of the object's own motion v is taken implicitly by the
+oscillators (:meth:`Simulation._aero_loads <treeanim.physics.simulation.Simulation>`).
 
 * **branches** are cylinders across the flow: only the wind normal to the axis pushes
   (the cross-flow principle), F = ½ρ C_d D L |U_⊥| U_⊥;
@@ -61,21 +64,23 @@ class Drag:
         self.r = float(p.reconfiguration)
         self.u0 = float(p.reconfiguration_speed)
 
-    def reconfigured(self, speed: np.ndarray, foliage: np.ndarray) -> np.ndarray:
-        """Factor on ½ρ C A: (max(|U|, U₀)/U₀)^(−r) where ``foliage``, else 1 (wood)."""
+    def reconfigured(self, speed: np.ndarray, foliage: np.ndarray | None = None) -> np.ndarray:
+        """Factor on ½ρ C A: (max(|U|, U₀)/U₀)^(−r) where ``foliage`` (None: everywhere), else 1
+        (wood)."""
         f = np.maximum(speed, self.u0)
         f *= 1.0 / self.u0
         np.power(f, -self.r, out=f)
-        f[~foliage] = 1.0
+        if foliage is not None:
+            f[~foliage] = 1.0
         return f
 
-    def loads(self, u_rel: np.ndarray, frame: np.ndarray, lamina_q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Drag of the air-relative wind on every object, in its carried frame.
+    def loads(self, wind: np.ndarray, frame: np.ndarray, lamina_q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Drag of the wind on every object, in its carried frame.
 
         Parameters
         ----------
-        u_rel : (3, M) float
-            Wind minus the object's velocity, world (m/s).
+        wind : (3, M) float
+            The wind each object feels, world (m/s): U, or U minus the object's velocity.
         frame : (4, M) float
             The objects' carried frames (quaternions).
         lamina_q : (4, L) float
@@ -87,11 +92,11 @@ class Drag:
         force : (3, M) float
             (F_u, F_v, F_w) in newtons, in the carried frame.
         speed : (M,) float
-            |U_rel| (m/s).
+            |wind| (m/s).
         """
-        M = u_rel.shape[1]
+        M = wind.shape[1]
         ws = self.ws
-        U = qrot(frame, u_rel, conj=True, out=ws.get("U", (3, M)), ws=ws)
+        U = qrot(frame, wind, conj=True, out=ws.get("U", (3, M)), ws=ws)
         speed = np.sqrt(np.einsum("ij,ij->j", U, U))
         coeff = self.reconfigured(speed, self.foliage)
         coeff *= self.half_rho_cda

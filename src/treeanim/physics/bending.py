@@ -191,6 +191,27 @@ def _stragglers(phi, a, k, theta0, tol):
     return out
 
 
+def saturating_twist(torque: np.ndarray, rate, scale) -> np.ndarray:
+    """Eq. 11's twist: γ = −scale·sgn(T)(1 − exp(−rate·|T|)), a new array.
+
+    Parameters
+    ----------
+    torque : (K,) float
+        The twisting moment T (the paper's L′_v, or the torsion a joint carries).
+    rate : float or (K,) float
+        1/moment at which the twist saturates (the paper's c0/k₀).
+    scale : float or (K,) float
+        Minus the largest twist (−0.5π/n per segment in the paper, −0.5π per joint).
+    """
+    gamma = np.abs(torque)
+    gamma *= rate
+    gamma *= -1.0
+    np.expm1(gamma, out=gamma)
+    gamma *= np.sign(torque)
+    gamma *= scale
+    return gamma
+
+
 def rest_frames(tree) -> np.ndarray:
     """(M, 3, 3) rest frames: columns (u, v, w) of every object (Eq. 1; leaves: Fig. 6).
 

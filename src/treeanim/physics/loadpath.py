@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .bending import saturating_twist
 from .rotation import Workspace
 
 __all__ = ["LoadPath", "TWIST_RATIO"]
@@ -238,8 +239,9 @@ class LoadPath:
         integral *= self.h
         self.k_E = self.lever**2 / np.maximum(integral, 1e-300)
         self.K_E = 1.0 / np.maximum(np.bincount(so, integral, self.M), 1e-300)  # at the load point
-        # Each joint twists under the torsion it carries, by ∫dx/GJ over its segment (GJ = EI/TWIST_RATIO).
-        self.twist_compliance = self.h * TWIST_RATIO / EI(0.5)
+        # Each joint twists under the torsion it carries, by c = ∫dx/GJ over its segment
+        # (GJ = EI/TWIST_RATIO); Eq. 11's law saturates it at a quarter turn, rate (2/π)c.
+        self.twist_rate = (2.0 / np.pi) * self.h * TWIST_RATIO / EI(0.5)
         self.modal = np.asarray(modal, bool)
         # Where a child's base sits on its parent's deflection: translation ψ and rotation χ per
         # unit deflection of the parent's load point (φᵢ = ℓᵢ/kᵢ per newton there).
@@ -460,11 +462,6 @@ class LoadPath:
             torsion[self.k_flat] += _dot(Ml, shk)
         a = np.sqrt(_dot(Feq, Feq))
         a *= self.lever
-        gamma = np.abs(torsion)
-        gamma *= self.twist_compliance
-        gamma *= -2.0 / np.pi
-        np.expm1(gamma, out=gamma)
-        gamma *= np.sign(torsion)
-        gamma *= -0.5 * np.pi
+        gamma = saturating_twist(torsion, self.twist_rate, -0.5 * np.pi)
         blocks = [(Feq[0, lo:hi], Feq[1, lo:hi], Feq[2, lo:hi], a[lo:hi]) for lo, hi in self.blocks]
         return blocks, gamma

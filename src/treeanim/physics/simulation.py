@@ -13,7 +13,7 @@ from ..model.geometry import arc_length, lamina_frames, object_lengths, polygon_
 from ..model.params import PhysicsParams
 from ..model.tree import KINDS, Tree
 from .aero import Drag
-from .bending import BendingPlan, matrix_to_quat, rest_frames
+from .bending import BendingPlan, matrix_to_quat, rest_frames, saturating_twist
 from .checks import finite_float, finite_vector3
 from .hierarchy import CompositionPlan
 from .loadpath import LoadPath
@@ -801,22 +801,12 @@ class Simulation:
 
         # 4. Force in the local rest frame (Eq. 6): (L′_w, 0, L′_u); twist (Eq. 11).
         po = np.take(self._p, self._bplan.order, axis=1, out=ws.get("po", (3, M)))
-        gamma = self._twist(po[1], self._c0k_ord)
+        gamma = saturating_twist(po[1], self._c0k_ord, self._neg_half_pi_over_n_ord)  # Eq. 11
         # 5. Bend every object in its local rest frame (Eqs. 7–10).
         bp = self._bplan
         bp.bend(po[2], po[0], gamma, self._k, predict=self._predict(dt))
         self._compose()
         self._paper_base_motion(dt)
-
-    def _twist(self, lv: np.ndarray, c0k: np.ndarray) -> np.ndarray:
-        """Eq. 11 per segment, in bending order: γ = 0.5π·sgn(L′_v)(1 − exp(−c0k·|L′_v|))/n."""
-        gamma = np.abs(lv)
-        gamma *= c0k
-        gamma *= -1.0
-        np.expm1(gamma, out=gamma)
-        gamma *= np.sign(lv)
-        gamma *= self._neg_half_pi_over_n_ord
-        return gamma
 
     def _predict(self, dt: float) -> float:
         """The bending solver's extrapolation ratio dt/dt_prev (0 on the first step)."""
@@ -856,7 +846,7 @@ class Simulation:
         oscillators (Eqs. 2–5) → bending (Eqs. 7–11 generalised) → hierarchy (Eq. 12)."""
         F_own, c_air = self._aero_loads(U)
         F_pull = self._pull_loads()
-        g_extra = self._base_excitation(f3, z3)
+        g_extra = self._base_excitation()
         advance = self._level_advance(f3, z3, dt, c_air)
         self._c_air = c_air
         g = self._g_prev
@@ -887,7 +877,7 @@ class Simulation:
             rel = U.T - self._sample_vel
         speed = np.sqrt(np.einsum("ij,ij->j", rel, rel))
         lp = self._lp
-        c_air = lp.Q_foliage * self._drag.reconfigured(speed, np.ones(self._M, bool))
+        c_air = lp.Q_foliage * self._drag.reconfigured(speed)
         c_air += lp.Q_wood
         c_air *= 2.0 * speed
         return F, c_air
@@ -901,7 +891,7 @@ class Simulation:
             F[:, held] = qrot(self._frame[:, held], world, conj=True)
         return F
 
-    def _base_excitation(self, f3: np.ndarray, z3: np.ndarray) -> np.ndarray:
+    def _base_excitation(self) -> np.ndarray:
         """(3, M) oscillator inputs −m_eff·a of the moving bases (always on in the load path:
         loads go down the tree and motion comes back up, or a gust sets it ringing), with the
         effective mass m_eff = K/(2πf)² of each bending mode (a branch's modal mass, since
