@@ -1140,6 +1140,8 @@ def _physical_table(beta_u: float, beta_vw: float, seed: int) -> np.ndarray:
         log_amp -= log_amp.max()
         amp = np.exp(log_amp)
         amp[0, 0, 0] = 0.0  # zero mean over the tile
+        if c:  # across the wind every line along it has zero mean: no long-run veer
+            amp[0] = 0.0
         rng = np.random.default_rng((seed, 11, c))
         spec = scipy.fft.rfftn(rng.standard_normal((nx, ny, nz)), axes=(0, 1, 2)) * amp
         var = float(np.sum(gain * (spec.real**2 + spec.imag**2))) / float(nx * ny * nz) ** 2
@@ -1232,21 +1234,21 @@ def _gusts(wind: "WindField", along: np.ndarray, g: float, length: float) -> np.
     error < 0.5 %), or directly where the span is too long for that."""
     rg = wind.gust_rate / 60.0
     per_m = rg / wind.speed  # gust count per metre along the wind
+    if not GUST_RISE * length * per_m > 1e-12:  # gusts so rare they never come
+        return np.zeros_like(along)
     sr = min(GUST_RISE * length * per_m, _GUST_MAX_WIDTH[0])
     sd = min(GUST_DECAY * length * per_m, _GUST_MAX_WIDTH[1])
-    lo_x, hi_x = float(along.min()), float(along.max())
-    step = 0.125 * sr / per_m  # metres
-    n = int((hi_x - lo_x) / step) + 2
-    if n <= 4096:
-        xs = lo_x + step * np.arange(n + 1)
-        ys = _gust_sum(wind.seed, g - xs * per_m, sr, sd)
-        f = along - lo_x
-        f *= 1.0 / step
-        i = f.astype(np.intp)
-        np.clip(i, 0, n - 1, out=i)
+    step = 0.125 * sr / per_m  # metres, on a lattice fixed in space (chunk-independent)
+    f = along * (1.0 / step)
+    lo_i, hi_i = math.floor(float(f.min())), math.floor(float(f.max()))
+    if hi_i - lo_i <= 4096:
+        ys = _gust_sum(wind.seed, g - (step * np.arange(lo_i, hi_i + 2)) * per_m, sr, sd)
+        i = np.floor(f)
         f -= i
-        out = ys[i + 1]
-        y0 = ys[i]
+        j = i.astype(np.intp)
+        j -= lo_i
+        out = ys[j + 1]
+        y0 = ys[j]
         out -= y0
         out *= f
         out += y0
@@ -1256,6 +1258,7 @@ def _gusts(wind: "WindField", along: np.ndarray, g: float, length: float) -> np.
 
 def _gust_sum(seed: int, gam: np.ndarray, sr: float, sd: float) -> np.ndarray:
     """Σ_k A_k·env(γ − c_k) − mean, gust k centred at c_k = k + jitter, γ in gust counts."""
+    gam = np.clip(gam, -(2.0**50), 2.0**50)
     kf = np.floor(gam)
     lo, hi = -math.ceil(4.0 * sd + 1.0), math.ceil(4.0 * sr + 1.0)
     m = np.arange(lo, hi + 1, dtype=np.float64)[:, None]
@@ -1263,6 +1266,7 @@ def _gust_sum(seed: int, gam: np.ndarray, sr: float, sd: float) -> np.ndarray:
     u = _hash_uniform(seed, 31, k.astype(np.int64).ravel(), 2).reshape(*k.shape, 2)
     x = gam[None, :] - (k + _GUST_JITTER * (u[..., 0] - 0.5))
     x /= np.where(x >= 0.0, sd, sr)
+    np.clip(x, -40.0, 40.0, out=x)  # exp(−800) is 0 already; no overflow for tiny widths
     env = np.exp(-0.5 * x * x)
     env *= 0.5 + u[..., 1]
     total = env.sum(axis=0)
@@ -1282,6 +1286,7 @@ def _physical_chunk(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray)
     speed = wind.speed
     frame = wind._frame
     a, s, g = wind._clocks(t)
+    g = math.fmod(g, 2.0**40)  # the gust sequence is hashed: any shift of it is as good
     table = _physical_table(wind.beta_u, wind.beta_vw, wind.seed)
     cell = length / _CELLS_PER_L
     k = p.shape[0]
