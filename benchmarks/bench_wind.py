@@ -54,7 +54,7 @@ def main(argv: list[str] | None = None) -> int:
     probe = np.array([[0.0, 5.0, 0.0]])
 
     def build():
-        WindField(grid=args.grid, seed=next(seeds)).sample(probe, 0.0)
+        WindField(model="paper", grid=args.grid, seed=next(seeds)).sample(probe, 0.0)
 
     build()  # warm up imports and FFT plans
     n_build = max(5, min(args.repeat // 10, 30))
