@@ -308,8 +308,8 @@ def test_panel_slider_and_checkbox_change_the_scene(viewer):
     d = v.sim.wind.direction
     assert np.degrees(np.arctan2(-d[2], d[0])) == pytest.approx(90.0, abs=10.0)
     assert not v.show_wind
-    for section in ("Physics", "Wind"):  # fold two sections: the overlays come into view
-        _click(v, *_centre(v.panel.item_rects[section]))
+    for section in ("Wind", "Physics"):  # fold two sections: the overlays come into view
+        _click(v, *_centre(v.panel.item_rects[section]))  # (Physics is below the fold at first)
     assert "f branch" not in v.panel.item_rects and "speed" not in v.panel.item_rects
     x, y = _centre(v.panel.item_rects["wind slices + arrow"])
     assert y < H - 8
