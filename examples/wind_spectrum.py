@@ -63,7 +63,7 @@ def main(argv: list[str] | None = None) -> int:
         return 1
 
     args.out.mkdir(parents=True, exist_ok=True)
-    wind = WindField(speed=args.speed, grid=args.grid, seed=args.seed)
+    wind = WindField(model="paper", speed=args.speed, grid=args.grid, seed=args.seed)
     n = wind.grid
 
     # -- spectra ---------------------------------------------------------------------------
@@ -119,7 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     mean = np.zeros(len(heights))
     seeds = [args.seed + i for i in range(8)]
     for seed in seeds:
-        w = WindField(speed=args.speed, grid=args.grid, seed=seed)
+        w = WindField(model="paper", speed=args.speed, grid=args.grid, seed=seed)
         for j, h in enumerate(heights):
             p = np.column_stack(
                 [rng.uniform(x0, x1, 500), np.full(500, h), rng.uniform(z0, z1, 500)]

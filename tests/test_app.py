@@ -308,8 +308,8 @@ def test_panel_slider_and_checkbox_change_the_scene(viewer):
     d = v.sim.wind.direction
     assert np.degrees(np.arctan2(-d[2], d[0])) == pytest.approx(90.0, abs=10.0)
     assert not v.show_wind
-    for section in ("Physics", "Wind"):  # fold two sections: the overlays come into view
-        _click(v, *_centre(v.panel.item_rects[section]))
+    for section in ("Wind", "Physics"):  # fold two sections: the overlays come into view
+        _click(v, *_centre(v.panel.item_rects[section]))  # (Physics is below the fold at first)
     assert "f branch" not in v.panel.item_rects and "speed" not in v.panel.item_rects
     x, y = _centre(v.panel.item_rects["wind slices + arrow"])
     assert y < H - 8
@@ -339,16 +339,22 @@ def test_panel_apply_sets_physics_season_and_time(viewer):
     assert v.sim.physics.summer.branch == v.tree.physics.summer.branch
     assert p.apply("zeta:leaf", (0.05, 0.02))  # given backwards: sorted
     assert v.sim.physics.winter.leaf.zeta == (0.02, 0.05)
-    assert p.apply("turbulence", 1.9) and v.sim.wind.turbulence == 1.9
+    assert p.apply("turbulence", 0.45) and v.sim.wind.turbulence == 0.45
+    assert p.apply("gust_strength", 0.6) and v.sim.wind.gust_strength == 0.6
+    assert p.apply("gust_rate", 8.0) and v.sim.wind.gust_rate == 8.0
+    assert p.apply("length_scale", 7.5) and v.sim.wind.length_scale == 7.5
+    assert p.apply("wind_preset", "gale") and v.sim.wind.speed == 19.0
+    assert not p.apply("wind_preset", "hurricane")
+    assert p.apply("turbulence", 0.45)
     assert p.apply("beta_u", 2.0) and v.sim.wind.beta_u == 2.0
-    assert p.apply("c3", 0.8) and v.sim.wind.c3 == 0.8
+    assert p.apply("c3", 0.8) and v.sim.wind.c3 == 0.8  # kept (paper only), validated
     assert p.apply("integrator", "euler") and v.sim.integrator == "euler"
     assert p.apply("coupling", False) and not v.sim.coupling
     assert p.apply("load_path", False) and not v.sim.load_path
     assert p.apply("time_scale", 0.25) and v.time_scale == 0.25
     assert not p.apply("turbulence", 7.0)  # refused by the wind field: shown, not raised
     assert v.messages[-1].startswith("error: turbulence")
-    assert v.sim.wind.turbulence == 1.9
+    assert v.sim.wind.turbulence == 0.45
     # everything still runs
     v.show_panel = True
     for _ in range(3):

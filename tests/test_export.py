@@ -70,8 +70,10 @@ def test_export_validates_and_plays_back(tmp_path, preset, name, seconds, fps, w
         baked = joint_world_positions(doc, blob, k)[1:]
         truth = frames[k][skel.joint_node[1:]]
         assert np.max(np.linalg.norm(baked - truth, axis=1)) < 1e-3, f"frame {k} joints off by more than 1 mm"
-    # The tree really moves in the file: the wind displaced joints by centimetres at least.
-    assert np.max(np.linalg.norm(frames[-1] - tree.rest_positions, axis=1)) > 0.01
+    # The tree really moves in the file: the wind displaced joints by centimetres at least
+    # (millimetres for the stiff blades, in the canopy's weaker wind).
+    moved = np.max(np.linalg.norm(frames[-1] - tree.rest_positions, axis=1))
+    assert moved > (0.002 if preset == "grassland" else 0.01)
 
 
 def test_export_mesh_matches_tree(tmp_path):

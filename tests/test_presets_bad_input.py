@@ -118,7 +118,9 @@ def test_empty_grass_refused(tmp_path):
 @pytest.mark.parametrize("args,words", [
     (["export", "beam", "--seconds", "1e308", "--out", "a.glb"], "--seconds"),
     (["export", "beam", "--seconds", "100000", "--fps", "100000", "--out", "a.glb"], "at most"),
-    (["export", "beam", "--turbulence", "5", "--out", "a.glb"], "[1, 2]"),
+    (["export", "beam", "--turbulence", "5", "--out", "a.glb"], "--turbulence"),
+    (["export", "beam", "--turbulence", "1.5", "--out", "a.glb"], "turbulence"),
+    (["export", "beam", "--wind-preset", "hurricane", "--out", "a.glb"], "--wind-preset"),
     (["export", "beam", "--seed", "-1", "--out", "a.glb"], "--seed"),
     (["render", "beam", "--start", "1e5", "--seconds", "100", "--out", "a.mp4"], "at most"),
     (["trace", "beam", "--pull", "1,0,0", "--hold", "1e308", "--out", "a.csv"], "--hold"),

@@ -51,7 +51,7 @@ def test_gale_keeps_lengths_and_stays_finite(name, azimuth, speed, turbulence, w
                                              coupling, season):
     tree, within, rest_len = preset(name)
     wind = ta.WindField(direction=(np.cos(azimuth), 0.0, np.sin(azimuth)), speed=speed, turbulence=turbulence,
-                        seed=wind_seed, grid=16)
+                        seed=wind_seed, grid=16, model="paper")
     sim = Simulation(tree, wind=wind, seed=seed, integrator=integrator, coupling=coupling, season=season)
     for dt in dts:
         sim.step(dt)

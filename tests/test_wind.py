@@ -1,4 +1,4 @@
-"""The 3-D 1/f^β wind field (paper §4.3, Eqs. 13–18; DESIGN §7).
+"""The paper's 3-D 1/f^β wind field, WindField(model="paper") (§4.3, Eqs. 13–18; DESIGN §7).
 
 Everything here is measured from what the code produces: spectra from the noise grids,
 profiles and directions from many samples, and the sampler against an independent
@@ -16,9 +16,34 @@ from hypothesis import strategies as st
 from scipy import stats
 from scipy.ndimage import map_coordinates
 
-from treeanim.physics.wind import WindField, fbm_noise
+from treeanim.physics.wind import WindField as _WindField
+from treeanim.physics.wind import fbm_noise
+
+
+def WindField(*args, **kwargs) -> _WindField:  # noqa: N802 - the paper's field, by its name
+    """The paper's field (these tests check Eqs. 13–18)."""
+    return _WindField(*args, **{"model": "paper", **kwargs})
 
 BETAS = (1.0, 1.33, 1.67, 2.0)
+
+
+def test_paper_model_reproduces_the_recorded_samples_bit_for_bit():
+    """tests/data/make_wind_paper_reference.py recorded these at 3e9ef3c, before issue 11."""
+    import sys
+    from pathlib import Path
+
+    data = Path(__file__).with_name("data")
+    sys.path.insert(0, str(data))
+    try:
+        import make_wind_paper_reference as ref_script
+    finally:
+        sys.path.remove(str(data))
+    ref = np.load(data / "wind_paper_reference.npz")
+    np.testing.assert_array_equal(ref["points"], ref_script.points())
+    for name, kw in ref_script.CASES.items():
+        wind = _WindField(model="paper", **kw)
+        got = np.stack([wind.sample(ref["points"], t) for t in ref["times"]])
+        np.testing.assert_array_equal(got, ref[name], err_msg=name)
 
 
 # ----------------------------------------------------------------------------- helpers

@@ -113,15 +113,44 @@ def _wind_speed(text: str) -> float:
 
 def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
     """Wind, season and seed options (the scene around the tree)."""
-    p.add_argument("--wind", type=_wind_speed, default=wind, metavar="SPEED",
-                   help=f"wind speed at the tree top, m/s (default {wind:g}; 0 = calm)")
+    from treeanim.physics.wind import MODELS, WIND_PRESETS
+
+    names = ", ".join(f"{k} (Beaufort {v['beaufort']}, {v['speed']:g} m/s)" for k, v in WIND_PRESETS.items())
+    p.add_argument("--wind", type=_wind_speed, default=None, metavar="SPEED",
+                   help=f"mean wind speed at the canopy top, m/s (default {wind:g}, or the preset's; 0 = calm)")
+    p.add_argument("--wind-preset", choices=list(WIND_PRESETS), default=None, metavar="NAME",
+                   help=f"a named wind: {names}; --wind and --turbulence override its values")
+    p.add_argument("--wind-model", choices=list(MODELS), default=None,
+                   help="physical (default: turbulence in metres carried downwind, gusts, canopy profile) "
+                   "or paper (Hu, Chiba & He 2012, Eqs. 13-18; the default with --paper)")
     p.add_argument("--wind-dir", type=_vector("direction"), default=(1.0, 0.0, 0.0), metavar="X,Y,Z",
                    help="wind direction; needs a horizontal part (default 1,0,0)")
-    p.add_argument("--turbulence", type=_number(float, 1, 2, lo_open=False), default=1.5, metavar="LAMBDA",
-                   help="λ of Eq. 17, in [1, 2] (default 1.5)")
+    p.add_argument("--turbulence", type=_number(float, 0, 2, lo_open=False), default=None, metavar="T",
+                   help="physical: turbulence intensity at the canopy top in [0, 1] (default 0.3); "
+                   "paper: lambda of Eq. 17 in [1, 2] (default 1.5)")
     p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
     p.add_argument("--seed", type=_number(int, 0, 2**32 - 1, lo_open=False), default=0,
                    help="seed of the wind and the modal noise (default 0)")
+    p.set_defaults(wind_default=wind)
+
+
+def wind_settings(args) -> dict:
+    """WindField keyword arguments from :func:`add_wind_options` (speed 0 means calm: no field)."""
+    from treeanim.physics.wind import wind_preset
+
+    model = getattr(args, "wind_model", None)
+    kw = dict(model=model or ("paper" if getattr(args, "paper", False) else "physical"))
+    if getattr(args, "wind_preset", None):
+        if kw["model"] == "paper":
+            raise UsageError("--wind-preset: the named winds are for --wind-model physical")
+        kw.update(wind_preset(args.wind_preset))
+    kw.setdefault("speed", args.wind_default)
+    if args.wind is not None:
+        kw["speed"] = args.wind
+    if getattr(args, "turbulence", None) is not None:
+        kw["turbulence"] = args.turbulence
+    kw.update(direction=args.wind_dir, seed=args.seed)
+    return kw
 
 
 def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, fps: float = 30.0,
@@ -135,7 +164,8 @@ def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, f
     p.add_argument("--pull", type=_pull, action="append", default=[], metavar="OBJECT:FX,FY,FZ@T0-T1",
                    help="pull OBJECT's tip with a world force in newtons from T0 to T1 s, then let go; repeatable")
     p.add_argument("--paper", action="store_true",
-                   help="the paper's model: every object on its own, linear drag (default: the load path)")
+                   help="the paper's model: every object on its own, linear drag, the paper's wind field "
+                   "(default: the load path in the physical wind)")
 
 
 def check_frames(seconds: float, fps: float) -> int:
@@ -155,8 +185,9 @@ def make_simulation(args):
     try:
         check_pulls(args.pull, tree.n_objects)
         wind = None
-        if args.wind > 0:
-            wind = ta.WindField(direction=args.wind_dir, speed=args.wind, turbulence=args.turbulence, seed=args.seed)
+        kw = wind_settings(args)
+        if kw["speed"] > 0:
+            wind = ta.WindField(**kw)
         sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed,
                             load_path=not getattr(args, "paper", False))
     except ValueError as e:
@@ -361,7 +392,8 @@ def cmd_view(args) -> int:
 
     tree = load_any(args.preset)
     try:
-        view(tree, season=args.season, wind_speed=args.wind, size=args.size, frames=args.frames,
+        view(tree, season=args.season, wind_speed=args.wind, wind_preset=args.wind_preset, size=args.size,
+             frames=args.frames,
              samples=args.samples)
     except (ViewerUnavailable, ValueError) as e:
         raise UsageError(str(e)) from None
@@ -503,8 +535,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("preset", nargs="?", default="small_cherry",
                    help="preset name (see 'treeanim list') or path to a preset .toml (default small_cherry)")
     p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
-    p.add_argument("--wind", type=_wind_speed, default=5.0, metavar="SPEED",
-                   help="wind speed at the tree top, m/s (default 5; 0 = calm)")
+    p.add_argument("--wind", type=_wind_speed, default=None, metavar="SPEED",
+                   help="mean wind speed at the canopy top, m/s (default 5, or the preset's; 0 = calm)")
+    p.add_argument("--wind-preset", choices=list(__import__("treeanim.physics.wind", fromlist=["x"]).WIND_PRESETS),
+                   default=None, metavar="NAME", help="a named wind: calm, breeze, windy, gale, storm (by Beaufort)")
     p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH",
                    help="window size (default 1280x720)")
     p.add_argument("--samples", type=int, choices=range(0, 17), default=None, metavar="N",

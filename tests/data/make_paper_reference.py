@@ -28,7 +28,7 @@ SCENARIOS = {
 def run(preset, speed, season, integrator, dt, steps, pulls, **sim_kwargs):
     """The poses of one scenario: (every fifth node's positions, rotations)."""
     tree = ta.load_preset(preset)
-    wind = ta.WindField(direction=(1.0, 0.0, 0.3), speed=speed, seed=3) if speed else None
+    wind = ta.WindField(direction=(1.0, 0.0, 0.3), speed=speed, seed=3, model="paper") if speed else None
     sim = ta.Simulation(tree, wind=wind, season=season, seed=1, integrator=integrator, **sim_kwargs)
     for k in range(steps):
         for obj, force, on, off in pulls:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from .errors import HEADLESS_HINT, ViewerUnavailable, check_display
 
 
-def view(tree, *, season: float = 0.0, wind_speed: float = 5.0, size: tuple[int, int] = (1280, 720),
+def view(tree, *, season: float = 0.0, wind_speed: float | None = None, wind_preset: str | None = None, size: tuple[int, int] = (1280, 720),
          frames: int | None = None, samples: int | None = None, title: str | None = None) -> int:
     """Show ``tree`` in a new window until the user closes it (or ``frames`` frames are drawn).
 
@@ -36,7 +36,7 @@ def view(tree, *, season: float = 0.0, wind_speed: float = 5.0, size: tuple[int,
     win = Window.open(*size, title or f"treeanim — {tree.name}", samples=samples)
     try:
         try:
-            viewer = Viewer(win, tree, season=season, wind_speed=wind_speed)
+            viewer = Viewer(win, tree, season=season, wind_speed=wind_speed, wind_preset=wind_preset)
         except ValueError as e:
             raise ValueError(f"cannot show {getattr(tree, 'name', 'the tree')}: {' '.join(str(e).split())}") from None
         try:

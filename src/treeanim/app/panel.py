@@ -18,6 +18,7 @@ from imgui_bundle import imgui
 from ..model.params import ModeRange
 from ..model.tree import KINDS
 from ..physics.simulation import INTEGRATORS
+from ..physics.wind import WIND_PRESETS
 from .settings import save_preset
 from .viewer import PANEL_WIDTH, wind_angle
 
@@ -26,7 +27,11 @@ RANGES = {
     "season": (0.0, 1.0, "%.2f", False),
     "wind_speed": (0.0, 30.0, "%.1f m/s", False),
     "wind_angle": (0.0, 360.0, "%.0f°", False),
-    "turbulence": (1.0, 2.0, "%.2f", False),
+    "turbulence": (0.0, 1.0, "%.2f", False),  # physical: intensity at the canopy top
+    "turbulence_paper": (1.0, 2.0, "%.2f", False),  # paper: λ of Eq. 17
+    "gust_strength": (0.0, 2.0, "%.2f", False),
+    "gust_rate": (0.0, 30.0, "%.1f /min", False),
+    "length_scale": (0.5, 100.0, "%.1f m", True),
     "beta_u": (0.5, 3.0, "%.2f", False),
     "beta_vw": (0.5, 3.0, "%.2f", False),
     "c3": (0.0, 2.0, "%.2f", False),
@@ -114,7 +119,8 @@ class Panel:
         """Apply one setting; returns whether it was accepted (a refusal is shown in the panel).
 
         Names: ``preset`` (a shipped preset's name), ``season``, ``wind_speed``, ``wind_angle``
-        (degrees about +y), ``turbulence``, ``beta_u``, ``beta_vw``, ``c3``, ``c4``, ``ei_max``,
+        (degrees about +y), ``wind_preset`` (calm, breeze, windy, gale, storm), ``turbulence``,
+        ``gust_strength``, ``gust_rate``, ``length_scale``, ``beta_u``, ``beta_vw``, ``c3``, ``c4``, ``ei_max``,
         ``f:KIND`` and ``zeta:KIND`` ((min, max) of the edited season's table), ``time_scale``,
         ``integrator``, ``coupling``, ``load_path``, ``paused``, ``show_trace``, ``show_frames``, ``show_wind``.
         """
@@ -132,8 +138,14 @@ class Panel:
                 v.set_wind(speed=float(value))
             elif name == "wind_angle":
                 v.set_wind(angle=float(value))
-            elif name in ("turbulence", "beta_u", "beta_vw", "c3", "c4"):
+            elif name == "turbulence_paper":
+                v.set_wind(turbulence=float(value))
+            elif name in ("turbulence", "beta_u", "beta_vw", "c3", "c4", "gust_strength", "gust_rate",
+                          "length_scale"):
                 v.set_wind(**{name: float(value)})
+            elif name == "wind_preset":
+                v.set_wind(preset=str(value))
+                v.say(f"wind: {value}")
             elif name == "ei_max":
                 sim.physics = dataclasses.replace(sim.physics, ei_max=float(value))
             elif name.startswith(("f:", "zeta:")):
@@ -291,13 +303,27 @@ class Panel:
 
         # --- wind
         if self._header("Wind", open_=True):
+            physical = wind.model == "physical"
+            if physical:
+                names = list(WIND_PRESETS)
+                changed, idx = imgui.combo("named wind", -1, [f"{n} (Bf {WIND_PRESETS[n]['beaufort']})" for n in names])
+                self._rect("named wind", frame_only=True)
+                if changed and 0 <= idx < len(names):
+                    self.apply("wind_preset", names[idx])
             self._slider("speed", "wind_speed", wind.speed)
             self._slider("direction", "wind_angle", wind_angle(wind.direction))
-            self._slider("turbulence λ", "turbulence", wind.turbulence)
+            if physical:
+                self._slider("turbulence", "turbulence", wind.turbulence)
+                self._slider("gust strength", "gust_strength", wind.gust_strength)
+                self._slider("gust rate", "gust_rate", wind.gust_rate)
+                self._slider("length scale", "length_scale", wind.length_scale)
+            else:
+                self._slider("turbulence λ", "turbulence_paper", wind.turbulence)
             self._slider("β_u", "beta_u", wind.beta_u, deferred=True)
             self._slider("β_vw", "beta_vw", wind.beta_vw, deferred=True)
-            self._slider("c3 (vertical)", "c3", wind.c3)
-            self._slider("c4 (lateral)", "c4", wind.c4)
+            if not physical:
+                self._slider("c3 (vertical)", "c3", wind.c3)
+                self._slider("c4 (lateral)", "c4", wind.c4)
 
         # --- physics
         if self._header("Physics", open_=True):

@@ -31,6 +31,7 @@ import numpy as np
 from ..model.tree import Tree
 from ..physics.simulation import MAX_PULL, Simulation
 from ..physics.wind import WindField
+from ..physics.wind import wind_preset as wind_preset_kwargs
 from ..render.camera import OrbitCamera
 from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
 from ..render.picking import Picker
@@ -123,9 +124,9 @@ class ViewCamera(OrbitCamera):
 
 
 def _clone_wind(w: WindField | None, **changes) -> WindField:
-    """A new WindField with ``w``'s settings (its bounds left to the next Simulation to fit)."""
-    keys = ("direction", "speed", "grid", "beta_u", "beta_vw", "turbulence", "c3", "c4", "c5", "c6", "seed")
-    kw = {} if w is None else {k: getattr(w, k) for k in keys}
+    """A new WindField with ``w``'s settings (its bounds and automatic canopy height left to
+    the next Simulation to fit)."""
+    kw = {} if w is None else w.settings()
     if w is not None and not np.any(kw["direction"]):
         kw["direction"] = (1.0, 0.0, 0.0)
     kw.update(changes)
@@ -196,8 +197,9 @@ class Viewer:
         draw calls, panel), seconds; ``sim_ms`` and ``render_ms`` are their moving averages.
     """
 
-    def __init__(self, window: Window, tree: Tree, *, season: float = 0.0, wind_speed: float = 5.0,
-                 wind_angle_deg: float = 0.0, seed: int = 0, show_panel: bool = True, clock=None) -> None:
+    def __init__(self, window: Window, tree: Tree, *, season: float = 0.0, wind_speed: float | None = None,
+                 wind_angle_deg: float = 0.0, seed: int = 0, show_panel: bool = True, clock=None,
+                 wind_preset: str | None = None) -> None:
         self.window = window
         self.ctx = window.ctx
         self.gl_renderer = str(window.ctx.info.get("GL_RENDERER", "unknown renderer"))
@@ -234,8 +236,11 @@ class Viewer:
         self._load_path = True
         self.sim: Simulation | None = None
         self.renderer: Renderer | None = None
-        self._wind = _clone_wind(None, speed=float(wind_speed), direction=wind_direction(wind_angle_deg),
-                                 seed=self.seed)
+        named = wind_preset_kwargs(wind_preset) if wind_preset else {}
+        if wind_speed is not None:
+            named["speed"] = float(wind_speed)
+        named.setdefault("speed", 5.0)
+        self._wind = _clone_wind(None, direction=wind_direction(wind_angle_deg), seed=self.seed, **named)
         self._season = float(season)
         self.gui = Gui(window.handle, scale=window.content_scale)
         try:
@@ -291,8 +296,14 @@ class Viewer:
 
     def set_wind(self, **changes) -> None:
         """Change wind settings: ``speed``, ``angle`` (degrees), ``turbulence``, ``beta_u``,
-        ``beta_vw``, ``c3``, ``c4`` (each through the WindField's checked setters)."""
+        ``beta_vw``, ``c3``, ``c4``, ``gust_strength``, ``gust_rate``, ``length_scale``
+        (each through the WindField's checked setters), or ``preset`` (a named wind of
+        :data:`treeanim.physics.wind.WIND_PRESETS`: its speed, turbulence and gusts)."""
         w = self.sim.wind
+        if "preset" in changes:
+            changes = {**wind_preset_kwargs(changes.pop("preset")), **changes}
+            if w.model != changes.pop("model"):
+                raise ValueError("preset: the named winds are for the physical wind model")
         for k, v in changes.items():
             if k == "angle":
                 w.direction = wind_direction(v)

@@ -1,11 +1,45 @@
-"""The three-dimensional 1/f^β wind field of Hu, Chiba & He (2012), §4.3 (Eqs. 13–18).
+"""Wind over trees: the physical field (default) and the paper's (Hu, Chiba & He 2012).
 
-Three independent periodic noise grids (``fbm_noise``) give the along-wind (u), vertical (v)
-and lateral (w) turbulence. ``WindField`` samples them by periodic trilinear interpolation,
-shapes them with the logarithmic mean profile (Eq. 16) and the normalisation of Eq. 17, and
-turns the result into a world velocity along the user's wind direction (Eq. 18).
+``WindField(model="physical")`` (DESIGN §12, issue 11) is weather-like wind:
 
-Choices made here (DESIGN §7 leaves them open):
+* **Turbulence in metres.** Three independent Gaussian fields (along-wind u, vertical v,
+  lateral w) on one periodic tile of 96 × 48 × 96 cells covering 8 L × 4 L × 8 L (along,
+  up, across the wind), L the along-wind integral length scale (``length_scale``, by
+  default the canopy height). The tile is independent of any tree's box, so several trees
+  share one field. The 3-D spectrum is (k² + k0²)^−(β+2)/2 with k0 = 1/(1.339 L_c), so the
+  spectrum along any line is the von Kármán form (k1² + k0²)^−β/2: f^−β in the inertial
+  range, flat below the energy-containing eddies (L_u = L, L_v = L_w = L/3, as in canopy
+  flows). Its Fourier amplitudes are pre-compensated for trilinear interpolation (exactly
+  along the wind, on average across it), so the spectrum at a fixed point keeps its slope
+  up to about half the grid's Nyquist frequency U·12/(2L).
+* **Taylor's frozen turbulence.** The tile is carried downwind at the mean speed at the
+  canopy top, so a gust reaches a point d metres downwind d/U seconds later and gusts come
+  faster in stronger wind.
+* **Evolution, no loop.** Two layers of the tile, weighted sin(πs) and |cos(πs)| (their
+  squares sum to one, so the variance is steady), evolve with the travelled distance:
+  s grows by one every 4 L of travel, and each layer jumps to a new random place in the
+  tile (a hash of the seed and the cycle) when its weight is zero. Eddies so live for
+  about 4 L / U seconds and nothing repeats: the point's autocorrelation is ~0 beyond a few
+  L / U.
+* **Canopy profile.** Mean speed ``speed``·ln((y − d)/z0)/ln((h − d)/z0) above the canopy
+  height h (d = 0.7 h, z0 = 0.1 h) and ``speed``·exp(a(y/h − 1)) inside it (a ≈ 3.03, so
+  the two meet smoothly). Standard deviations σ_u : σ_w(lateral) : σ_v(vertical) =
+  1 : 0.75 : 0.5 with σ_u = ``turbulence``·``speed`` at and above h, decaying as
+  exp(y/h − 1) inside the canopy (the intensity rises towards the ground).
+* **Gusts.** ``gust_rate`` gusts a minute, each a plane front across the wind with a sharp
+  rise (0.5 L) and a slower decay (1.5 L) of peak ``gust_strength``·U·A (A uniform in
+  [0.5, 1.5]), carried at the wind speed; their mean is subtracted, so they are gusts and
+  lulls about the set mean.
+* **Mean direction.** Every fluctuation across the wind has zero mean by construction
+  (symmetric Gaussian noise, no rescaling), so the long-run mean wind points along
+  ``direction``.
+
+``WindField(model="paper")`` keeps the three-dimensional 1/f^β field of §4.3 (Eqs. 13–18)
+exactly. Three independent periodic noise grids (``fbm_noise``) give the along-wind (u),
+vertical (v) and lateral (w) turbulence. ``WindField`` samples them by periodic trilinear
+interpolation, shapes them with the logarithmic mean profile (Eq. 16) and the normalisation
+of Eq. 17, and turns the result into a world velocity along the user's wind direction
+(Eq. 18). Choices made there (DESIGN §7 leaves them open):
 
 * **Grid frame.** The grids are sampled in the *wind's own frame*: a point is scaled by the
   bounds to [0, 1]³, then to grid units (× (N − 1)), and its grid coordinates are its
@@ -18,6 +52,9 @@ Choices made here (DESIGN §7 leaves them open):
 * **Defaults.** ``c2 = 50 / H`` (the profile starts at 2 % of the tree top H, the top of
   the bounds) and ``c1 = 1 / ln(c2·H)`` so W(H) = 1 and ``speed`` is the mean-profile speed at
   the tree top. ``c3 = 0.5``, ``c4 = 1.0``, ``c5 = 4`` cells/s, ``c6 = 0.5`` cells/s.
+
+Named winds by Beaufort number (:data:`WIND_PRESETS`, :func:`wind_preset`,
+``WindField.from_preset``): calm, breeze, windy, gale, storm.
 """
 
 from __future__ import annotations
@@ -32,8 +69,10 @@ import scipy.fft
 
 from .checks import finite_float, finite_vector3
 
-__all__ = ["fbm_noise", "WindField"]
+__all__ = ["fbm_noise", "WindField", "WIND_PRESETS", "wind_preset", "MODELS"]
 
+#: The wind models: weather-like (default) and Hu, Chiba & He's Eqs. 13–18.
+MODELS = ("physical", "paper")
 #: Default bounds ((x0, y0, z0), (x1, y1, z1)) in metres, until a Simulation fits the field.
 DEFAULT_BOUNDS = ((-5.0, 0.0, -5.0), (5.0, 10.0, 5.0))
 #: Refused above this wind speed (m/s): far beyond any wind, and it keeps the field finite.
@@ -44,9 +83,21 @@ MAX_GRID = 256
 MAX_BETA = 10.0
 #: Largest c1, c3, c4 accepted (anything near it is meaningless; it keeps the field finite).
 MAX_COEFF = 1000.0
+#: Largest gust strength (fraction of the mean speed) and gust rate (per minute) accepted.
+MAX_GUST_STRENGTH = 2.0
+MAX_GUST_RATE = 30.0
+#: Smallest automatic length scale (m): below it (grass) the eddies are still metres across.
+MIN_AUTO_LENGTH = 1.0
+#: Travel (in length scales) over which the turbulence evolves through one cycle.
+EVOLUTION_LENGTH = 4.0
 #: Bounds must lie within ±_MAX_COORD m and be at least _MIN_EXTENT m thick on each axis.
 _MAX_COORD = 1e9
 _MIN_EXTENT = 1e-9
+#: Length scale and canopy height limits (m).
+_MIN_LENGTH = 0.01
+_MAX_LENGTH = 1e4
+#: The physical clocks run for at most this many seconds from their last change.
+_TIME_CLIP = 1e12
 #: Points per vectorised pass of sample() (bounds the scratch memory).
 _CHUNK = 16384
 #: A direction whose horizontal part is at most this fraction of its length is "vertical".
@@ -56,8 +107,50 @@ _COORD_CLIP = 1e12
 #: ... and grid coordinates to ±2^40 cells, where q mod N is still exact.
 _GRID_CLIP = 2.0**40
 
+#: Named winds by Beaufort number: speed (m/s at the canopy top, the middle of the
+#: Beaufort band), turbulence intensity, gust strength and gusts per minute.
+WIND_PRESETS: dict[str, dict] = {
+    "calm": dict(beaufort=1, speed=1.0, turbulence=0.2, gust_strength=0.1, gust_rate=1.0),
+    "breeze": dict(beaufort=3, speed=4.5, turbulence=0.25, gust_strength=0.25, gust_rate=3.0),
+    "windy": dict(beaufort=5, speed=9.5, turbulence=0.3, gust_strength=0.35, gust_rate=4.0),
+    "gale": dict(beaufort=8, speed=19.0, turbulence=0.3, gust_strength=0.4, gust_rate=5.0),
+    "storm": dict(beaufort=10, speed=26.5, turbulence=0.35, gust_strength=0.5, gust_rate=6.0),
+}
+
+
+def wind_preset(name: str) -> dict:
+    """WindField keyword arguments for a named wind (physical model).
+
+    Parameters
+    ----------
+    name : str
+        ``calm`` (Beaufort 1, light air, 1 m/s), ``breeze`` (3, gentle breeze, 4.5 m/s),
+        ``windy`` (5, fresh breeze, 9.5 m/s), ``gale`` (8, 19 m/s) or ``storm`` (10,
+        26.5 m/s).
+
+    Returns
+    -------
+    dict
+        ``speed``, ``turbulence``, ``gust_strength``, ``gust_rate`` and ``model``.
+
+    Raises
+    ------
+    ValueError
+        If the name is not one of :data:`WIND_PRESETS`.
+    """
+    if name not in WIND_PRESETS:
+        raise ValueError(f"wind preset must be one of {', '.join(WIND_PRESETS)}, got {name!r}")
+    kw = {k: v for k, v in WIND_PRESETS[name].items() if k != "beaufort"}
+    return dict(kw, model="physical")
+
 
 # ----------------------------------------------------------------------------- validation
+
+
+def _optional_length(name: str, value) -> float | None:
+    if value is None:
+        return None
+    return _in_range(name, value, _MIN_LENGTH, _MAX_LENGTH, " m")
 
 
 def _in_range(name: str, value, lo: float, hi: float, what: str = "") -> float:
@@ -198,7 +291,13 @@ def _cached_grid(n: int, beta: float, seed: int, component: int) -> np.ndarray:
 
 
 class WindField:
-    """Turbulent 3-D wind over a tree (Eqs. 13–18), sampled at any points and time.
+    """Wind over trees, sampled at any points and time: the physical model or the paper's.
+
+    ``model="physical"`` (the default, DESIGN §12) is turbulence in metres carried downwind
+    at the wind speed (Taylor), evolving along its way so that it never repeats, with a
+    von Kármán f^−β spectrum, a canopy profile and gusts; see the module docstring.
+    ``model="paper"`` is Hu, Chiba & He (2012) Eqs. 13–18 exactly as before issue 11 (same
+    samples, bit for bit, for the same parameters).
 
     Parameters
     ----------
@@ -206,59 +305,70 @@ class WindField:
         Wind direction in world coordinates (y up); only its direction is used. It must have
         a horizontal part; a zero vector means calm (``sample`` returns zeros).
     speed : float, default 5.0
-        Wind speed in m/s at the tree top (the mean profile is 1 there), in [0, 1000].
-        0 means calm.
+        Mean wind speed in m/s at the canopy top (physical) or the tree top (paper), in
+        [0, 1000]. 0 means calm.
     grid : int, default 32
-        Edge N of the three N³ noise grids, in [4, 256].
-    beta_u, beta_vw : float, default 1.67 and 1.33
-        Spectral exponents of the along-wind and of the vertical and lateral noise (Eq. 15),
-        in [−10, 10].
-    turbulence : float, default 1.5
-        λ of Eq. 17, the noise scaling factor, in [1, 2].
-    c1 : float or None, default None
-        Mean-profile scale of Eq. 16, in [0, 1000]. None: 1 / ln(c2·H), so W(H) = 1 at the
-        top H of the bounds.
-    c2 : float or None, default None
-        Mean-profile constant of Eq. 16 in 1/m, in [1e-12, 1e12]; the profile is zero below
-        h = 1/c2. None: 50 / H, i.e. the wind starts at 2 % of the tree's height.
-    c3 : float, default 0.5
-        Vertical turbulence scale of Eq. 17, in [0, 1000].
-    c4 : float, default 1.0
-        Lateral turbulence scale of Eq. 17, in [0, 1000].
-    c5 : float, default 4.0
-        Downwind speed of the frozen turbulence, in grid cells per second (Eq. 17).
-    c6 : float, default 0.5
-        Lateral drift of the frozen turbulence, in grid cells per second (Eq. 17).
+        Paper: edge N of the three N³ noise grids, in [4, 256]. Unused by the physical model.
+    beta_u, beta_vw : float or None
+        Spectral exponents of the along-wind and of the vertical and lateral turbulence, in
+        [−10, 10]. None: 5/3 and 5/3 (physical, Kolmogorov), 1.67 and 1.33 (paper, Eq. 15).
+    turbulence : float or None
+        Physical: the along-wind turbulence intensity σ_u/U at the canopy top, in [0, 1];
+        None: 0.3. Paper: λ of Eq. 17, in [1, 2]; None: 1.5.
+    c1, c2, c3, c4, c5, c6 : float
+        Paper only (Eqs. 16–17): c1 in [0, 1000] or None (1 / ln(c2·H)), c2 in [1e-12, 1e12]
+        1/m or None (50 / H), c3 and c4 the vertical and lateral scales in [0, 1000] (0.5
+        and 1.0), c5 and c6 the downwind and lateral drift in grid cells per second (4 and
+        0.5). Kept, and validated, by the physical model, which does not use them.
     seed : int, default 0
-        Seed of the noise; component c (0 = u, 1 = v, 2 = w) is
-        ``fbm_noise(grid, beta, (seed, c))``.
+        Seed of the noise (both models) and of the gusts.
     bounds : ((x0, y0, z0), (x1, y1, z1)) or None
-        Box in metres that maps onto the grid; None means ((−5, 0, −5), (5, 10, 5)) until a
-        Simulation calls ``fit`` with its tree's rest bounding box. Every extent must be
-        positive (at least 1e-9 m) and the box within ±1e9 m; its top y1 is H.
+        Paper: box in metres that maps onto the grid; None means ((−5, 0, −5), (5, 10, 5))
+        until a Simulation calls ``fit`` with its tree's rest bounding box. Every extent must
+        be positive (at least 1e-9 m) and the box within ±1e9 m; its top y1 is H. Physical:
+        only its top y1 is used, as the canopy height when ``canopy_height`` is None.
+    model : {"physical", "paper"}, default "physical"
+        Which field; fixed at construction (keyword only).
+    length_scale : float or None
+        Physical: the along-wind integral length scale L of the turbulence in metres, in
+        [0.01, 10000]; the vertical and lateral ones are L/3. None: the canopy height (at
+        least 1 m). Keyword only.
+    canopy_height : float or None
+        Physical: the canopy height h in metres, in [0.01, 10000], the height of ``speed``
+        and of the canopy profile. None: the top of ``bounds`` (10 m until a Simulation fits
+        the field to its tree). Keyword only.
+    gust_strength : float, default 0.3
+        Physical: mean peak speed of a gust above the mean, as a fraction of the mean
+        speed, in [0, 2]. Keyword only.
+    gust_rate : float, default 4.0
+        Physical: gusts per minute passing a point, in [0, 30]. Keyword only.
 
     Notes
     -----
-    The grids are sampled in the wind frame (û along the wind, v̂ vertical, ŵ lateral):
-    a point's grid coordinates are its components along (û, v̂, ŵ) after scaling the bounds
-    to [0, N − 1]³, shifted by (c5·t, 0, c6·t). ``direction``, ``speed``, ``turbulence`` and
-    c1 … c6 can be changed at any time at no cost; changing ``grid``, ``beta_u``,
-    ``beta_vw`` or ``seed`` rebuilds the grids (cached). All setters validate their value
-    and raise ``ValueError`` naming the argument.
+    Every setter validates its value and raises a one-line ``ValueError`` naming the
+    argument; the old value is kept. ``direction``, ``speed``, ``turbulence``,
+    ``length_scale``, ``canopy_height``, ``gust_strength``, ``gust_rate`` and c1 … c6 change
+    at no cost; ``beta_u``, ``beta_vw``, ``seed`` (and, for the paper, ``grid``) rebuild
+    the noise (cached). Changing the speed, the length scale or the gust rate keeps the
+    field continuous in time: the downwind travel, the evolution and the gust clock are
+    integrated piecewise from the last sampled time, so ``sample`` is a pure function of
+    ``t`` between changes. Turning the wind rotates the field about the world origin.
+    ``sample`` is thread-safe.
 
-    Eq. 17 makes the speed of each sample W·(1 + λ(s2/s1 − 0.5)); the mean of that factor
-    over one seed's grids is near 1 (about 0.85–1.0), so ``speed`` is the tree-top speed of
-    the mean profile, and the measured mean there is a little lower. The noise grids are
+    Paper model: Eq. 17 makes the speed of each sample W·(1 + λ(s2/s1 − 0.5)); the mean of
+    that factor over one seed's grids is near 1 (about 0.85–1.0). The grids are
     standardised to exactly [−0.5, 0.5], which leaves each a small residual mean, so one
-    seed's mean wind can be a few degrees off ``direction`` (the average over seeds is not).
-    Where s2 = 0 (no direction) the wind is zero. Interpolation runs in float32 (relative
-    error ~1e-7); ``sample`` keeps per-thread scratch buffers, so it is thread-safe.
+    seed's mean wind can be a few degrees off ``direction``. Interpolation runs in float32.
 
     Examples
     --------
     >>> wind = WindField(direction=(1, 0, 1), speed=8.0)
     >>> wind.sample([[0.0, 5.0, 0.0], [1.0, 9.0, 2.0]], t=0.5).shape
     (2, 3)
+    >>> WindField.from_preset("gale").speed
+    19.0
+    >>> WindField(model="paper").turbulence  # λ of Eq. 17
+    1.5
     """
 
     def __init__(
@@ -266,9 +376,9 @@ class WindField:
         direction=(1, 0, 0),
         speed: float = 5.0,
         grid: int = 32,
-        beta_u: float = 1.67,
-        beta_vw: float = 1.33,
-        turbulence: float = 1.5,
+        beta_u: float | None = None,
+        beta_vw: float | None = None,
+        turbulence: float | None = None,
         c1: float | None = None,
         c2: float | None = None,
         c3: float = 0.5,
@@ -277,8 +387,22 @@ class WindField:
         c6: float = 0.5,
         seed: int = 0,
         bounds=None,
+        *,
+        model: str = "physical",
+        length_scale: float | None = None,
+        canopy_height: float | None = None,
+        gust_strength: float = 0.3,
+        gust_rate: float = 4.0,
     ):
+        if model not in MODELS:
+            raise ValueError(f"model must be one of {', '.join(map(repr, MODELS))}, got {model!r}")
+        self._model = model
+        paper = model == "paper"
         self._grid = _integer("grid", grid, 4, MAX_GRID)
+        if beta_u is None:
+            beta_u = 1.67 if paper else 5.0 / 3.0
+        if beta_vw is None:
+            beta_vw = 1.33 if paper else 5.0 / 3.0
         self._beta_u = _in_range("beta_u", beta_u, -MAX_BETA, MAX_BETA)
         self._beta_vw = _in_range("beta_vw", beta_vw, -MAX_BETA, MAX_BETA)
         self._seed = _integer("seed", seed, 0)
@@ -286,17 +410,68 @@ class WindField:
         self._c2 = None if c2 is None else self._check_c2(c2)
         b = _bounds(DEFAULT_BOUNDS if bounds is None else bounds)
         _check_extent(b)
-        self._constants(b, self._c1, self._c2)
+        if paper:
+            self._constants(b, self._c1, self._c2)
         self._bounds = b
+        self._length_scale = _optional_length("length_scale", length_scale)
+        self._canopy_height = _optional_length("canopy_height", canopy_height)
+        self._gust_strength = _in_range("gust_strength", gust_strength, 0.0, MAX_GUST_STRENGTH)
+        self._gust_rate = _in_range("gust_rate", gust_rate, 0.0, MAX_GUST_RATE, " per minute")
         self.direction = direction
-        self.speed = speed
-        self.turbulence = turbulence
+        self._speed = _in_range("speed", speed, 0.0, MAX_SPEED, " m/s")
+        self.turbulence = (1.5 if paper else 0.3) if turbulence is None else turbulence
         self.c3 = c3
         self.c4 = c4
         self.c5 = c5
         self.c6 = c6
         self._tables = None  # padded, raveled float32 grids, built on first use
         self._local = threading.local()  # per-thread scratch buffers for sample()
+        # Physical clocks: (t0, travel a0 in m, evolution s0 in cycles, gusts g0) at t0;
+        # each advances linearly from t0 at its current rate (see _rebase).
+        self._clock = (0.0, 0.0, 0.0, 0.0)
+        self._t_last = 0.0
+
+    @classmethod
+    def from_preset(cls, name: str, **overrides) -> "WindField":
+        """A physical field from a named wind (:data:`WIND_PRESETS`, by Beaufort number).
+
+        Parameters
+        ----------
+        name : str
+            One of ``calm``, ``breeze``, ``windy``, ``gale``, ``storm``.
+        **overrides
+            Any other constructor argument (``direction``, ``seed``, ...) or a preset value
+            to replace.
+
+        Returns
+        -------
+        WindField
+        """
+        return cls(**{**wind_preset(name), **overrides})
+
+    def settings(self) -> dict:
+        """The constructor arguments that rebuild this field for another tree.
+
+        Explicit values only: ``bounds`` and an automatic ``canopy_height`` or
+        ``length_scale`` are left out, so the next Simulation fits them to its tree.
+
+        Returns
+        -------
+        dict
+            Keyword arguments for :class:`WindField`.
+        """
+        kw = dict(direction=self.direction, speed=self._speed, grid=self._grid,
+                  beta_u=self._beta_u, beta_vw=self._beta_vw, turbulence=self._turbulence,
+                  c1=self._c1, c2=self._c2, c3=self._c3, c4=self._c4, c5=self._c5, c6=self._c6,
+                  seed=self._seed, model=self._model, length_scale=self._length_scale,
+                  canopy_height=self._canopy_height, gust_strength=self._gust_strength,
+                  gust_rate=self._gust_rate)
+        return kw
+
+    @property
+    def model(self) -> str:
+        """``"physical"`` or ``"paper"`` (read-only)."""
+        return self._model
 
     # -- cheap parameters ------------------------------------------------------------------
 
@@ -333,12 +508,14 @@ class WindField:
 
     @property
     def speed(self) -> float:
-        """Wind speed at the tree top, m/s, in [0, 1000]."""
+        """Mean wind speed at the canopy top (paper: the tree top), m/s, in [0, 1000]."""
         return self._speed
 
     @speed.setter
     def speed(self, value) -> None:
-        self._speed = _in_range("speed", value, 0.0, MAX_SPEED, " m/s")
+        x = _in_range("speed", value, 0.0, MAX_SPEED, " m/s")
+        self._rebase()
+        self._speed = x
 
     @property
     def calm(self) -> bool:
@@ -347,12 +524,65 @@ class WindField:
 
     @property
     def turbulence(self) -> float:
-        """λ of Eq. 17, in [1, 2]."""
+        """Physical: turbulence intensity σ_u/U at the canopy top, in [0, 1].
+        Paper: λ of Eq. 17, in [1, 2]."""
         return self._turbulence
 
     @turbulence.setter
     def turbulence(self, value) -> None:
-        self._turbulence = _in_range("turbulence", value, 1.0, 2.0)
+        if self._model == "paper":
+            self._turbulence = _in_range("turbulence", value, 1.0, 2.0)
+        else:
+            self._turbulence = _in_range("turbulence", value, 0.0, 1.0, " (intensity)")
+
+    @property
+    def length_scale(self) -> float:
+        """Along-wind integral length scale L of the turbulence, m (physical).
+
+        Set None for automatic: the canopy height, at least 1 m."""
+        if self._length_scale is not None:
+            return self._length_scale
+        return max(self.canopy_height, MIN_AUTO_LENGTH)
+
+    @length_scale.setter
+    def length_scale(self, value) -> None:
+        x = _optional_length("length_scale", value)
+        self._rebase()
+        self._length_scale = x
+
+    @property
+    def canopy_height(self) -> float:
+        """Canopy height h, m (physical): the height of ``speed`` and of the profile's
+        displacement (0.7 h) and roughness (0.1 h). Set None for the top of ``bounds``."""
+        if self._canopy_height is not None:
+            return self._canopy_height
+        return min(max(float(self._bounds[1, 1]), _MIN_LENGTH), _MAX_LENGTH)
+
+    @canopy_height.setter
+    def canopy_height(self, value) -> None:
+        x = _optional_length("canopy_height", value)
+        self._rebase()
+        self._canopy_height = x
+
+    @property
+    def gust_strength(self) -> float:
+        """Mean peak gust above the mean speed, as a fraction of it, in [0, 2] (physical)."""
+        return self._gust_strength
+
+    @gust_strength.setter
+    def gust_strength(self, value) -> None:
+        self._gust_strength = _in_range("gust_strength", value, 0.0, MAX_GUST_STRENGTH)
+
+    @property
+    def gust_rate(self) -> float:
+        """Gusts per minute passing a point, in [0, 30] (physical)."""
+        return self._gust_rate
+
+    @gust_rate.setter
+    def gust_rate(self, value) -> None:
+        x = _in_range("gust_rate", value, 0.0, MAX_GUST_RATE, " per minute")
+        self._rebase()
+        self._gust_rate = x
 
     @property
     def c1(self) -> float:
@@ -362,7 +592,8 @@ class WindField:
     @c1.setter
     def c1(self, value) -> None:
         c1 = None if value is None else _in_range("c1", value, 0.0, MAX_COEFF)
-        self._constants(self._bounds, c1, self._c2)
+        if self._model == "paper":
+            self._constants(self._bounds, c1, self._c2)
         self._c1 = c1
 
     @property
@@ -373,7 +604,8 @@ class WindField:
     @c2.setter
     def c2(self, value) -> None:
         c2 = None if value is None else self._check_c2(value)
-        self._constants(self._bounds, self._c1, c2)
+        if self._model == "paper":
+            self._constants(self._bounds, self._c1, c2)
         self._c2 = c2
 
     @property
@@ -423,13 +655,17 @@ class WindField:
     def bounds(self, value) -> None:
         b = _bounds(value)
         _check_extent(b)
-        self._constants(b, self._c1, self._c2)
+        if self._model == "paper":
+            self._constants(b, self._c1, self._c2)
+        self._rebase()
         self._bounds = b
 
     def fit(self, bounds) -> None:
         """Fit the field to a tree's rest bounding box (what a Simulation calls).
 
-        Like setting ``bounds``, except that an axis of (near) zero extent — a straight
+        Paper: the box maps onto the noise grid. Physical: only the box top is used, as the
+        canopy height (and so the default length scale) when ``canopy_height`` is None; the
+        turbulence stays in metres, whatever the box. Like setting ``bounds``, except that an axis of (near) zero extent — a straight
         vertical beam has no width — is widened symmetrically to 10 % of the largest extent.
 
         Parameters
@@ -489,7 +725,12 @@ class WindField:
         return self._constants(self._bounds, self._c1, self._c2)
 
     def profile(self, h) -> np.ndarray:
-        """Mean wind profile W(h) = c1·ln(c2·h) of Eq. 16, 0 below h = 1/c2.
+        """Mean wind profile: the mean speed at height h over ``speed``.
+
+        Physical: the canopy profile, ln((h − d)/z0) / ln((h_c − d)/z0) above the canopy
+        height h_c (d = 0.7 h_c, z0 = 0.1 h_c) and exp(a(h/h_c − 1)) inside it, with
+        a = 1/(0.3 ln 3) ≈ 3.03 so the two meet smoothly; 1 at h_c. Paper: W(h) = c1·ln(c2·h)
+        of Eq. 16, 0 below h = 1/c2, 1 at the top of the bounds by default.
 
         Parameters
         ----------
@@ -499,11 +740,13 @@ class WindField:
         Returns
         -------
         numpy.ndarray
-            W(h), dimensionless (1 at the top of the bounds by default), same shape as h.
+            The profile, dimensionless, same shape as h.
         """
         h = np.asarray(h, dtype=np.float64)
         if not np.all(np.isfinite(h)):
             raise ValueError("h must be finite")
+        if self._model != "paper":
+            return _canopy_mean(h, self.canopy_height)
         c1, c2 = self._profile_constants()
         log_h0 = -math.log(c2)
         # ln(c2·h) = ln h − ln(1/c2), written so that no finite h overflows.
@@ -587,18 +830,41 @@ class WindField:
             ws = self._local.ws = _Workspace(max(n, 256))
         return ws
 
+    # -- physical clocks ------------------------------------------------------------------------
+
+    def _rates(self) -> tuple[float, float, float]:
+        """(downwind travel m/s, evolution cycles/s, gusts/s) at the current settings."""
+        u = self._speed
+        return u, u / (EVOLUTION_LENGTH * self.length_scale), self._gust_rate / 60.0
+
+    def _clocks(self, t: float) -> tuple[float, float, float]:
+        """(travel a in m, evolution s in cycles, gust count g) at time t."""
+        t0, a0, s0, g0 = self._clock
+        dt = min(max(t - t0, -_TIME_CLIP), _TIME_CLIP)
+        ra, rs, rg = self._rates()
+        return a0 + ra * dt, s0 + rs * dt, g0 + rg * dt
+
+    def _rebase(self) -> None:
+        """Start the clocks afresh at the last sampled time, before a rate changes."""
+        if getattr(self, "_model", "paper") == "paper" or not hasattr(self, "_clock"):
+            return
+        t = self._t_last
+        self._clock = (t, *self._clocks(t))
+
     # -- sampling ------------------------------------------------------------------------------
 
     def sample(self, points, t: float) -> np.ndarray:
-        """World wind velocity at ``points`` and time ``t`` (Eqs. 16–18).
+        """World wind velocity at ``points`` and time ``t``.
 
         Parameters
         ----------
         points : array_like, shape (K, 3) or (3,)
-            World positions in metres (y up). Any finite values; outside the bounds the field
-            repeats periodically (the mean profile keeps growing with height).
+            World positions in metres (y up, ground at y = 0). Any finite values. Paper:
+            outside the bounds the field repeats periodically. Physical: the turbulence
+            repeats every 8 L along and across the wind and 4 L up, in space only (in time
+            it never repeats); the mean profile keeps growing with height.
         t : float
-            Time in seconds (moves the frozen turbulence, Eq. 17).
+            Time in seconds (moves the turbulence downwind).
 
         Returns
         -------
@@ -623,7 +889,12 @@ class WindField:
         t = finite_float("t", t)
         k = p.shape[0]
         out = np.zeros((k, 3))
+        if self._model != "paper":
+            self._t_last = t
         if self.calm or k == 0:
+            return out
+        if self._model != "paper":
+            _sample_physical(self, p, t, out)
             return out
 
         n = self._grid
@@ -652,8 +923,16 @@ class WindField:
 
     def __repr__(self) -> str:
         d = ", ".join(f"{x:g}" for x in self._direction)
+        if self._model != "paper":
+            return (
+                f"WindField(model='physical', direction=({d}), speed={self._speed:g}, "
+                f"turbulence={self._turbulence:g}, length_scale={self.length_scale:g}, "
+                f"canopy_height={self.canopy_height:g}, gust_strength={self._gust_strength:g}, "
+                f"gust_rate={self._gust_rate:g}, beta_u={self._beta_u:g}, "
+                f"beta_vw={self._beta_vw:g}, seed={self._seed})"
+            )
         return (
-            f"WindField(direction=({d}), speed={self._speed:g}, grid={self._grid}, "
+            f"WindField(model='paper', direction=({d}), speed={self._speed:g}, grid={self._grid}, "
             f"beta_u={self._beta_u:g}, beta_vw={self._beta_vw:g}, "
             f"turbulence={self._turbulence:g}, c1={self.c1:.4g}, c2={self.c2:.4g}, "
             f"c3={self._c3:g}, c4={self._c4:g}, c5={self._c5:g}, c6={self._c6:g}, "
@@ -770,3 +1049,270 @@ def _corner_offsets(mp: int) -> np.ndarray:
     d = np.arange(2)
     off = (d[:, None, None] * mp + d[None, :, None]) * mp + d[None, None, :]
     return off.reshape(8)
+
+
+# ----------------------------------------------------------------------------- physical model
+
+#: The physical tile: cells along, up and across the wind; cells per length scale L.
+_TILE = (128, 48, 96)
+_CELLS_PER_L = 16.0
+#: von Kármán: k0 = 1 / (1.339 L) puts the integral scale of (k² + k0²)^−5/6 at L.
+_VON_KARMAN = 1.339
+#: Integral scales of the vertical and lateral components, in L (canopy flows: L_w ≈ h/3).
+_CROSS_SCALE = 1.0
+#: σ_u : σ_v(vertical) : σ_w(lateral) in the wind frame (along, vertical, lateral).
+SIGMA_RATIOS = (1.0, 0.5, 0.75)
+#: Canopy profile: displacement height and roughness length in canopy heights, and the
+#: attenuation inside the canopy (matches the log law's slope at the top), and of σ there.
+DISPLACEMENT = 0.7
+ROUGHNESS = 0.1
+_LOG_TOP = math.log((1.0 - DISPLACEMENT) / ROUGHNESS)
+CANOPY_ATTENUATION = 1.0 / ((1.0 - DISPLACEMENT) * _LOG_TOP)
+SIGMA_ATTENUATION = 1.0
+#: Gust shape: rise and decay widths (Gaussian σ) in length scales; jitter of the gust
+#: times (fraction of the mean interval); widths are capped at this many intervals.
+GUST_RISE = 0.5
+GUST_DECAY = 1.5
+_GUST_JITTER = 0.7
+_GUST_MAX_WIDTH = (1.0, 3.0)
+
+
+def _canopy_mean(h: np.ndarray, top: float) -> np.ndarray:
+    """Mean speed over the speed at the canopy top ``top`` at heights ``h`` (m)."""
+    z = np.minimum(np.maximum(h, 0.0), _COORD_CLIP) / top
+    above = np.log((np.maximum(z, 1.0) - DISPLACEMENT) / ROUGHNESS) / _LOG_TOP
+    inside = np.exp(CANOPY_ATTENUATION * (np.minimum(z, 1.0) - 1.0))
+    return np.where(z >= 1.0, above, inside)
+
+
+def _canopy_sigma(h: np.ndarray, top: float) -> np.ndarray:
+    """σ over σ at the canopy top at heights ``h``: 1 above, decaying inside."""
+    z = np.minimum(np.maximum(h, 0.0), top) / top
+    return np.exp(SIGMA_ATTENUATION * (z - 1.0))
+
+
+_M64 = (1 << 64) - 1
+
+
+def _mix(x: np.ndarray) -> np.ndarray:
+    """splitmix64's finaliser on a uint64 array (wrapping arithmetic)."""
+    x = x ^ (x >> np.uint64(30))
+    x = x * np.uint64(0xBF58476D1CE4E5B9)
+    x = x ^ (x >> np.uint64(27))
+    x = x * np.uint64(0x94D049BB133111EB)
+    return x ^ (x >> np.uint64(31))
+
+
+def _hash_uniform(seed: int, stream: int, k: np.ndarray, lanes: int) -> np.ndarray:
+    """Deterministic uniform [0, 1) numbers, (len(k), lanes), for integer keys ``k``."""
+    base = (seed * 0xD1B54A32D192ED03 + stream * 0x8CB92BA72F3D8DD7 + 0x632BE59BD9B4E019) & _M64
+    kk = np.asarray(k, dtype=np.int64).astype(np.uint64)
+    x = kk[:, None] * np.uint64(lanes) + np.arange(lanes, dtype=np.uint64)[None, :]
+    x = _mix(x * np.uint64(0x9E3779B97F4A7C15) + np.uint64(base))
+    return (x >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)
+
+
+@lru_cache(maxsize=4)
+def _physical_table(beta_u: float, beta_vw: float, seed: int) -> np.ndarray:
+    """The padded tile's look-up tables: (u + i·v as complex64, w as float32), raveled."""
+    nx, ny, nz = _TILE
+    kx = 2 * np.pi * np.fft.fftfreq(nx)
+    ky = 2 * np.pi * np.fft.fftfreq(ny)
+    kz = 2 * np.pi * np.fft.rfftfreq(nz)
+    k2 = kx[:, None, None] ** 2 + ky[None, :, None] ** 2 + kz[None, None, :] ** 2
+    # Trilinear interpolation: along the wind a point's series is the piecewise-linear
+    # interpolation of the grid line, whose amplitude transfer is sinc²; across, the
+    # variance transfer averaged over the cell is (2 + cos k)/3 per axis.
+    across = lambda k: (2.0 + np.cos(k)) / 3.0  # noqa: E731
+    comp = (np.sinc(kx / (2 * np.pi)) ** -2)[:, None, None] \
+        * (across(ky) ** -0.5)[None, :, None] * (across(kz) ** -0.5)[None, None, :]
+    seen = across(kx)[:, None, None] * across(ky)[None, :, None] * across(kz)[None, None, :]
+    weight = np.full(k2.shape, 2.0)
+    weight[..., 0] = 1.0
+    if nz % 2 == 0:
+        weight[..., -1] = 1.0
+    gain = comp * comp * seen * weight
+    tile = np.zeros((nx + 1, ny + 1, nz + 1, 3), dtype=np.float32)
+    scales = (1.0, _CROSS_SCALE, _CROSS_SCALE)
+    for c, beta in enumerate((beta_u, beta_vw, beta_vw)):
+        k0 = 1.0 / (_VON_KARMAN * _CELLS_PER_L * scales[c])
+        log_amp = -0.25 * (beta + 2.0) * np.log(k2 + k0 * k0)
+        log_amp -= log_amp.max()
+        amp = np.exp(log_amp)
+        amp[0, 0, 0] = 0.0  # zero mean over the tile
+        if c:  # across the wind every line along it has zero mean: no long-run veer
+            amp[0] = 0.0
+        rng = np.random.default_rng((seed, 11, c))
+        spec = scipy.fft.rfftn(rng.standard_normal((nx, ny, nz)), axes=(0, 1, 2)) * amp
+        var = float(np.sum(gain * (spec.real**2 + spec.imag**2))) / float(nx * ny * nz) ** 2
+        spec *= comp / math.sqrt(var) if var > 0 else 0.0
+        field = scipy.fft.irfftn(spec, s=(nx, ny, nz), axes=(0, 1, 2))
+        tile[:nx, :ny, :nz, c] = field
+    tile[nx] = tile[0]
+    tile[:, ny] = tile[:, 0]
+    tile[:, :, nz] = tile[:, :, 0]
+    # u and v travel together as one complex64 (8-byte gathers), w alone (as the paper's).
+    uv = np.empty(tile[..., 0].size, dtype=np.complex64)
+    uv.real = tile[..., 0].ravel()
+    uv.imag = tile[..., 1].ravel()
+    w = np.ascontiguousarray(tile[..., 2]).ravel()
+    uv.setflags(write=False)
+    w.setflags(write=False)
+    return uv, w
+
+
+@lru_cache(maxsize=2)
+def _tile_corners() -> np.ndarray:
+    nx, ny, nz = _TILE
+    d = np.arange(2)
+    off = (d[:, None, None] * (ny + 1) + d[None, :, None]) * (nz + 1) + d[None, None, :]
+    return off.reshape(8)
+
+
+_TILE_DIMS = np.array(_TILE, dtype=np.float64)[:, None]
+_TILE_INT = np.array(_TILE, dtype=np.intp)[:, None]
+_TILE_LAST = _TILE_INT - 1
+
+
+def _trilinear(tables, q: np.ndarray, offsets, weights) -> tuple[np.ndarray, np.ndarray]:
+    """Periodic trilinear look-up of the tile, blending layers before the interpolation.
+
+    ``q`` (3, n) cell coordinates (overwritten); ``offsets`` whole-cell shifts (3,) of each
+    layer and ``weights`` their weights. Whole-cell offsets share the fractions, so the
+    layers' corner values blend first and one interpolation serves them all. Returns
+    ((n,) complex64 u + i·v, (n,) float32 w)."""
+    tab_uv, tab_w = tables
+    np.clip(q, -_GRID_CLIP, _GRID_CLIP, out=q)
+    fl = np.floor(q / _TILE_DIMS)
+    fl *= _TILE_DIMS
+    q -= fl
+    i = q.astype(np.intp)
+    np.minimum(i, _TILE_LAST, out=i)
+    np.maximum(i, 0, out=i)
+    fr = np.subtract(q, i, dtype=np.float32)
+    nx, ny, nz = _TILE
+    corners = _tile_corners()[:, None]
+    blend_uv = blend_w = None
+    for off, wt in zip(offsets, weights):
+        ij = i + off[:, None]
+        ij -= (ij > _TILE_LAST) * _TILE_INT
+        base = ij[0] * (ny + 1)
+        base += ij[1]
+        base *= nz + 1
+        base += ij[2]
+        idx = np.add(corners, base)
+        vuv = tab_uv.take(idx, mode="clip")
+        vw = tab_w.take(idx, mode="clip")
+        vuv *= np.float32(wt)
+        vw *= np.float32(wt)
+        if blend_uv is None:
+            blend_uv, blend_w = vuv, vw
+        else:
+            blend_uv += vuv
+            blend_w += vw
+    fa, fb, fc = fr
+    out = []
+    for vals in (blend_uv, blend_w):
+        d = vals[4:8] - vals[0:4]
+        d *= fa
+        d += vals[0:4]
+        e = d[2:4] - d[0:2]
+        e *= fb
+        e += d[0:2]
+        r = e[1] - e[0]
+        r *= fc
+        r += e[0]
+        out.append(r)
+    return out[0], out[1]
+
+
+def _gusts(wind: "WindField", along: np.ndarray, g: float, length: float) -> np.ndarray:
+    """Sum of gust envelopes minus their mean, at along-wind positions ``along`` (m).
+
+    Gusts are plane fronts, so the sum is a function of ``along`` only: it is evaluated on
+    a 1-D grid of spacing GUST_RISE·L/8 over the points' span and interpolated (relative
+    error < 0.5 %), or directly where the span is too long for that."""
+    rg = wind.gust_rate / 60.0
+    per_m = rg / max(wind.speed, 1e-6)  # gust count per metre (still air carries no gusts)
+    if not GUST_RISE * length * per_m > 1e-12:  # gusts so rare they never come
+        return np.zeros_like(along)
+    sr = min(GUST_RISE * length * per_m, _GUST_MAX_WIDTH[0])
+    sd = min(GUST_DECAY * length * per_m, _GUST_MAX_WIDTH[1])
+    step = 0.125 * sr / per_m  # metres, on a lattice fixed in space (chunk-independent)
+    f = along * (1.0 / step)
+    lo, hi = float(f.min()), float(f.max())
+    if -(2.0**50) < lo and hi < 2.0**50 and hi - lo <= 4096:  # (a lattice of int64 indices)
+        lo_i = math.floor(lo)
+        ys = _gust_sum(wind.seed, g - (step * np.arange(lo_i, math.floor(hi) + 2)) * per_m, sr, sd)
+        i = np.floor(f)
+        f -= i
+        j = i.astype(np.intp)
+        j -= lo_i
+        out = ys[j + 1]
+        y0 = ys[j]
+        out -= y0
+        out *= f
+        out += y0
+        return out
+    return _gust_sum(wind.seed, g - along * per_m, sr, sd)
+
+
+def _gust_sum(seed: int, gam: np.ndarray, sr: float, sd: float) -> np.ndarray:
+    """Σ_k A_k·env(γ − c_k) − mean, gust k centred at c_k = k + jitter, γ in gust counts."""
+    gam = np.clip(gam, -(2.0**50), 2.0**50)
+    kf = np.floor(gam)
+    lo, hi = -math.ceil(4.0 * sd + 1.0), math.ceil(4.0 * sr + 1.0)
+    m = np.arange(lo, hi + 1, dtype=np.float64)[:, None]
+    k = kf[None, :] + m  # (neighbours, n)
+    u = _hash_uniform(seed, 31, k.astype(np.int64).ravel(), 2).reshape(*k.shape, 2)
+    x = gam[None, :] - (k + _GUST_JITTER * (u[..., 0] - 0.5))
+    x /= np.where(x >= 0.0, sd, sr)
+    np.clip(x, -40.0, 40.0, out=x)  # exp(−800) is 0 already; no overflow for tiny widths
+    env = np.exp(-0.5 * x * x)
+    env *= 0.5 + u[..., 1]
+    total = env.sum(axis=0)
+    total -= math.sqrt(0.5 * math.pi) * (sr + sd)  # mean of A (1) × area per gust
+    return total
+
+
+def _sample_physical(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray) -> None:
+    for start in range(0, p.shape[0], _CHUNK):
+        stop = min(start + _CHUNK, p.shape[0])
+        _physical_chunk(wind, p[start:stop], t, out[start:stop])
+
+
+def _physical_chunk(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray) -> None:
+    length = wind.length_scale
+    top = wind.canopy_height
+    speed = wind.speed
+    frame = wind._frame
+    a, s, g = wind._clocks(t)
+    g = math.fmod(g, 2.0**40)  # the gust sequence is hashed: any shift of it is as good
+    table = _physical_table(wind.beta_u, wind.beta_vw, wind.seed)
+    cell = length / _CELLS_PER_L
+    k = p.shape[0]
+    pc = np.clip(p, -_COORD_CLIP, _COORD_CLIP)
+    local = frame @ pc.T  # (3, k) metres along, up, across the wind
+    weights, offsets = [], []
+    for j in (0, 1):
+        phase = min(max(s + 0.5 * j, -2.0**62), 2.0**62)
+        cycle = math.floor(phase)
+        weights.append(math.sin(math.pi * (phase - cycle)))
+        where = _hash_uniform(wind.seed, 20 + j, np.array([cycle]), 3)[0] * _TILE
+        offsets.append(np.minimum(where.astype(np.intp), np.array(_TILE) - 1))
+    q = local * (1.0 / cell)
+    q[0] -= math.fmod(a / cell, _TILE[0])
+    uv, lat = _trilinear(table, q, offsets, weights)
+    turb = np.empty((k, 3))
+    turb[:, 0] = uv.real
+    turb[:, 1] = uv.imag
+    turb[:, 2] = lat
+    h = p[:, 1]
+    mean = _canopy_mean(h, top)
+    sigma = (wind.turbulence * _canopy_sigma(h, top))[:, None] * np.array(SIGMA_RATIOS)
+    comps = sigma * turb
+    comps[:, 0] += mean
+    if wind.gust_strength > 0.0 and wind.gust_rate > 0.0:
+        comps[:, 0] += (wind.gust_strength * mean) * _gusts(wind, local[0], g, length)
+    np.matmul(comps, frame, out=out)
+    out *= speed
