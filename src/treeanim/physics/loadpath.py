@@ -4,7 +4,9 @@ In the paper each object feels only the wind on its own area (Eq. 19), so the cr
 never reaches the trunk. Here:
 
 * an object's load is its own drag plus the force and moment each child transmits at its
-  attach node, accumulated from the outermost level inward (one vectorised pass per level);
+  attach node: subtree sums through constant sparse matrices over (ancestor, descendant)
+  pairs, the oscillators' coupling solved level by level from the outermost in (one sparse
+  product per level);
 * each object's three oscillators (Eqs. 2–5) filter its **total** load: modes u and w the
   equivalent force at the object's load point, E = (base moment) / lever, mode v the torsion
   about v. A child transmits its elastic reaction — its static load plus the dynamic excess
@@ -64,13 +66,6 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     d += a[1] * b[1]
     d += a[2] * b[2]
     return d
-
-
-def _grouped(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(order sorting ``keys``, the unique keys, the start of each key's run in that order)."""
-    perm = np.argsort(keys, kind="stable")
-    uniq, starts = np.unique(keys[perm], return_index=True)
-    return perm, uniq, starts
 
 
 class LoadPath:
@@ -140,17 +135,16 @@ class LoadPath:
         # (F·ŝ)ŝ + (M × ŝ)/ℓ = Fo·α + (Fo·ŝ)·dA + Ft·β + (Ft·ŝ)·dB.
         lev = self.lever
         self.s_hat = s_hat
-        self.A = A
         self.alpha = _dot(A, s_hat) / lev
         self.dA = W * s_hat - A / lev
         self.beta = _dot(self.lever_vec, s_hat) / lev
         self.dB = s_hat - self.lever_vec / lev
+        self.twist_own = _cross(s_hat, A)  # torsion per unit load: (A × F)·ŝ = F·(ŝ × A)
+        self.twist_tip = _cross(s_hat, self.lever_vec)
 
         # Children and the nodes they sit on.
         nonroot = np.flatnonzero(parent >= 0)
         self.nonroot, self.par = nonroot, parent[nonroot]
-        self.attach_idx = attach[nonroot] - start[self.par]
-        self.Xatt = np.ascontiguousarray(X[attach[nonroot]].T)
         att_nodes, slot = np.unique(attach[nonroot], return_inverse=True)
         self.att_nodes = att_nodes
         has_kids = np.zeros(M, bool)
@@ -162,12 +156,7 @@ class LoadPath:
             lo, hi = np.searchsorted(nonroot, [sl.start, sl.stop])
             if hi - lo not in (0, sl.stop - sl.start):
                 raise ValueError("a hierarchy level mixes roots and children")  # never built so
-            perm, uniq, starts = _grouped(slot[lo:hi])
-            if np.array_equal(perm, np.arange(hi - lo)):
-                perm = None  # already grouped by attach node: no gather
-            own = np.flatnonzero((owner >= sl.start) & (owner < sl.stop))  # slots of this level
-            kobj, kstart = np.unique(owner[own], return_index=True)
-            self.levels.append((sl, hi > lo, perm, uniq, starts, kobj, own, kstart))
+            self.levels.append((sl, hi > lo))
         self.slot_owner = owner
         self.Xslot = np.ascontiguousarray(X[att_nodes].T)
         self.r_load = self.Xl - self.Xb
@@ -185,6 +174,55 @@ class LoadPath:
         self.diam_max = float(diam.max()) if N else 1.0
         self.kind = tree.kind
         self.ws = Workspace()
+        self._couplings(parent, has_kids)
+
+    def _couplings(self, parent: np.ndarray, has_kids: np.ndarray) -> None:
+        """The tree's constant linear maps, as sparse matrices over (ancestor, descendant) pairs:
+
+        * ``D`` (M, M): subtree sums (D[j, k] = 1 where k is j or grows on it);
+        * ``SLD`` (A, M): what each attach slot carries (the subtrees of its children);
+        * G (3M, 3M): the equivalent loads (E_w, T, E_u) at j of the dynamic excess
+          (rows u, v, w of the modes) of each object k growing on j — the load path's only
+          coupling between levels, kept as the rows of each level's objects with children
+          (``solve_levels``, outermost first) for :meth:`inward`.
+        """
+        from scipy import sparse
+
+        M = self.M
+        k, j, c = [], [], []  # descendant, its ancestor, the ancestor's child on the way
+        cur = np.flatnonzero(parent >= 0)
+        desc, via = cur, cur
+        while len(desc):
+            anc = parent[via]
+            k.append(desc), j.append(anc), c.append(via)
+            up = parent[anc] >= 0
+            desc, via = desc[up], anc[up]
+        self.pairs = tuple(np.concatenate(a) if a else np.zeros(0, int) for a in (k, j, c))
+        k, j, c = self.pairs
+        one = np.ones(M + len(k))
+        self.D = sparse.csr_matrix((one, (np.r_[np.arange(M), j], np.r_[np.arange(M), k])), shape=(M, M))
+        nonroot = self.nonroot
+        SL = sparse.csr_matrix((np.ones(len(nonroot)), (self.slot, nonroot)), shape=(len(self.att_nodes), M))
+        self.SLD = (SL @ self.D).tocsr()
+        # G: the excess x_k = (along w, torsion, along u) is the force u_k x₂ + w_k x₀ at k's
+        # load point and the moment v_k x₁; j takes their moment about its base.
+        u, v, w = self.axes
+        r = self.Xl[:, k] - self.Xb[:, j]
+        L0 = self.lever0[j]
+        moments = (_cross(r, w[:, k]), v[:, k], _cross(r, u[:, k]))  # per column x₀, x₁, x₂
+        rows, cols, vals = [], [], []
+        for col, m0 in enumerate(moments):
+            for row, e in enumerate((_dot(u[:, j], m0) / L0, _dot(v[:, j], m0), -_dot(w[:, j], m0) / L0)):
+                rows.append(row * M + j), cols.append(col * M + k), vals.append(e)
+        G = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                              shape=(3 * M, 3 * M))
+        # Objects with children, level by level from the outermost in: their rows of G.
+        self.solve_levels = []
+        for sl, _ in reversed(self.levels):
+            objs = np.arange(sl.start, sl.stop)[has_kids[sl]]
+            if len(objs):
+                rows = np.concatenate([objs + row * M for row in range(3)])
+                self.solve_levels.append((rows, G[rows].tocsr()))
 
     def _to_world(self, x: np.ndarray, objs=slice(None)) -> np.ndarray:
         """Local (3, K) vectors of objects ``objs`` in rest-world coordinates."""
@@ -283,6 +321,32 @@ class LoadPath:
         self.Q_wood, self.Q_foliage = Qw, Qf
         self.m_modal = m_modal
         self.tune(None)
+        self._base_map()
+
+    def _base_map(self) -> None:
+        """``B`` (2M, 2M): the local (u, w) acceleration of each object's load point per unit
+        deflection acceleration (along u, along w) of each of its ancestors' load points.
+
+        An ancestor j moves the base of its child c on the way by ψ (translation) and turns it
+        by χ v_j × δ̈ (rotation); the rotation carries every load point k beyond it round by
+        the rigid chain of levers from c to k (rest offsets, as the loads)."""
+        from scipy import sparse
+
+        M = self.M
+        k, j, c = self.pairs
+        s = self.slot[np.searchsorted(self.nonroot, c)]
+        V = np.zeros((3, M))  # each base reached along its chain of levers from its root
+        for row in range(3):
+            np.add.at(V[row], k, self.Xslot[row, s] - self.Xb[row, j])
+        R = V[:, k] + self.r_load[:, k] - V[:, c]
+        u, v, w = self.axes
+        rows, cols, vals = [], [], []
+        for col, d in enumerate((u[:, j], w[:, j])):
+            t = self.psi[s] * d + self.chi[s] * _cross(_cross(v[:, j], d), R)
+            for row, axis in enumerate((u[:, k], w[:, k])):
+                rows.append(row * M + k), cols.append(col * M + j), vals.append(_dot(axis, t))
+        self.B = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                                   shape=(2 * M, 2 * M))
 
     def tune(self, w2: np.ndarray | None) -> None:
         """Set the stiffness of the ``modal`` objects from their modes: K = m·ω², with m the
@@ -314,35 +378,20 @@ class LoadPath:
         p_acc : (3, M) float
             d²L′/dt² of every oscillator now (rows u, v, w), from its state at the start of
             the step (no lag): the load point accelerates by (p̈_w, 0, p̈_u)/K, local (mode w
-            bends along u, mode u along w). A child's base follows its parent's attach node:
-            ψ times that translation, plus the rotation χ (v × δ̈) there, carried outward
-            level by level.
+            bends along u, mode u along w), and carries every object growing on it (``B``).
         """
-        u, v, w = self.axes
-        M = self.M
-        a_base = np.zeros((3, M))
-        alpha = np.zeros((3, M))
-        for sl, transmits, perm, uniq, starts, kobj, own, kstart in self.levels:  # roots first
-            if transmits:  # bases at the slots computed for the level above
-                sk = self.slot[sl.start - self.nonroot[0]:sl.stop - self.nonroot[0]]
-                np.take(a_slot, sk, axis=1, out=a_base[:, sl])
-                np.take(w_slot, sk, axis=1, out=alpha[:, sl])
-            if len(own):  # this level's attach nodes: translation ψ δ̈ and rotation χ (v × δ̈)
-                o = self.slot_owner[own]
-                d2 = u[:, o] * (p_acc[2, o] / self.K[o])
-                d2 += w[:, o] * (p_acc[0, o] / self.K[o])
-                a_slot = np.zeros((3, len(self.att_nodes)))
-                w_slot = np.zeros((3, len(self.att_nodes)))
-                a_slot[:, own] = a_base[:, o] + _cross(alpha[:, o], self.Xslot[:, own] - self.Xb[:, o])
-                a_slot[:, own] += self.psi[own] * d2
-                w_slot[:, own] = alpha[:, o] + self.chi[own] * _cross(v[:, o], d2)
-        a = a_base + _cross(alpha, self.r_load)
-        return np.stack([_dot(u, a), _dot(w, a)])
+        q = np.concatenate([p_acc[2] / self.K, p_acc[0] / self.K])
+        return (self.B @ q).reshape(2, self.M)
 
-    def inward(self, F_own: np.ndarray, F_tip: np.ndarray, g_extra: np.ndarray, advance,
-               g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Accumulate the loads from the outermost level inward, advancing each level's
-        oscillators as soon as its total load is known (Eqs. 2–5 on the load path).
+    def inward(self, F_own: np.ndarray, F_tip: np.ndarray, g_extra: np.ndarray,
+               response: tuple[np.ndarray, np.ndarray], g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The loads of the whole tree and the oscillators' inputs (Eqs. 2–5 on the load path).
+
+        Each object's input is the equivalent load of its subtree's static loads plus the
+        dynamic excess x = L′ − E of every object growing on it. The oscillators respond
+        linearly over the step, L′ = p_free + c·g, so the excesses solve
+        x = p_free + c·g_extra + (c − 1)(E_static + G x), level by level from the outermost
+        in (G couples an object only to what grows on it).
 
         Parameters
         ----------
@@ -352,9 +401,8 @@ class LoadPath:
             Loads at the load points (pulls), local.
         g_extra : (3, M) float
             Added to the oscillators' inputs only (base excitation): not transmitted.
-        advance : callable
-            ``advance(sl, g)`` steps the oscillators of object slice ``sl`` under the (3, n)
-            input g (rows u, v, w) and returns their outputs L′ (3, n).
+        response : ((3, M), (3, M)) float
+            The oscillators' free output p_free and gain c over the step (rows u, v, w).
         g : (3, M) float
             Filled with the oscillators' inputs.
 
@@ -369,50 +417,35 @@ class LoadPath:
         """
         M = self.M
         u, v, w = self.axes
-        F_sub = self._to_world(F_own)  # rest-world force and first moment S = X × F of subtrees
-        S_sub = _cross(self.Xo, F_sub)
+        F = self._to_world(F_own)  # rest-world force and first moment S = X × F
+        own = np.empty((6, M))
+        own[:3] = F
+        _cross(self.Xo, F, out=own[3:])
         held = np.flatnonzero(F_tip.any(axis=0))
         if len(held):
             Ft = self._to_world(F_tip[:, held], held)
-            F_sub[:, held] += Ft
-            S_sub[:, held] += _cross(self.Xl[:, held], Ft)
-        slots = np.zeros((6, len(self.att_nodes)))
-        dE = np.zeros((3, M))
-        for sl, transmits, perm, uniq, starts, kobj, own, kstart in reversed(self.levels):
-            if len(own):
-                sums = np.add.reduceat(slots[:, own], kstart, axis=1)
-                F_sub[:, kobj] += sums[:3]
-                S_sub[:, kobj] += sums[3:]
-            Fs, Ss = F_sub[:, sl], S_sub[:, sl]
-            M0 = Ss - _cross(self.Xb[:, sl], Fs)  # moment about the base
-            L0 = self.lever0[sl]
-            us, vs, ws_ = u[:, sl], v[:, sl], w[:, sl]
-            E_u = _dot(ws_, M0)  # M = ℓ v × E: M_u = ℓE_w, M_w = −ℓE_u
-            E_u /= -L0
-            E_w = _dot(us, M0)
-            E_w /= L0
-            T = _dot(vs, M0)
-            gl = g[:, sl]
-            np.add(E_w, g_extra[0, sl], out=gl[0])  # mode u bends along w
-            np.add(T, g_extra[1, sl], out=gl[1])
-            np.add(E_u, g_extra[2, sl], out=gl[2])  # mode w bends along u
-            out = advance(sl, gl)
-            d = dE[:, sl]
-            np.subtract(out[2], E_u, out=d[0])
-            np.subtract(out[0], E_w, out=d[2])
-            np.subtract(out[1], T, out=d[1])
-            if transmits:  # to the parents: the static load plus the dynamic excess
-                dF = us * d[0]
-                dF += ws_ * d[2]
-                tr = np.empty((6, sl.stop - sl.start))
-                np.add(Fs, dF, out=tr[:3])
-                _cross(self.Xl[:, sl], dF, out=tr[3:])
-                tr[3:] += Ss
-                tr[3:] += vs * d[1]  # the torsion's excess
-                if perm is not None:
-                    tr = tr[:, perm]
-                slots[:, uniq] += np.add.reduceat(tr, starts, axis=1)
-        return dE, slots
+            own[:3, held] += Ft
+            own[3:, held] += _cross(self.Xl[:, held], Ft)
+        sub = (self.D @ own.T).T
+        M0 = sub[3:] - _cross(self.Xb, sub[:3])  # moment about the base: M = ℓ v × E
+        e = np.stack([_dot(u, M0) / self.lever0, _dot(v, M0), -_dot(w, M0) / self.lever0])
+        p_free, gain = response
+        c1 = gain - 1.0
+        x = p_free + gain * g_extra
+        x += c1 * e
+        xf, cf, ef = x.ravel(), c1.ravel(), e.ravel()
+        for rows, G in self.solve_levels:  # (only objects with children have a G x)
+            Gx = G @ xf
+            ef[rows] += Gx
+            xf[rows] += cf[rows] * Gx
+        np.add(e, g_extra, out=g)
+        dE = x[::-1]  # (along u, torsion, along w)
+        dF = u * dE[0]
+        dF += w * dE[2]
+        own[:3] += dF
+        own[3:] += _cross(self.Xl, dF)
+        own[3:] += v * dE[1]
+        return dE, (self.SLD @ own.T).T
 
     def segment_forces(self, F_own: np.ndarray, F_tip: np.ndarray, dT: np.ndarray,
                        slots: np.ndarray) -> tuple[list[tuple], np.ndarray]:
@@ -445,9 +478,9 @@ class LoadPath:
         Feq += np.multiply(self.dA, _dot(Fo, sh), out=tmp)
         Feq += np.multiply(Ft, self.beta, out=tmp)
         Feq += np.multiply(self.dB, _dot(Ft, sh), out=tmp)
-        torsion = np.take(dT, self.seg_obj)
-        torsion += _dot(_cross(self.A, Fo, out=tmp), sh)
-        torsion += _dot(_cross(self.lever_vec, Ft, out=tmp), sh)
+        torsion = np.take(dT, self.seg_obj)  # + (A × Fo)·ŝ + (ℓ × Ft)·ŝ
+        torsion += _dot(Fo, self.twist_own)
+        torsion += _dot(Ft, self.twist_tip)
         if len(self.k_flat):  # children beyond the joint, rest-world → local
             rc = np.zeros((6, slots.shape[1] + 1))
             rc[:, :-1] = np.cumsum(slots[:, ::-1], axis=1)[:, ::-1]

@@ -847,15 +847,16 @@ class Simulation:
         F_own, c_air = self._aero_loads(U)
         F_pull = self._pull_loads()
         g_extra = self._base_excitation()
-        advance = self._level_advance(f3, z3, dt, c_air)
-        self._c_air = c_air
+        p_free, pd_free, gain, gain_d = self._oscillator_response(f3, z3, dt)
         g = self._g_prev
-        dE, node = self._lp.inward(F_own, F_pull, g_extra, advance, g)
+        dE, slots = self._lp.inward(F_own, F_pull, g_extra, (p_free, gain), g)
+        self._advance(g, p_free, pd_free, gain, gain_d, c_air * dt)
+        self._c_air = c_air
         self._L = g.copy()
         F_tip = F_pull
         F_tip[0] += dE[0]
         F_tip[2] += dE[2]
-        blocks, gamma = self._lp.segment_forces(F_own, F_tip, dE[1], node)
+        blocks, gamma = self._lp.segment_forces(F_own, F_tip, dE[1], slots)
         self._bplan.bend(None, None, gamma, self._lp.k_blocks, predict=self._predict(dt), blocks=blocks)
         self._sample_prev[...] = self._sample_pos
         self._compose()
@@ -867,7 +868,7 @@ class Simulation:
         The drag of the air-relative wind, F(U − v), is split as F(U) − c·v: the drag of the
         wind itself, here, and the damping c = ∂F/∂v = ρ C A |U − v| (2 × ½ρCA|U_rel|, on the
         object's mode and, through Q, on what it carries), which the oscillators take
-        implicitly (:meth:`_level_advance`) — stable however light a twig and strong the wind.
+        implicitly (:meth:`_advance`) — stable however light a twig and strong the wind.
         """
         lam_q = np.take(self._bplan.q, self._leaf_tip_flat, axis=1)
         if U is None:
@@ -916,39 +917,40 @@ class Simulation:
         g[2] *= -a_u
         return g
 
-    def _level_advance(self, f3: np.ndarray, z3: np.ndarray, dt: float, c_air: np.ndarray):
-        """Stage 3 (load path): ``advance(sl, g)`` for :meth:`LoadPath.inward` — the
-        oscillators of a slice of objects over the step (Eqs. 2–5), the air's damping
-        (split off, implicit: ṗ /= 1 + ω²c·dt/K), held objects critically damped (§8)."""
-        exact = self._integrator == "exact"
-        coef = self._oscillator_coefficients(f3, z3, dt) if exact else None
-        K = self._lp.K
-        held = np.fromiter(self._pulls, dtype=np.int64) if self._pulls else None
+    def _oscillator_response(self, f3: np.ndarray, z3: np.ndarray, dt: float) -> tuple[np.ndarray, ...]:
+        """Stage 3 (load path): the oscillators over the step (Eqs. 2–5) are linear in their
+        input g: L′ = p_free + c·g, L̇′ = pd_free + c_d·g. Held objects are critically damped
+        (§8). Returns (p_free, pd_free, c, c_d), each (3, M)."""
         p, pd = self._p, self._pd
+        if self._integrator == "exact":
+            A, B, C, D = self._oscillator_coefficients(f3, z3, dt)
+            out = (A * p + B * pd, C * p + D * pd, 1.0 - A, -C)
+        else:  # the free response, then the response to a unit input from rest
+            out = p.copy(), pd.copy(), np.zeros_like(p), np.zeros_like(pd)
+            euler_step(out[0], out[1], np.zeros_like(p), f3, z3, dt)
+            euler_step(out[2], out[3], np.ones_like(p), f3, z3, dt)
+        if self._pulls:
+            held = np.fromiter(self._pulls, dtype=np.int64)
+            zc = np.maximum(z3[:, held], 1.0)
+            zc[1] = z3[1, held]
+            A, B, C, D = exact_coefficients(f3[:, held], zc, dt)
+            for arr, val in zip(out, (A * p[:, held] + B * pd[:, held], C * p[:, held] + D * pd[:, held],
+                                      1.0 - A, -C)):
+                arr[:, held] = val
+        return out
 
-        def advance(sl: slice, g: np.ndarray) -> np.ndarray:
-            ps, pds = p[:, sl], pd[:, sl]
-            mine = None
-            if held is not None:
-                mine = held[(held >= sl.start) & (held < sl.stop)]
-                saved = (p[:, mine].copy(), pd[:, mine].copy())
-            if exact:
-                exact_step(ps, pds, g, tuple(c[:, sl] for c in coef))
-            else:
-                euler_step(ps, pds, g, f3[:, sl], z3[:, sl], dt)
-            damp = c_air[sl] * dt
-            damp /= K[sl]
-            for row in (0, 2):
-                pds[row] /= 1.0 + self._w2[row, sl] * damp
-            if mine is not None and len(mine):
-                zc = np.maximum(z3[:, mine], 1.0)
-                zc[1] = z3[1, mine]
-                pm, pdm = saved
-                exact_step(pm, pdm, g[:, mine - sl.start], exact_coefficients(f3[:, mine], zc, dt))
-                p[:, mine], pd[:, mine] = pm, pdm
-            return ps
-
-        return advance
+    def _advance(self, g, p_free, pd_free, gain, gain_d, c_dt) -> None:
+        """Set the oscillators' state after the step under the input g, with the air's damping
+        split off and implicit: ṗ /= 1 + ω²c·dt/K (stable however light a twig)."""
+        np.multiply(gain, g, out=self._p)
+        self._p += p_free
+        np.multiply(gain_d, g, out=self._pd)
+        self._pd += pd_free
+        damp = c_dt / self._lp.K
+        if self._pulls:  # a held object approaches its pull critically damped, as it is
+            damp[np.fromiter(self._pulls, dtype=np.int64)] = 0.0
+        for row in (0, 2):
+            self._pd[row] /= 1.0 + self._w2[row] * damp
 
 
 def _unshared_refs() -> int:
