@@ -1079,16 +1079,24 @@ _GUST_MAX_WIDTH = (1.0, 3.0)
 
 def _canopy_mean(h: np.ndarray, top: float) -> np.ndarray:
     """Mean speed over the speed at the canopy top ``top`` at heights ``h`` (m)."""
-    z = np.minimum(np.maximum(h, 0.0), _COORD_CLIP) / top
-    above = np.log((np.maximum(z, 1.0) - DISPLACEMENT) / ROUGHNESS) / _LOG_TOP
-    inside = np.exp(CANOPY_ATTENUATION * (np.minimum(z, 1.0) - 1.0))
-    return np.where(z >= 1.0, above, inside)
+    h = np.asarray(h, float)
+    return _canopy(h.reshape(-1), top)[0].reshape(h.shape)
 
 
-def _canopy_sigma(h: np.ndarray, top: float) -> np.ndarray:
-    """σ over σ at the canopy top at heights ``h``: 1 above, decaying inside."""
-    z = np.minimum(np.maximum(h, 0.0), top) / top
-    return np.exp(SIGMA_ATTENUATION * (z - 1.0))
+def _canopy(h: np.ndarray, top: float) -> tuple[np.ndarray, np.ndarray]:
+    """(mean speed, σ) over their values at the canopy top ``top``, at heights ``h`` (m): the
+    log law above the canopy (σ constant there), exponential decay inside it."""
+    z = np.minimum(np.maximum(h, 0.0), _COORD_CLIP)
+    z *= 1.0 / top
+    inside = np.minimum(z, 1.0)
+    inside -= 1.0  # ≤ 0
+    sigma = np.exp(SIGMA_ATTENUATION * inside)
+    inside *= CANOPY_ATTENUATION
+    mean = np.exp(inside, out=inside)
+    above = z > 1.0
+    if above.any():
+        mean[above] = np.log((z[above] - DISPLACEMENT) / ROUGHNESS) / _LOG_TOP
+    return mean, sigma
 
 
 _M64 = (1 << 64) - 1
@@ -1303,16 +1311,14 @@ def _physical_chunk(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray)
     q = local * (1.0 / cell)
     q[0] -= math.fmod(a / cell, _TILE[0])
     uv, lat = _trilinear(table, q, offsets, weights)
-    turb = np.empty((k, 3))
-    turb[:, 0] = uv.real
-    turb[:, 1] = uv.imag
-    turb[:, 2] = lat
-    h = p[:, 1]
-    mean = _canopy_mean(h, top)
-    sigma = (wind.turbulence * _canopy_sigma(h, top))[:, None] * np.array(SIGMA_RATIOS)
-    comps = sigma * turb
-    comps[:, 0] += mean
+    mean, sigma = _canopy(p[:, 1], top)
+    sigma *= wind.turbulence * speed
+    comps = np.empty((k, 3))
+    for c, (x, ratio) in enumerate(zip((uv.real, uv.imag, lat), SIGMA_RATIOS)):
+        np.multiply(x, sigma, out=comps[:, c])
+        if ratio != 1.0:
+            comps[:, c] *= ratio
     if wind.gust_strength > 0.0 and wind.gust_rate > 0.0:
-        comps[:, 0] += (wind.gust_strength * mean) * _gusts(wind, local[0], g, length)
+        mean *= 1.0 + wind.gust_strength * _gusts(wind, local[0], g, length)
+    comps[:, 0] += speed * mean
     np.matmul(comps, frame, out=out)
-    out *= speed
