@@ -444,56 +444,8 @@ class BendingPlan:
             else:
                 fu, fv, fw, amag = blocks[i]
             tmp = ws.get("tmp", (K,))
-            if i == 0:
-                # s′ = Rot(v, −γ) s₀ = s₀ = (0, l, 0):  N = s′ × F = (l·F_w, 0, −l·F_u), s′·F = l·F_v
-                sp = s
-                l = s[1]
-                n0 = mul(l, fw)
-                n2 = mul(l, fu)
-                np.negative(n2, out=n2)
-                n1 = None
-                if safe:
-                    nn = mul(n0, n0)
-                    nn += mul(n2, n2, out=tmp)
-                    np.sqrt(nn, out=nn)
-                else:
-                    nn = np.hypot(n0, n2)
-                if fv is None:
-                    dot = np.zeros(K)
-                    theta0 = np.full(K, 0.5 * np.pi)
-                else:
-                    dot = mul(l, fv)
-                    theta0 = np.arctan2(nn, dot)
-            else:
-                # T = Rot(v, −γ) ⊗ C_{i−1}:  cv·C + sv·(−C_y, C_z, C_w, −C_x)
-                C = prev[:, :K]
-                T = ws.get("T", (4, K))
-                np.take(C, _SWAP, axis=0, out=T)
-                T *= _SWAP_SIGN
-                T *= sv[tw]
-                T += mul(C, cv[tw], out=ws.get("T2", (4, K)))
-                sp = qrot(T, s, out=ws.get("sp", (3, K)), ws=ws)
-                sx, sy, sz = sp
-                n0 = mul(sy, fw)
-                n1 = mul(sz, fu)
-                n1 -= mul(sx, fw, out=tmp)
-                n2 = mul(sy, fu)
-                np.negative(n2, out=n2)
-                if fv is not None:
-                    n0 -= mul(sz, fv, out=tmp)
-                    n2 += mul(sx, fv, out=tmp)
-                if safe:
-                    nn = mul(n0, n0)
-                    nn += mul(n1, n1, out=tmp)
-                    nn += mul(n2, n2, out=tmp)
-                    np.sqrt(nn, out=nn)
-                else:
-                    nn = np.hypot(np.hypot(n0, n1), n2)
-                dot = mul(sx, fu)
-                dot += mul(sz, fw, out=tmp)
-                if fv is not None:
-                    dot += mul(sy, fv, out=tmp)
-                theta0 = np.arctan2(nn, dot)
+            c_, s_ = cv[tw], sv[tw]
+            sp, T, n, nn, dot, theta0 = self._moment(i, K, (fu, fv, fw), prev, c_, s_, safe, tmp)
             phi, t = solve_bend_angle(nn, dot, k[i], theta0, mul(rho_start[a:b], theta0),
                                       a=amag)  # Eqs. 8–9
             # No bend where the force is zero or (anti)parallel to the segment.
@@ -504,51 +456,118 @@ class BendingPlan:
             np.divide(1.0, inv, out=inv)
             self.phi[a:b] = phi
             np.divide(phi, np.maximum(theta0, 1e-300), out=self.rho[a:b])
-            # Bend quaternion (cos φ/2, sin φ/2 · N/|N|)
-            t2 = t * t
-            ch2 = 1.0 + t2
-            np.divide(1.0, ch2, out=ch2)  # cos²(φ/2)
-            ch = np.sqrt(ch2)
-            sh = mul(t, ch)
-            sh *= inv  # sin(φ/2) / |N|
-            b0 = ch
-            b1 = mul(n0, sh)
-            b3 = mul(n2, sh)
             dst = self.q[:, a:b]
-            if i == 0:
-                # C₀ = q_bend ⊗ Rot(v, −γ), with q_bend = (b0, b1, 0, b3), Rot = (cv, 0, sv, 0)
-                c_, s_ = cv[tw], sv[tw]
-                mul(b0, c_, out=dst[0])
-                mul(b1, c_, out=dst[1])
-                dst[1] -= mul(b3, s_, out=tmp)
-                mul(b0, s_, out=dst[2])
-                mul(b1, s_, out=dst[3])
-                dst[3] += mul(b3, c_, out=tmp)
-            else:
-                qb = ws.get("qb", (4, K))
-                qb[0] = b0
-                qb[1] = b1
-                mul(n1, sh, out=qb[2])
-                qb[3] = b3
-                qmul(qb, T, out=dst, ws=ws)  # Cᵢ = q_bend ⊗ T
-            # Bent segment Cᵢsᵢ = cos φ·s′ + sin φ·(N̂ × s′), N̂ × s′ = (F|s|² − s′(s′·F))/|N|
-            c_phi = 1.0 - t2
-            c_phi *= ch2
-            s_phi = mul(t, ch2)
-            s_phi *= inv
-            s_phi += s_phi
-            s_phi *= self.seg_len2[i]  # sin φ · |s|² / |N|
+            t2, ch2 = self._rotation(i, K, n, t, inv, T, c_, s_, dst, tmp)
             oo = self.o[:, a:b]
-            mul(sp, c_phi, out=oo)
-            oo[0] += mul(fu, s_phi, out=tmp)
-            oo[2] += mul(fw, s_phi, out=tmp)
-            if fv is not None:
-                oo[1] += mul(fv, s_phi, out=tmp)
-            if i > 0 or fv is not None:
-                s_phi /= self.seg_len2[i]
-                s_phi *= dot
-                oo -= mul(sp, s_phi, out=ws.get("v3", (3, K)))
+            self._bent_segment(i, sp, (fu, fv, fw), t, t2, ch2, inv, dot, oo, tmp)
             if i > 0:
                 oo += prev_o[:, :K]  # accumulate along the object
             prev = dst
             prev_o = oo
+
+    def _moment(self, i, K, f, prev, c_, s_, safe, tmp):
+        """Segment i twisted by Rot(v, −γ) after its parent's rotation: the moment
+        N = s′ × F of its force (Eq. 8), |N|, s′·F and the angle θ₀ from s′ to F.
+
+        Returns (s′, T, (n0, n1, n2), |N|, s′·F, θ₀) with T = Rot(v, −γ) ⊗ C_{i−1}
+        (None for the first segment, whose s′ = s₀ = (0, l, 0) and n1 = None)."""
+        mul, ws = np.multiply, self.ws
+        fu, fv, fw = f
+        s = self.seg[i]
+        if i == 0:
+            # s′ = s₀ = (0, l, 0):  N = s′ × F = (l·F_w, 0, −l·F_u), s′·F = l·F_v
+            l = s[1]
+            n0 = mul(l, fw)
+            n2 = mul(l, fu)
+            np.negative(n2, out=n2)
+            if safe:
+                nn = mul(n0, n0)
+                nn += mul(n2, n2, out=tmp)
+                np.sqrt(nn, out=nn)
+            else:
+                nn = np.hypot(n0, n2)
+            if fv is None:
+                return s, None, (n0, None, n2), nn, np.zeros(K), np.full(K, 0.5 * np.pi)
+            dot = mul(l, fv)
+            return s, None, (n0, None, n2), nn, dot, np.arctan2(nn, dot)
+        # T = Rot(v, −γ) ⊗ C_{i−1}:  cv·C + sv·(−C_y, C_z, C_w, −C_x)
+        C = prev[:, :K]
+        T = ws.get("T", (4, K))
+        np.take(C, _SWAP, axis=0, out=T)
+        T *= _SWAP_SIGN
+        T *= s_
+        T += mul(C, c_, out=ws.get("T2", (4, K)))
+        sp = qrot(T, s, out=ws.get("sp", (3, K)), ws=ws)
+        sx, sy, sz = sp
+        n0 = mul(sy, fw)
+        n1 = mul(sz, fu)
+        n1 -= mul(sx, fw, out=tmp)
+        n2 = mul(sy, fu)
+        np.negative(n2, out=n2)
+        if fv is not None:
+            n0 -= mul(sz, fv, out=tmp)
+            n2 += mul(sx, fv, out=tmp)
+        if safe:
+            nn = mul(n0, n0)
+            nn += mul(n1, n1, out=tmp)
+            nn += mul(n2, n2, out=tmp)
+            np.sqrt(nn, out=nn)
+        else:
+            nn = np.hypot(np.hypot(n0, n1), n2)
+        dot = mul(sx, fu)
+        dot += mul(sz, fw, out=tmp)
+        if fv is not None:
+            dot += mul(sy, fv, out=tmp)
+        return sp, T, (n0, n1, n2), nn, dot, np.arctan2(nn, dot)
+
+    def _rotation(self, i, K, n, t, inv, T, c_, s_, dst, tmp):
+        """Segment i's rotation Cᵢ into ``dst``: the bend quaternion (cos φ/2, sin φ/2 · N/|N|)
+        with t = tan(φ/2), after T (the first segment: after Rot(v, −γ) = (c_, 0, s_, 0)).
+        Returns (t², cos²(φ/2))."""
+        mul = np.multiply
+        n0, n1, n2 = n
+        t2 = t * t
+        ch2 = 1.0 + t2
+        np.divide(1.0, ch2, out=ch2)  # cos²(φ/2)
+        ch = np.sqrt(ch2)
+        sh = mul(t, ch)
+        sh *= inv  # sin(φ/2) / |N|
+        b0 = ch
+        b1 = mul(n0, sh)
+        b3 = mul(n2, sh)
+        if i == 0:  # C₀ = q_bend ⊗ Rot(v, −γ), with q_bend = (b0, b1, 0, b3)
+            mul(b0, c_, out=dst[0])
+            mul(b1, c_, out=dst[1])
+            dst[1] -= mul(b3, s_, out=tmp)
+            mul(b0, s_, out=dst[2])
+            mul(b1, s_, out=dst[3])
+            dst[3] += mul(b3, c_, out=tmp)
+        else:
+            qb = self.ws.get("qb", (4, K))
+            qb[0] = b0
+            qb[1] = b1
+            mul(n1, sh, out=qb[2])
+            qb[3] = b3
+            qmul(qb, T, out=dst, ws=self.ws)  # Cᵢ = q_bend ⊗ T
+        return t2, ch2
+
+    def _bent_segment(self, i, sp, f, t, t2, ch2, inv, dot, oo, tmp) -> None:
+        """The bent segment Cᵢsᵢ = cos φ·s′ + sin φ·(N̂ × s′) into ``oo``, with
+        N̂ × s′ = (F|s|² − s′(s′·F))/|N|."""
+        mul = np.multiply
+        fu, fv, fw = f
+        c_phi = 1.0 - t2
+        c_phi *= ch2
+        s_phi = mul(t, ch2)
+        s_phi *= inv
+        s_phi += s_phi
+        s_phi *= self.seg_len2[i]  # sin φ · |s|² / |N|
+        mul(sp, c_phi, out=oo)
+        oo[0] += mul(fu, s_phi, out=tmp)
+        oo[2] += mul(fw, s_phi, out=tmp)
+        if fv is not None:
+            oo[1] += mul(fv, s_phi, out=tmp)
+        if i > 0 or fv is not None:
+            s_phi /= self.seg_len2[i]
+            s_phi *= dot
+            oo -= mul(sp, s_phi, out=self.ws.get("v3", sp.shape))
