@@ -33,6 +33,7 @@ geometric non-linearity stays in Eq. 8, as in the paper.
 from __future__ import annotations
 
 import numpy as np
+from scipy import sparse
 
 from .bending import saturating_twist
 from .rotation import Workspace
@@ -66,6 +67,11 @@ def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     d += a[1] * b[1]
     d += a[2] * b[2]
     return d
+
+
+def _csr(rows: list, cols: list, vals: list, n: int):
+    """An (n, n) CSR matrix from lists of (row indices, column indices, values) blocks."""
+    return sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
 
 
 class LoadPath:
@@ -104,7 +110,6 @@ class LoadPath:
         seg_i = np.concatenate([np.full(K, i) for i, K in enumerate(bplan.counts)]) if S else np.zeros(0, int)
         node = start[seg_obj] + seg_i
         self.seg_obj, self.seg_node = seg_obj, node
-        self.order = bplan.order
         self.blocks = list(zip(bplan.offsets[:-1], bplan.offsets[1:]))
         xj = local(seg_obj, X[node])
         s = local(seg_obj, X[node + 1]) - xj
@@ -170,7 +175,7 @@ class LoadPath:
         self.k_end = last
         self.Xj_k = np.ascontiguousarray(X[node[self.k_flat]].T)
         self.axes_k = self.axes[:, :, ko]
-        self.start, self.count = start, count
+        self.start = start
         self.diam_max = float(diam.max()) if N else 1.0
         self.kind = tree.kind
         self.ws = Workspace()
@@ -186,8 +191,6 @@ class LoadPath:
           coupling between levels, kept as the rows of each level's objects with children
           (``solve_levels``, outermost first) for :meth:`inward`.
         """
-        from scipy import sparse
-
         M = self.M
         k, j, c = [], [], []  # descendant, its ancestor, the ancestor's child on the way
         cur = np.flatnonzero(parent >= 0)
@@ -214,8 +217,7 @@ class LoadPath:
         for col, m0 in enumerate(moments):
             for row, e in enumerate((_dot(u[:, j], m0) / L0, _dot(v[:, j], m0), -_dot(w[:, j], m0) / L0)):
                 rows.append(row * M + j), cols.append(col * M + k), vals.append(e)
-        G = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                              shape=(3 * M, 3 * M))
+        G = _csr(rows, cols, vals, 3 * M)
         # Objects with children, level by level from the outermost in: their rows of G.
         self.solve_levels = []
         for sl, _ in reversed(self.levels):
@@ -330,8 +332,6 @@ class LoadPath:
         An ancestor j moves the base of its child c on the way by ψ (translation) and turns it
         by χ v_j × δ̈ (rotation); the rotation carries every load point k beyond it round by
         the rigid chain of levers from c to k (rest offsets, as the loads)."""
-        from scipy import sparse
-
         M = self.M
         k, j, c = self.pairs
         s = self.slot[np.searchsorted(self.nonroot, c)]
@@ -345,8 +345,7 @@ class LoadPath:
             t = self.psi[s] * d + self.chi[s] * _cross(_cross(v[:, j], d), R)
             for row, axis in enumerate((u[:, k], w[:, k])):
                 rows.append(row * M + k), cols.append(col * M + j), vals.append(_dot(axis, t))
-        self.B = sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                                   shape=(2 * M, 2 * M))
+        self.B = _csr(rows, cols, vals, 2 * M)
 
     def tune(self, w2: np.ndarray | None) -> None:
         """Set the stiffness of the ``modal`` objects from their modes: K = m·ω², with m the

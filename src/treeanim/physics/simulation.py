@@ -844,13 +844,14 @@ class Simulation:
     def _step_load_path(self, U, f3: np.ndarray, z3: np.ndarray, dt: float) -> None:
         """The whole-tree step (DESIGN §12): aerodynamic loads → load path with the
         oscillators (Eqs. 2–5) → bending (Eqs. 7–11 generalised) → hierarchy (Eq. 12)."""
+        held = np.fromiter(self._pulls, dtype=np.int64)  # the objects being pulled
         F_own, c_air = self._aero_loads(U)
-        F_pull = self._pull_loads()
+        F_pull = self._pull_loads(held)
         g_extra = self._base_excitation()
-        p_free, pd_free, gain, gain_d = self._oscillator_response(f3, z3, dt)
+        p_free, pd_free, gain, gain_d = self._oscillator_response(f3, z3, dt, held)
         g = self._g_prev
         dE, slots = self._lp.inward(F_own, F_pull, g_extra, (p_free, gain), g)
-        self._advance(g, p_free, pd_free, gain, gain_d, c_air * dt)
+        self._advance(g, p_free, pd_free, gain, gain_d, c_air * dt, held)
         self._c_air = c_air
         self._L = g.copy()
         F_tip = F_pull
@@ -883,11 +884,10 @@ class Simulation:
         c_air *= 2.0 * speed
         return F, c_air
 
-    def _pull_loads(self) -> np.ndarray:
-        """(3, M) the pulls at the objects' load points, local (carried frames)."""
+    def _pull_loads(self, held: np.ndarray) -> np.ndarray:
+        """(3, M) the pulls at the objects' load points ``held``, local (carried frames)."""
         F = np.zeros((3, self._M))
-        if self._pulls:
-            held = np.fromiter(self._pulls, dtype=np.int64)
+        if len(held):
             world = np.array([self._pulls[i] for i in held]).T
             F[:, held] = qrot(self._frame[:, held], world, conj=True)
         return F
@@ -917,29 +917,31 @@ class Simulation:
         g[2] *= -a_u
         return g
 
-    def _oscillator_response(self, f3: np.ndarray, z3: np.ndarray, dt: float) -> tuple[np.ndarray, ...]:
+    def _oscillator_response(self, f3: np.ndarray, z3: np.ndarray, dt: float,
+                             held: np.ndarray) -> tuple[np.ndarray, ...]:
         """Stage 3 (load path): the oscillators over the step (Eqs. 2–5) are linear in their
-        input g: L′ = p_free + c·g, L̇′ = pd_free + c_d·g. Held objects are critically damped
-        (§8). Returns (p_free, pd_free, c, c_d), each (3, M)."""
+        input g: L′ = p_free + c·g, L̇′ = pd_free + c_d·g. The ``held`` objects are critically
+        damped (§8). Returns (p_free, pd_free, c, c_d), each (3, M)."""
+
+        def exact(coef, p, pd):  # y(dt) = A·y + B·ẏ, ẏ(dt) = C·y + D·ẏ with y = p − g
+            A, B, C, D = coef
+            return A * p + B * pd, C * p + D * pd, 1.0 - A, -C
+
         p, pd = self._p, self._pd
         if self._integrator == "exact":
-            A, B, C, D = self._oscillator_coefficients(f3, z3, dt)
-            out = (A * p + B * pd, C * p + D * pd, 1.0 - A, -C)
+            out = exact(self._oscillator_coefficients(f3, z3, dt), p, pd)
         else:  # the free response, then the response to a unit input from rest
             out = p.copy(), pd.copy(), np.zeros_like(p), np.zeros_like(pd)
             euler_step(out[0], out[1], np.zeros_like(p), f3, z3, dt)
             euler_step(out[2], out[3], np.ones_like(p), f3, z3, dt)
-        if self._pulls:
-            held = np.fromiter(self._pulls, dtype=np.int64)
+        if len(held):
             zc = np.maximum(z3[:, held], 1.0)
             zc[1] = z3[1, held]
-            A, B, C, D = exact_coefficients(f3[:, held], zc, dt)
-            for arr, val in zip(out, (A * p[:, held] + B * pd[:, held], C * p[:, held] + D * pd[:, held],
-                                      1.0 - A, -C)):
+            for arr, val in zip(out, exact(exact_coefficients(f3[:, held], zc, dt), p[:, held], pd[:, held])):
                 arr[:, held] = val
         return out
 
-    def _advance(self, g, p_free, pd_free, gain, gain_d, c_dt) -> None:
+    def _advance(self, g, p_free, pd_free, gain, gain_d, c_dt, held) -> None:
         """Set the oscillators' state after the step under the input g, with the air's damping
         split off and implicit: ṗ /= 1 + ω²c·dt/K (stable however light a twig)."""
         np.multiply(gain, g, out=self._p)
@@ -947,8 +949,7 @@ class Simulation:
         np.multiply(gain_d, g, out=self._pd)
         self._pd += pd_free
         damp = c_dt / self._lp.K
-        if self._pulls:  # a held object approaches its pull critically damped, as it is
-            damp[np.fromiter(self._pulls, dtype=np.int64)] = 0.0
+        damp[held] = 0.0  # a held object approaches its pull critically damped, as it is
         for row in (0, 2):
             self._pd[row] /= 1.0 + self._w2[row] * damp
 
