@@ -74,7 +74,7 @@ class Drag:
             f[~foliage] = 1.0
         return f
 
-    def loads(self, wind: np.ndarray, frame: np.ndarray, lamina_q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def loads(self, wind: np.ndarray, frame: np.ndarray, lamina_q: np.ndarray) -> np.ndarray:
         """Drag of the wind on every object, in its carried frame.
 
         Parameters
@@ -89,18 +89,12 @@ class Drag:
 
         Returns
         -------
-        force : (3, M) float
+        (3, M) float
             (F_u, F_v, F_w) in newtons, in the carried frame.
-        speed : (M,) float
-            |wind| (m/s).
         """
         M = wind.shape[1]
         ws = self.ws
         U = qrot(frame, wind, conj=True, out=ws.get("U", (3, M)), ws=ws)
-        speed = np.sqrt(np.einsum("ij,ij->j", U, U))
-        coeff = self.reconfigured(speed, self.foliage)
-        coeff *= self.half_rho_cda
-        coeff *= speed
         F = np.zeros((3, M))
         c = self.cross  # cross-flow: only the wind normal to the axis v pushes
         un = np.hypot(U[0, c], U[2, c])
@@ -108,10 +102,14 @@ class Drag:
         F[0, c] = k * U[0, c]
         F[2, c] = k * U[2, c]
         lf = self.leaf
-        if len(lf):
+        if len(lf):  # the normal force ½ρC A |U| (U·n) n on the lamina
             w, x, y, z = lamina_q  # n = the leaf's bend and twist applied to its rest normal w
             n = np.stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
             Ul = U[:, lf]
+            speed = np.sqrt(np.einsum("ij,ij->j", Ul, Ul))
             un = np.einsum("ij,ij->j", Ul, n)
-            F[:, lf] = n * (coeff[lf] * un)
-        return F, speed
+            un *= self.reconfigured(speed)
+            un *= speed
+            un *= self.half_rho_cda[lf]
+            F[:, lf] = n * un
+        return F

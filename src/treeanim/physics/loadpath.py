@@ -4,9 +4,9 @@ In the paper each object feels only the wind on its own area (Eq. 19), so the cr
 never reaches the trunk. Here:
 
 * an object's load is its own drag plus the force and moment each child transmits at its
-  attach node: subtree sums through constant sparse matrices over (ancestor, descendant)
-  pairs, the oscillators' coupling solved level by level from the outermost in (one sparse
-  product per level);
+  attach node: one pass up the tree, level by level from the outermost in, sums each level's
+  subtrees into their attach slots and parents and solves the oscillators' coupling on the
+  way (whole-level array operations);
 * each object's three oscillators (Eqs. 2–5) filter its **total** load: modes u and w the
   equivalent force at the object's load point, E = (base moment) / lever, mode v the torsion
   about v. A child transmits its elastic reaction — its static load plus the dynamic excess
@@ -138,14 +138,20 @@ class LoadPath:
         # The equivalent force of Eq. 8 at the lever ℓ for the own load Fo (share W, first
         # moment A × Fo) and the load-point load Ft (lever vector B):
         # (F·ŝ)ŝ + (M × ŝ)/ℓ = Fo·α + (Fo·ŝ)·dA + Ft·β + (Ft·ŝ)·dB.
+        # A leaf's own load acts where the load-point load does (W = 1, A = B): the own load's
+        # terms are kept as differences from the load point's, on the other segments only.
         lev = self.lever
         self.s_hat = s_hat
-        self.alpha = _dot(A, s_hat) / lev
-        self.dA = W * s_hat - A / lev
         self.beta = _dot(self.lever_vec, s_hat) / lev
         self.dB = s_hat - self.lever_vec / lev
-        self.twist_own = _cross(s_hat, A)  # torsion per unit load: (A × F)·ŝ = F·(ŝ × A)
-        self.twist_tip = _cross(s_hat, self.lever_vec)
+        self.twist_tip = _cross(s_hat, self.lever_vec)  # torsion per unit load: (B × F)·ŝ = F·(ŝ × B)
+        spread = np.flatnonzero(~leafseg)
+        self.spread = slice(None) if len(spread) == S else spread
+        self.spread_obj = seg_obj[spread]
+        self.s_hat_spread = s_hat[:, spread]
+        self.d_alpha = _dot(A[:, spread], self.s_hat_spread) / lev[spread] - self.beta[spread]
+        self.d_dA = W[spread] * self.s_hat_spread - A[:, spread] / lev[spread] - self.dB[:, spread]
+        self.d_twist = _cross(self.s_hat_spread, A[:, spread]) - self.twist_tip[:, spread]
 
         # Children and the nodes they sit on.
         nonroot = np.flatnonzero(parent >= 0)
@@ -182,14 +188,15 @@ class LoadPath:
         self._couplings(parent, has_kids)
 
     def _couplings(self, parent: np.ndarray, has_kids: np.ndarray) -> None:
-        """The tree's constant linear maps, as sparse matrices over (ancestor, descendant) pairs:
+        """The tree's constant maps for the upward pass of :meth:`inward` and for :meth:`_base_map`.
 
-        * ``D`` (M, M): subtree sums (D[j, k] = 1 where k is j or grows on it);
-        * ``SLD`` (A, M): what each attach slot carries (the subtrees of its children);
-        * G (3M, 3M): the equivalent loads (E_w, T, E_u) at j of the dynamic excess
-          (rows u, v, w of the modes) of each object k growing on j — the load path's only
-          coupling between levels, kept as the rows of each level's objects with children
-          (``solve_levels``, outermost first) for :meth:`inward`.
+        * ``pairs``: (descendant, ancestor, the ancestor's child on the way) of every
+          (ancestor, descendant) pair;
+        * ``own_map`` (6, 3, M): an object's local load → rest-world force and first moment;
+        * per level, outermost first (``up``): ``Pe`` (3, 6, n), the equivalent loads
+          (E_w, T, E_u) of a subtree's force and first moment about the object's base;
+          ``Q`` (6, 3, n), the force and first moment of the dynamic excess x (rows u, v, w of
+          the modes); and how the level's subtrees add up into attach slots and parents.
         """
         M = self.M
         k, j, c = [], [], []  # descendant, its ancestor, the ancestor's child on the way
@@ -201,30 +208,29 @@ class LoadPath:
             up = parent[anc] >= 0
             desc, via = desc[up], anc[up]
         self.pairs = tuple(np.concatenate(a) if a else np.zeros(0, int) for a in (k, j, c))
-        k, j, c = self.pairs
-        one = np.ones(M + len(k))
-        self.D = sparse.csr_matrix((one, (np.r_[np.arange(M), j], np.r_[np.arange(M), k])), shape=(M, M))
-        nonroot = self.nonroot
-        SL = sparse.csr_matrix((np.ones(len(nonroot)), (self.slot, nonroot)), shape=(len(self.att_nodes), M))
-        self.SLD = (SL @ self.D).tocsr()
-        # G: the excess x_k = (along w, torsion, along u) is the force u_k x₂ + w_k x₀ at k's
-        # load point and the moment v_k x₁; j takes their moment about its base.
         u, v, w = self.axes
-        r = self.Xl[:, k] - self.Xb[:, j]
-        L0 = self.lever0[j]
-        moments = (_cross(r, w[:, k]), v[:, k], _cross(r, u[:, k]))  # per column x₀, x₁, x₂
-        rows, cols, vals = [], [], []
-        for col, m0 in enumerate(moments):
-            for row, e in enumerate((_dot(u[:, j], m0) / L0, _dot(v[:, j], m0), -_dot(w[:, j], m0) / L0)):
-                rows.append(row * M + j), cols.append(col * M + k), vals.append(e)
-        G = _csr(rows, cols, vals, 3 * M)
-        # Objects with children, level by level from the outermost in: their rows of G.
-        self.solve_levels = []
-        for sl, _ in reversed(self.levels):
-            objs = np.arange(sl.start, sl.stop)[has_kids[sl]]
-            if len(objs):
-                rows = np.concatenate([objs + row * M for row in range(3)])
-                self.solve_levels.append((rows, G[rows].tocsr()))
+        self.own_map = np.stack([np.concatenate([a, _cross(self.Xo, a)]) for a in (u, v, w)], axis=1)
+        # E = a·S − (a × X_b)·F for a = u/ℓ, v, −w/ℓ (the moment about the base, S − X_b × F)
+        a = (u / self.lever0, v, -w / self.lever0)
+        Pe = np.stack([np.concatenate([-_cross(ac, self.Xb), ac]) for ac in a])
+        # The excess x moves the load point by u x₂ + w x₀ and twists it by v x₁.
+        zero = np.zeros((3, M))
+        Q = np.stack([np.concatenate([w, _cross(self.Xl, w)]), np.concatenate([zero, v]),
+                      np.concatenate([u, _cross(self.Xl, u)])], axis=1)
+        self.up = []
+        for sl, transmits in reversed(self.levels):
+            lvl = {"sl": sl, "Pe": np.ascontiguousarray(Pe[:, :, sl]), "Q": np.ascontiguousarray(Q[:, :, sl])}
+            if transmits:  # the level's subtrees → their attach slots (contiguous) → parents
+                slot = self.slot[np.searchsorted(self.nonroot, np.arange(sl.start, sl.stop))]
+                perm = np.argsort(slot, kind="stable")
+                s = slot[perm]
+                first = np.flatnonzero(np.r_[True, s[1:] != s[:-1]])
+                lo, hi = int(s[0]), int(s[-1]) + 1
+                owner = self.slot_owner[lo:hi]
+                ofirst = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+                lvl.update(perm=None if np.all(perm == np.arange(len(perm))) else perm, first=first,
+                           slots=slice(lo, hi), owners=owner[ofirst], ofirst=ofirst)
+            self.up.append(lvl)
 
     def _to_world(self, x: np.ndarray, objs=slice(None)) -> np.ndarray:
         """Local (3, K) vectors of objects ``objs`` in rest-world coordinates."""
@@ -382,15 +388,16 @@ class LoadPath:
         q = np.concatenate([p_acc[2] / self.K, p_acc[0] / self.K])
         return (self.B @ q).reshape(2, self.M)
 
-    def inward(self, F_own: np.ndarray, F_tip: np.ndarray, g_extra: np.ndarray,
+    def inward(self, F_own: np.ndarray, F_tip: np.ndarray, held: np.ndarray, g_extra: np.ndarray,
                response: tuple[np.ndarray, np.ndarray], g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The loads of the whole tree and the oscillators' inputs (Eqs. 2–5 on the load path).
 
         Each object's input is the equivalent load of its subtree's static loads plus the
         dynamic excess x = L′ − E of every object growing on it. The oscillators respond
         linearly over the step, L′ = p_free + c·g, so the excesses solve
-        x = p_free + c·g_extra + (c − 1)(E_static + G x), level by level from the outermost
-        in (G couples an object only to what grows on it).
+        x = p_free + c·g_extra + (c − 1)·E, with E the equivalent load of the subtree's own
+        loads and its descendants' excesses: one pass from the outermost level in, where each
+        level's subtrees are whole when it is reached.
 
         Parameters
         ----------
@@ -398,6 +405,8 @@ class LoadPath:
             Each object's own load (drag), local.
         F_tip : (3, M) float
             Loads at the load points (pulls), local.
+        held : (H,) int
+            The objects whose ``F_tip`` is not zero.
         g_extra : (3, M) float
             Added to the oscillators' inputs only (base excitation): not transmitted.
         response : ((3, M), (3, M)) float
@@ -414,37 +423,30 @@ class LoadPath:
             What the children transmit at each attach node (``att_nodes``), rest-world:
             force and first moment about the origin.
         """
-        M = self.M
-        u, v, w = self.axes
-        F = self._to_world(F_own)  # rest-world force and first moment S = X × F
-        own = np.empty((6, M))
-        own[:3] = F
-        _cross(self.Xo, F, out=own[3:])
-        held = np.flatnonzero(F_tip.any(axis=0))
+        ws = self.ws
+        Z = np.einsum("dck,ck->dk", self.own_map, F_own, out=ws.get("Z", (6, self.M)))  # F, S = X × F
         if len(held):
             Ft = self._to_world(F_tip[:, held], held)
-            own[:3, held] += Ft
-            own[3:, held] += _cross(self.Xl[:, held], Ft)
-        sub = (self.D @ own.T).T
-        M0 = sub[3:] - _cross(self.Xb, sub[:3])  # moment about the base: M = ℓ v × E
-        e = np.stack([_dot(u, M0) / self.lever0, _dot(v, M0), -_dot(w, M0) / self.lever0])
+            Z[:3, held] += Ft
+            Z[3:, held] += _cross(self.Xl[:, held], Ft)
         p_free, gain = response
+        x = np.multiply(gain, g_extra, out=ws.get("x", (3, self.M)))
+        x += p_free
         c1 = gain - 1.0
-        x = p_free + gain * g_extra
-        x += c1 * e
-        xf, cf, ef = x.ravel(), c1.ravel(), e.ravel()
-        for rows, G in self.solve_levels:  # (only objects with children have a G x)
-            Gx = G @ xf
-            ef[rows] += Gx
-            xf[rows] += cf[rows] * Gx
-        np.add(e, g_extra, out=g)
-        dE = x[::-1]  # (along u, torsion, along w)
-        dF = u * dE[0]
-        dF += w * dE[2]
-        own[:3] += dF
-        own[3:] += _cross(self.Xl, dF)
-        own[3:] += v * dE[1]
-        return dE, (self.SLD @ own.T).T
+        slots = np.empty((6, len(self.att_nodes)))
+        for lvl in self.up:  # outermost first: a level's subtrees are whole when it is reached
+            sl = lvl["sl"]
+            Zs, xs = Z[:, sl], x[:, sl]
+            e = np.einsum("cdk,dk->ck", lvl["Pe"], Zs)
+            np.add(e, g_extra[:, sl], out=g[:, sl])
+            e *= c1[:, sl]
+            xs += e
+            Zs += np.einsum("dck,ck->dk", lvl["Q"], xs)
+            if "first" in lvl:
+                into = slots[:, lvl["slots"]]
+                np.add.reduceat(Zs if lvl["perm"] is None else Zs[:, lvl["perm"]], lvl["first"], axis=1, out=into)
+                Z[:, lvl["owners"]] += np.add.reduceat(into, lvl["ofirst"], axis=1)
+        return x[::-1], slots
 
     def segment_forces(self, F_own: np.ndarray, F_tip: np.ndarray, dT: np.ndarray,
                        slots: np.ndarray) -> tuple[list[tuple], np.ndarray]:
@@ -469,17 +471,19 @@ class LoadPath:
         """
         ws = self.ws
         S = len(self.seg_obj)
-        Fo = np.take(F_own, self.seg_obj, axis=1, out=ws.get("Fo", (3, S)))
-        Ft = np.take(F_tip, self.seg_obj, axis=1, out=ws.get("Ft", (3, S)))
+        Ft = np.add(F_own, F_tip, out=ws.get("Fsum", F_own.shape))
+        Ft = np.take(Ft, self.seg_obj, axis=1, out=ws.get("Ft", (3, S)))
         sh = self.s_hat
-        Feq = np.multiply(Fo, self.alpha, out=ws.get("Feq", (3, S)))
-        tmp = ws.get("tmp", (3, S))
-        Feq += np.multiply(self.dA, _dot(Fo, sh), out=tmp)
-        Feq += np.multiply(Ft, self.beta, out=tmp)
-        Feq += np.multiply(self.dB, _dot(Ft, sh), out=tmp)
-        torsion = np.take(dT, self.seg_obj)  # + (A × Fo)·ŝ + (ℓ × Ft)·ŝ
-        torsion += _dot(Fo, self.twist_own)
+        Feq = np.multiply(Ft, self.beta, out=ws.get("Feq", (3, S)))
+        Feq += np.multiply(self.dB, _dot(Ft, sh), out=ws.get("tmp", (3, S)))
+        torsion = np.take(dT, self.seg_obj)
         torsion += _dot(Ft, self.twist_tip)
+        # The own load spread along a branch or blade, as its difference from the load point's
+        Fo = np.take(F_own, self.spread_obj, axis=1)
+        d = Fo * self.d_alpha
+        d += self.d_dA * _dot(Fo, self.s_hat_spread)
+        Feq[:, self.spread] += d
+        torsion[self.spread] += _dot(Fo, self.d_twist)
         if len(self.k_flat):  # children beyond the joint, rest-world → local
             rc = np.zeros((6, slots.shape[1] + 1))
             rc[:, :-1] = np.cumsum(slots[:, ::-1], axis=1)[:, ::-1]

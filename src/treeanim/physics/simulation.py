@@ -850,7 +850,7 @@ class Simulation:
         g_extra = self._base_excitation()
         p_free, pd_free, gain, gain_d = self._oscillator_response(f3, z3, dt, held)
         g = self._g_prev
-        dE, slots = self._lp.inward(F_own, F_pull, g_extra, (p_free, gain), g)
+        dE, slots = self._lp.inward(F_own, F_pull, held, g_extra, (p_free, gain), g)
         self._advance(g, p_free, pd_free, gain, gain_d, c_air * dt, held)
         self._c_air = c_air
         self._L = g.copy()
@@ -875,7 +875,7 @@ class Simulation:
         if U is None:
             F, rel = np.zeros((3, self._M)), -self._sample_vel
         else:
-            F, _ = self._drag.loads(U.T, self._frame, lam_q)
+            F = self._drag.loads(U.T, self._frame, lam_q)
             rel = U.T - self._sample_vel
         speed = np.sqrt(np.einsum("ij,ij->j", rel, rel))
         lp = self._lp
