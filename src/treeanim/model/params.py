@@ -82,6 +82,9 @@ class PhysicsParams:
         Foliage streamlining (load path): above ``reconfiguration_speed`` U₀ (m/s) the drag of
         leaves and blades grows as U^(2 − r) with r = ``reconfiguration`` (Vogel's exponent
         b = −r).
+    leaf_flutter : float
+        Load path: the largest twist (rad) of a leaf's flutter about its petiole, reached by a
+        lamina edge-on to a strong wind (:mod:`treeanim.physics.leaves`).
 
     Notes
     -----
@@ -118,6 +121,7 @@ class PhysicsParams:
     drag_blade: float = 1.0
     reconfiguration: float = 0.7
     reconfiguration_speed: float = 4.0
+    leaf_flutter: float = 0.35
 
     def modes(self, kind: str, season: float) -> ModeRange | None:
         """f and ζ ranges for ``kind``, linearly interpolated at ``season`` in [0, 1]."""

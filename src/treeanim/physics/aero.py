@@ -45,6 +45,7 @@ class Drag:
         self.kind = kind
         self.area = np.asarray(frontal_area, float)
         self.ws = Workspace()
+        self.leaf_speed = self.leaf_incidence = np.zeros(len(self.leaf))
 
     def derive(self, physics, present: np.ndarray) -> None:
         """Take ½ρ C A per object from ``physics`` (absent leaves carry no load).
@@ -91,6 +92,9 @@ class Drag:
         -------
         (3, M) float
             (F_u, F_v, F_w) in newtons, in the carried frame.
+
+        The leaves' wind speed and the cosine of its angle to each lamina's normal are kept
+        as ``leaf_speed`` and ``leaf_incidence`` (L,) for their flutter.
         """
         M = wind.shape[1]
         ws = self.ws
@@ -108,6 +112,8 @@ class Drag:
             Ul = U[:, lf]
             speed = np.sqrt(np.einsum("ij,ij->j", Ul, Ul))
             un = np.einsum("ij,ij->j", Ul, n)
+            self.leaf_speed = speed
+            self.leaf_incidence = un / np.maximum(speed, 1e-300)
             un *= self.reconfigured(speed)
             un *= speed
             un *= self.half_rho_cda[lf]

@@ -446,6 +446,13 @@ class BendingPlan:
             tmp = ws.get("tmp", (K,))
             c_, s_ = cv[tw], sv[tw]
             sp, T, n, nn, dot, theta0 = self._moment(i, K, (fu, fv, fw), prev, c_, s_, safe, tmp)
+            if blocks is not None:
+                # The load path: a force's compression along the segment does not bend it (a
+                # twig held well below its buckling load) — only the part across it does, so a
+                # force pointing back along a segment cannot flip its bend from side to side.
+                back = theta0 > 0.5 * np.pi
+                amag = np.where(back, amag * np.sin(theta0), amag)
+                np.minimum(theta0, 0.5 * np.pi, out=theta0)
             phi, t = solve_bend_angle(nn, dot, k[i], theta0, mul(rho_start[a:b], theta0),
                                       a=amag)  # Eqs. 8–9
             # No bend where the force is zero or (anti)parallel to the segment.

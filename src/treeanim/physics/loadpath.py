@@ -145,6 +145,8 @@ class LoadPath:
         self.beta = _dot(self.lever_vec, s_hat) / lev
         self.dB = s_hat - self.lever_vec / lev
         self.twist_tip = _cross(s_hat, self.lever_vec)  # torsion per unit load: (B × F)·ŝ = F·(ŝ × B)
+        self.leaf_seg = np.flatnonzero(leafseg)
+        self.leaf_seg_obj = seg_obj[self.leaf_seg]
         spread = np.flatnonzero(~leafseg)
         self.spread = slice(None) if len(spread) == S else spread
         self.spread_obj = seg_obj[spread]
@@ -448,7 +450,7 @@ class LoadPath:
                 Z[:, lvl["owners"]] += np.add.reduceat(into, lvl["ofirst"], axis=1)
         return x[::-1], slots
 
-    def segment_forces(self, F_own: np.ndarray, F_tip: np.ndarray, dT: np.ndarray,
+    def segment_forces(self, F_own: np.ndarray, F_tip: np.ndarray, dT: np.ndarray, Lv: np.ndarray,
                        slots: np.ndarray) -> tuple[list[tuple], np.ndarray]:
         """Per bending block, the equivalent force on each segment and its moment at the lever;
         per segment, the twist.
@@ -460,7 +462,9 @@ class LoadPath:
         Tᵢ = Mᵢ·ŝ (plus the object's dynamic excess ``dT``) twists segment i by Eq. 11's
         saturating law with the segment's own torsional compliance cᵢ:
         γᵢ = ½π·sgn Tᵢ·(1 − exp(−(2/π)·cᵢ|Tᵢ|)), so a small twist is cᵢTᵢ, the largest a
-        quarter turn.
+        quarter turn. A leaf's petiole twists under its torsional mode's output ``Lv`` (L′_v)
+        alone: the torque of the lamina's normal force turns with the lamina, and taken
+        unfiltered it would flip the leaf from side to side every step.
 
         Returns
         -------
@@ -496,6 +500,7 @@ class LoadPath:
             shk = sh[:, self.k_flat]
             Feq[:, self.k_flat] += _dot(Fl, shk) * shk + _cross(Ml, shk) / self.lever[self.k_flat]
             torsion[self.k_flat] += _dot(Ml, shk)
+        torsion[self.leaf_seg] = Lv[self.leaf_seg_obj]
         a = np.sqrt(_dot(Feq, Feq))
         a *= self.lever
         gamma = saturating_twist(torsion, self.twist_rate, -0.5 * np.pi)

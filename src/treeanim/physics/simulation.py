@@ -16,6 +16,7 @@ from .aero import Drag
 from .bending import BendingPlan, matrix_to_quat, rest_frames, saturating_twist
 from .checks import finite_float, finite_vector3
 from .hierarchy import CompositionPlan
+from .leaves import LeafTwist
 from .loadpath import LoadPath
 from .modal import ModalDraws, ModalParameters, derive_modes, mean_diameters
 from .oscillator import euler_step, exact_coefficients, exact_step
@@ -56,7 +57,7 @@ def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
             raise ValueError(f"physics.{name} must be > 0, got {x!r}")
     for name in ("stiffness_exponent", "twist_c0", "leaf_twist_c0", "leaf_zeta_w_scale",
                  "leaf_zeta_v_scale", "wind_gain_branch", "wind_gain_leaf", "wind_gain_blade",
-                 "drag_branch", "drag_leaf", "drag_blade", "reconfiguration"):
+                 "drag_branch", "drag_leaf", "drag_blade", "reconfiguration", "leaf_flutter"):
         x = finite_float(f"physics.{name}", getattr(p, name))
         if x < 0:
             raise ValueError(f"physics.{name} must be >= 0, got {x!r}")
@@ -267,6 +268,9 @@ class Simulation:
         self._mid_t = t
         self._leaves = np.flatnonzero(leaf)
         self._leaf_tip_flat = self._bplan.flat_of_node[tip[leaf]]
+        lp = self._lp
+        self._leaf_twist = LeafTwist(np.searchsorted(self._leaves, lp.seg_obj[lp.leaf_seg]),
+                                     np.asarray(tree.lamina_length, float)[self._leaves], self._seed)
 
     def _derive_physics(self) -> None:
         """Stiffness, gains, masses and twist constants from ``self._physics``."""
@@ -701,6 +705,8 @@ class Simulation:
         self._c_air = np.zeros(M)  # the air's damping of the last step (load path)
         self._sample_prev = self._sample_pos.copy()
         self._sample_vel = np.zeros((3, M))
+        self._leaf_twist.reset()
+        self._spread = None  # the low-passed loads along the objects (load path)
         self._pulls.clear()
         self._pos_out = None
         self._rot_out = None
@@ -854,14 +860,44 @@ class Simulation:
         self._advance(g, p_free, pd_free, gain, gain_d, c_air * dt, held)
         self._c_air = c_air
         self._L = g.copy()
-        F_tip = F_pull
-        F_tip[0] += dE[0]
-        F_tip[2] += dE[2]
-        blocks, gamma = self._lp.segment_forces(F_own, F_tip, dE[1], slots)
+        F_own, F_tip, dT, slots = self._distributed_loads(F_own, F_pull, slots, g - g_extra, dE[::-1], dt)
+        blocks, gamma = self._lp.segment_forces(F_own, F_tip, dT, self._p[1], slots)
+        leaf = self._lp.leaf_seg  # leaves turn at a bounded speed, and flutter
+        gamma[leaf] = self._leaf_twist.step(gamma[leaf], self._drag.leaf_speed, self._drag.leaf_incidence,
+                                            self._physics.leaf_flutter, dt)
         self._bplan.bend(None, None, gamma, self._lp.k_blocks, predict=self._predict(dt), blocks=blocks)
         self._sample_prev[...] = self._sample_pos
         self._compose()
         self._sample_vel = (self._sample_pos - self._sample_prev) / dt
+
+    def _distributed_loads(self, F_own, F_pull, slots, E, x, dt) -> tuple[np.ndarray, ...]:
+        """Stage 4 (load path): the loads along each object, low-passed at its own frequency.
+
+        An object's oscillators filter the equivalent load at its load point (E′); how the load
+        spreads along it would otherwise follow the wind and its children from step to step
+        with no inertia at all, and a lamina's force, which turns with the lamina, would flip
+        the twig it bends from side to side within one step. So the own loads, pulls and
+        children's loads (``slots``) reach the segments through a first-order low-pass at the
+        object's bending frequency, and the load point takes the rest, E′ − Ē, with Ē the
+        same low-pass of the static equivalent load E: the segments still carry E′ in all.
+
+        Returns (own loads, load-point loads, torsion excess, slots) for
+        :meth:`LoadPath.segment_forces`.
+        """
+        a = -np.expm1(-dt * np.sqrt(np.sqrt(self._w2[0] * self._w2[2])))
+        new = (F_own, F_pull, slots, E)
+        if self._spread is None:
+            self._spread = [v.copy() for v in new]
+        else:
+            for bar, v, alpha in zip(self._spread, new, (a, a, a[self._lp.slot_owner], a)):
+                bar += alpha * (v - bar)
+        F_bar, P_bar, S_bar, E_bar = self._spread
+        dE = x + E
+        dE -= E_bar  # E′ − Ē, rows of the modes u, v, w
+        F_tip = P_bar.copy()
+        F_tip[0] += dE[2]  # mode w bends along u, mode u along w
+        F_tip[2] += dE[0]
+        return F_bar, F_tip, dE[1], S_bar
 
     def _aero_loads(self, U) -> tuple[np.ndarray, np.ndarray]:
         """Stage 2 (load path): the drag, local, and the air's damping on each object's mode.
