@@ -450,9 +450,11 @@ class BendingPlan:
                 # The load path: a force's compression along the segment does not bend it (a
                 # twig held well below its buckling load) — only the part across it does, so a
                 # force pointing back along a segment cannot flip its bend from side to side.
-                back = theta0 > 0.5 * np.pi
-                amag = np.where(back, amag * np.sin(theta0), amag)
-                np.minimum(theta0, 0.5 * np.pi, out=theta0)
+                back = np.flatnonzero(theta0 > 0.5 * np.pi)
+                if len(back):
+                    amag = amag.copy()
+                    amag[back] *= np.sin(theta0[back])
+                    theta0[back] = 0.5 * np.pi
             phi, t = solve_bend_angle(nn, dot, k[i], theta0, mul(rho_start[a:b], theta0),
                                       a=amag)  # Eqs. 8–9
             # No bend where the force is zero or (anti)parallel to the segment.
