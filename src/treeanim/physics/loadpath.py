@@ -146,7 +146,6 @@ class LoadPath:
         self.dB = s_hat - self.lever_vec / lev
         self.twist_tip = _cross(s_hat, self.lever_vec)  # torsion per unit load: (B × F)·ŝ = F·(ŝ × B)
         self.leaf_seg = np.flatnonzero(leafseg)
-        self.leaf_seg_obj = seg_obj[self.leaf_seg]
         spread = np.flatnonzero(~leafseg)
         self.spread = slice(None) if len(spread) == S else spread
         self.spread_obj = seg_obj[spread]
@@ -391,7 +390,7 @@ class LoadPath:
         return (self.B @ q).reshape(2, self.M)
 
     def inward(self, F_own: np.ndarray, F_tip: np.ndarray, held: np.ndarray, g_extra: np.ndarray,
-               response: tuple[np.ndarray, np.ndarray], g: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+               response: tuple[np.ndarray, np.ndarray], g: np.ndarray) -> np.ndarray:
         """The loads of the whole tree and the oscillators' inputs (Eqs. 2–5 on the load path).
 
         Each object's input is the equivalent load of its subtree's static loads plus the
@@ -418,9 +417,6 @@ class LoadPath:
 
         Returns
         -------
-        dE : (3, M) float
-            The dynamic excess of every object: E′ − E at its load point (rows u, w, local)
-            and the torsion's, L′_v − T (row v, N·m).
         slots : (6, A) float
             What the children transmit at each attach node (``att_nodes``), rest-world:
             force and first moment about the origin.
@@ -448,7 +444,7 @@ class LoadPath:
                 into = slots[:, lvl["slots"]]
                 np.add.reduceat(Zs if lvl["perm"] is None else Zs[:, lvl["perm"]], lvl["first"], axis=1, out=into)
                 Z[:, lvl["owners"]] += np.add.reduceat(into, lvl["ofirst"], axis=1)
-        return x[::-1], slots
+        return slots
 
     def segment_forces(self, F_own: np.ndarray, F_tip: np.ndarray, dT: np.ndarray, Lv: np.ndarray,
                        slots: np.ndarray) -> tuple[list[tuple], np.ndarray]:
@@ -480,14 +476,17 @@ class LoadPath:
         sh = self.s_hat
         Feq = np.multiply(Ft, self.beta, out=ws.get("Feq", (3, S)))
         Feq += np.multiply(self.dB, _dot(Ft, sh), out=ws.get("tmp", (3, S)))
-        torsion = np.take(dT, self.seg_obj)
-        torsion += _dot(Ft, self.twist_tip)
+        torsion = np.take(Lv, self.seg_obj)  # a leaf's: its torsional mode's output
         # The own load spread along a branch or blade, as its difference from the load point's
+        sp = self.spread
         Fo = np.take(F_own, self.spread_obj, axis=1)
         d = Fo * self.d_alpha
         d += self.d_dA * _dot(Fo, self.s_hat_spread)
-        Feq[:, self.spread] += d
-        torsion[self.spread] += _dot(Fo, self.d_twist)
+        Feq[:, sp] += d
+        t = np.take(dT, self.spread_obj)
+        t += _dot(Ft[:, sp], self.twist_tip[:, sp])
+        t += _dot(Fo, self.d_twist)
+        torsion[sp] = t
         if len(self.k_flat):  # children beyond the joint, rest-world → local
             rc = np.zeros((6, slots.shape[1] + 1))
             rc[:, :-1] = np.cumsum(slots[:, ::-1], axis=1)[:, ::-1]
@@ -500,7 +499,6 @@ class LoadPath:
             shk = sh[:, self.k_flat]
             Feq[:, self.k_flat] += _dot(Fl, shk) * shk + _cross(Ml, shk) / self.lever[self.k_flat]
             torsion[self.k_flat] += _dot(Ml, shk)
-        torsion[self.leaf_seg] = Lv[self.leaf_seg_obj]
         a = np.sqrt(_dot(Feq, Feq))
         a *= self.lever
         gamma = saturating_twist(torsion, self.twist_rate, -0.5 * np.pi)

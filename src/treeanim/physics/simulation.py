@@ -856,11 +856,11 @@ class Simulation:
         g_extra = self._base_excitation()
         p_free, pd_free, gain, gain_d = self._oscillator_response(f3, z3, dt, held)
         g = self._g_prev
-        dE, slots = self._lp.inward(F_own, F_pull, held, g_extra, (p_free, gain), g)
+        slots = self._lp.inward(F_own, F_pull, held, g_extra, (p_free, gain), g)
         self._advance(g, p_free, pd_free, gain, gain_d, c_air * dt, held)
         self._c_air = c_air
         self._L = g.copy()
-        F_own, F_tip, dT, slots = self._distributed_loads(F_own, F_pull, slots, g - g_extra, dE[::-1], dt)
+        F_own, F_tip, dT, slots = self._distributed_loads(F_own, F_pull, slots, g - g_extra, dt)
         blocks, gamma = self._lp.segment_forces(F_own, F_tip, dT, self._p[1], slots)
         leaf = self._lp.leaf_seg  # leaves turn at a bounded speed, and flutter
         gamma[leaf] = self._leaf_twist.step(gamma[leaf], self._drag.leaf_speed, self._drag.leaf_incidence,
@@ -870,7 +870,7 @@ class Simulation:
         self._compose()
         self._sample_vel = (self._sample_pos - self._sample_prev) / dt
 
-    def _distributed_loads(self, F_own, F_pull, slots, E, x, dt) -> tuple[np.ndarray, ...]:
+    def _distributed_loads(self, F_own, F_pull, slots, E, dt) -> tuple[np.ndarray, ...]:
         """Stage 4 (load path): the loads along each object, low-passed at its own frequency.
 
         An object's oscillators filter the equivalent load at its load point (E′); how the load
@@ -879,7 +879,8 @@ class Simulation:
         the twig it bends from side to side within one step. So the own loads, pulls and
         children's loads (``slots``) reach the segments through a first-order low-pass at the
         object's bending frequency, and the load point takes the rest, E′ − Ē, with Ē the
-        same low-pass of the static equivalent load E: the segments still carry E′ in all.
+        same low-pass of the static equivalent load E (E′ the oscillators' output, advanced):
+        the segments still carry E′ in all.
 
         Returns (own loads, load-point loads, torsion excess, slots) for
         :meth:`LoadPath.segment_forces`.
@@ -892,8 +893,7 @@ class Simulation:
             for bar, v, alpha in zip(self._spread, new, (a, a, a[self._lp.slot_owner], a)):
                 bar += alpha * (v - bar)
         F_bar, P_bar, S_bar, E_bar = self._spread
-        dE = x + E
-        dE -= E_bar  # E′ − Ē, rows of the modes u, v, w
+        dE = self._p - E_bar  # E′ − Ē, rows of the modes u, v, w
         F_tip = P_bar.copy()
         F_tip[0] += dE[2]  # mode w bends along u, mode u along w
         F_tip[2] += dE[0]
