@@ -397,10 +397,11 @@ class BendingPlan:
             The solver starts from ρ·θ₀ with ρ = φ/θ₀ extrapolated as ρ + predict·(ρ −
             ρ_previous): 0 restarts from the last fractions, dt/dt_prev extrapolates linearly
             in time (a better start, fewer iterations).
-        blocks : list of (fu, fv, fw, a), optional
+        blocks : list of (fu, fv, fw, a, r), optional
             Instead of Eq. 7's fractions of one force: per block i, the force on each
-            segment (local components, (K_i,) each) and a = |Fᵢ|·ℓᵢ, the moment it exerts at
-            its lever ℓᵢ (Eq. 8's |Fᵢ||sᵢ|). Used by the load path.
+            segment (local components, (K_i,) each), a = |Fᵢ|·ℓᵢ, the moment it exerts at
+            its lever ℓᵢ (Eq. 8's |Fᵢ||sᵢ|), and r = ℓᵢ/|sᵢ|. Used by the load path; ``a`` is
+            overwritten.
         """
         # Start of the angle solve: the bend as a fraction ρ = φ/θ₀ of the angle to the force
         # (nearly constant from step to step even where θ₀ moves), extrapolated linearly.
@@ -425,10 +426,9 @@ class BendingPlan:
             Fmag = np.hypot(Fu, Fw)  # |F| per object
             fmax = Fmag.max(initial=0.0)
         else:
-            fmax = np.sqrt(3.0) * max((max(c.max(initial=0.0), -c.min(initial=0.0)) for bl in blocks for c in bl[:3]),
-                                      default=0.0)
+            nmax = max(((bl[3] / bl[4]).max(initial=0.0) for bl in blocks), default=0.0)  # a/r = |F||s|
         # |N| <= |F||s|: below the bound the plain sum of squares cannot overflow.
-        safe = not (fmax * self.max_seg > _SQUARE_SAFE)
+        safe = not ((fmax * self.max_seg if blocks is None else nmax) > _SQUARE_SAFE)
         prev = None
         prev_o = None
         per_segment = len(gamma) == self.n_flat
@@ -442,7 +442,7 @@ class BendingPlan:
                 fv = None
                 amag = mul(Fmag[:K], self.frac_len[i], out=ws.get("amag", (K,)))  # a = |Fᵢ||sᵢ|
             else:
-                fu, fv, fw, amag = blocks[i]
+                fu, fv, fw, amag, r = blocks[i]
             tmp = ws.get("tmp", (K,))
             c_, s_ = cv[tw], sv[tw]
             sp, T, n, nn, dot, theta0 = self._moment(i, K, (fu, fv, fw), prev, c_, s_, safe, tmp)
@@ -450,11 +450,9 @@ class BendingPlan:
                 # The load path: a force's compression along the segment does not bend it (a
                 # twig held well below its buckling load) — only the part across it does, so a
                 # force pointing back along a segment cannot flip its bend from side to side.
-                back = np.flatnonzero(theta0 > 0.5 * np.pi)
-                if len(back):
-                    amag = amag.copy()
-                    amag[back] *= np.sin(theta0[back])
-                    theta0[back] = 0.5 * np.pi
+                # There a·sin θ₀ = |N|·ℓ/|s| (a = |F|·ℓ, sin θ₀ = |N|/(|F||s|)).
+                np.multiply(nn, r, out=amag, where=dot < 0.0)
+                np.minimum(theta0, 0.5 * np.pi, out=theta0)
             phi, t = solve_bend_angle(nn, dot, k[i], theta0, mul(rho_start[a:b], theta0),
                                       a=amag)  # Eqs. 8–9
             # No bend where the force is zero or (anti)parallel to the segment.

@@ -119,6 +119,7 @@ class LoadPath:
         self.lever_vec = self.x_load[:, seg_obj] - xj  # joint → load point
         self.lever = np.maximum(np.linalg.norm(self.lever_vec, axis=0), 1e-12)
         self.lever0 = np.maximum(np.linalg.norm(self.x_load, axis=0), 1e-12)
+        self.lever_per_len = self.lever / np.maximum(self.h, 1e-300)  # a·sin θ₀ = |N|·ℓ/|s|
 
         # Own load beyond joint i: a fraction W of it, with first moment A × F about the joint.
         # Branches and blades spread it over their segments by frontal area; a leaf's acts on
@@ -464,7 +465,7 @@ class LoadPath:
 
         Returns
         -------
-        blocks : list of (fu, fv, fw, a)
+        blocks : list of (fu, fv, fw, a, r)
             For :meth:`BendingPlan.bend`'s ``blocks``.
         gamma : (n_flat,) float
             Twist of every segment, in the bending pass's flat order.
@@ -502,5 +503,6 @@ class LoadPath:
         a = np.sqrt(_dot(Feq, Feq))
         a *= self.lever
         gamma = saturating_twist(torsion, self.twist_rate, -0.5 * np.pi)
-        blocks = [(Feq[0, lo:hi], Feq[1, lo:hi], Feq[2, lo:hi], a[lo:hi]) for lo, hi in self.blocks]
+        r = self.lever_per_len
+        blocks = [(Feq[0, lo:hi], Feq[1, lo:hi], Feq[2, lo:hi], a[lo:hi], r[lo:hi]) for lo, hi in self.blocks]
         return blocks, gamma
