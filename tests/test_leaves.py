@@ -86,3 +86,75 @@ def test_no_leaf_snaps_through_in_a_gale_at_any_frame_rate(name):
     assert fast.max() < 90.0, fast.max()  # never to the other side of the petiole
     # A bounded angular speed: four times the frames, about a quarter the turn per frame.
     assert p_fast < 0.4 * p_slow, (p_fast, p_slow)
+
+
+# ---------------------------------------------------------------- falling leaves
+def leaf_nodes(tree, objects):
+    return np.concatenate([np.arange(tree.object_start[i], tree.object_start[i] + tree.object_count[i])
+                           for i in objects])
+
+
+def drop_leaves(speed, seconds, dt=1.0 / 30.0, **kw):
+    """Small cherry swaying for 1 s, then the season slider to winter: the leaves that fell,
+    and per frame their node positions (T, K, 3) and lamina normals (T, L, 3)."""
+    tree = ta.load_preset("small_cherry")
+    wind = ta.WindField(speed=speed, direction=(1.0, 0.0, 0.0)) if speed else None
+    sim = ta.Simulation(tree, wind=wind, **kw)
+    for _ in range(30):
+        sim.step(dt)
+    before = sim.present.copy()
+    sim.season = 1.0
+    fell = np.flatnonzero(before & ~sim.present)
+    nodes = leaf_nodes(tree, fell)
+    tips = tree.object_start[fell] + tree.object_count[fell] - 1
+    P, N = [sim.positions[nodes]], []
+    for _ in range(int(round(seconds / dt))):
+        sim.step(dt)
+        P.append(sim.positions[nodes])
+        N.append(np.einsum("kij,kj->ki", sim.rotations[tips], tree.rest_w[fell]))
+    return sim, fell, np.array(P), np.array(N)
+
+
+def test_dropped_leaves_tumble_down_and_rest_flat_on_the_ground():
+    dt = 1.0 / 30.0
+    sim, fell, P, N = drop_leaves(0.0, 12.0, dt)
+    assert len(fell) > 500
+    assert sim.shown[fell].all() and not sim.present[fell].any()  # drawn, off the tree
+    assert np.isfinite(P).all()
+    # They let go where they were, without a jump: the first 1/30 s moves a node less than
+    # 3 cm (gravity alone: g·dt² = 1.1 cm; the spin turns a petiole's end by up to 6 mm).
+    assert np.abs(P[1] - P[0]).max() < 0.03
+    # They sink at a falling leaf's terminal speed: 0.8–1.6 m/s in still air (swinging).
+    y = P[..., 1].reshape(len(P), len(fell), -1).mean(axis=2)
+    start = y[0]
+    low = np.argmax(y < 0.05, axis=0)  # first frame near the ground
+    high = start > 1.5
+    speed = (start[high] - 0.05) / (low[high] * dt)
+    assert 0.6 < np.median(speed) < 1.6, np.median(speed)
+    # They tumble: the lamina turns on the way down.
+    turn = np.degrees(np.arccos(np.clip(np.einsum("tki,tki->tk", N[:-1], N[1:]), -1, 1))).sum(axis=0)
+    assert np.median(turn) > 90.0
+    # Every leaf reaches the ground and lies flat on it, still.
+    assert (P[-1][:, 1] > -1e-9).all() and (P[-1][:, 1] < 0.03).all()
+    assert np.median(np.abs(N[-1][:, 1])) > 0.99
+    assert np.array_equal(P[-1], P[-2])
+
+
+def test_wind_carries_falling_leaves_downwind():
+    calm = drop_leaves(0.0, 8.0)[2]
+    windy = drop_leaves(8.0, 8.0)[2]
+    drift = lambda P: np.median(P[-1][:, 0] - P[0][:, 0])  # noqa: E731
+    assert abs(drift(calm)) < 0.2
+    assert drift(windy) > 1.0
+
+
+def test_leaves_back_on_the_tree_leave_the_ground_and_the_paper_drops_them_unseen():
+    sim, fell, P, N = drop_leaves(5.0, 2.0)
+    sim.season = 0.0
+    assert sim.present[fell].all()
+    assert np.array_equal(sim.shown, sim.present)
+    sim.step(1.0 / 30.0)
+    rest = sim.tree.rest_positions[leaf_nodes(sim.tree, fell)]
+    assert np.abs(sim.positions[leaf_nodes(sim.tree, fell)] - rest).max() < 0.5  # on their twigs again
+    paper = drop_leaves(5.0, 0.5, load_path=False)[0]
+    assert np.array_equal(paper.shown, paper.present)

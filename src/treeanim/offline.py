@@ -475,10 +475,10 @@ def run_render(job: RenderJob, tree, sim, log=print) -> RenderResult:
     with offscreen(job.width, job.height, job.samples) as off:
         off.load(tree)
         cam = framed_camera(tree, job.width, job.height, job.azimuth, job.elevation, job.distance,
-                            present=sim.present)
+                            present=sim.shown)
 
         def shoot() -> np.ndarray:
-            off.update(sim.positions, sim.rotations, sim.present)
+            off.update(sim.positions, sim.rotations, sim.shown)
             return off.render(cam, season=job.season)
 
         if target.kind == "still":
@@ -711,7 +711,7 @@ def bench_row(key: str, off, width: int, height: int, frames: int, steps: int, w
     for k in range(frames + 2):
         sim.step(dt)
         t0 = time.perf_counter()
-        off.update(sim.positions, sim.rotations, sim.present)
+        off.update(sim.positions, sim.rotations, sim.shown)
         off.render(cam, season=season)  # draws, resolves and reads the pixels back: the GPU is done
         if k >= 2:  # the first frames compile and upload
             ren_ms.append((time.perf_counter() - t0) * 1e3)

@@ -393,9 +393,9 @@ class Viewer:
         sim, r = self.sim, self.renderer
         highlight = self.grab.object if self.grab is not None else None
         pos = sim.positions
-        key = (id(r), id(pos), sim.time, id(sim.present), highlight)
+        key = (id(r), id(pos), sim.time, id(sim.shown), highlight)
         if key != self._uploaded:  # the pose is unchanged while paused or between steps
-            r.update(pos, sim.rotations, present=sim.present, highlight=highlight)
+            r.update(pos, sim.rotations, present=sim.shown, highlight=highlight)
             self._uploaded = key
         self.ctx.screen.use()
         r.draw(self.camera, fw, fh, season=sim.season, overlays=self.overlays())

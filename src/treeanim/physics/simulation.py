@@ -14,6 +14,7 @@ from ..model.params import PhysicsParams
 from ..model.tree import KINDS, Tree
 from .aero import Drag
 from .bending import BendingPlan, matrix_to_quat, rest_frames, saturating_twist
+from .falling import FallingLeaves
 from .checks import finite_float, finite_vector3
 from .hierarchy import CompositionPlan
 from .leaves import LeafTwist
@@ -50,7 +51,7 @@ def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
     if not isinstance(p, PhysicsParams):
         raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
     positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness",
-                "leaf_youngs_modulus", "air_density", "reconfiguration_speed")
+                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density", "reconfiguration_speed")
     for name in positive:
         x = finite_float(f"physics.{name}", getattr(p, name))
         if x <= 0:
@@ -122,8 +123,13 @@ class Simulation:
         ``modes.f`` and ``modes.zeta``, (M, 3) arrays, columns (u, v, w), writable; read at
         every step. Setting ``season`` or ``physics`` re-derives them (Eqs. 20–22).
     present : (M,) bool, read-only
-        Objects shown at the current season (fallen leaves are False); ``present_nodes`` is the
-        same per node. Fallen leaves are still simulated (cheap), just not shown.
+        Objects on the tree at the current season (fallen leaves are False); ``present_nodes``
+        is the same per node. Absent leaves are still simulated (cheap), carrying no load.
+    shown : (M,) bool, read-only
+        Objects to draw: those present plus, with the load path, the leaves that fell while
+        the simulation ran — they tumble down and lie on the ground (:mod:`.falling`), posed in
+        ``positions`` and ``rotations``. The paper's model (``load_path=False``) drops them
+        out of sight, as ``present``.
     season : float
         Settable, in [0, 1].
     physics : PhysicsParams
@@ -271,6 +277,7 @@ class Simulation:
         lp = self._lp
         self._leaf_twist = LeafTwist(np.searchsorted(self._leaves, lp.seg_obj[lp.leaf_seg]),
                                      np.asarray(tree.lamina_length, float)[self._leaves], self._seed)
+        self._fallen = FallingLeaves(tree.object_start, tree.object_count, tree.rest_w, self._seed)
 
     def _derive_physics(self) -> None:
         """Stiffness, gains, masses and twist constants from ``self._physics``."""
@@ -299,7 +306,8 @@ class Simulation:
         p = self._physics
         self._drag.derive(p, self._present)
         branch = self._tree.kind == "branch"
-        E = np.where(branch, NOMINAL_WOOD_MODULUS, p.leaf_youngs_modulus)
+        E = np.select([branch, self._tree.kind == "leaf"], [NOMINAL_WOOD_MODULUS, p.leaf_youngs_modulus],
+                      p.blade_youngs_modulus)
         self._lp.derive(E, p.stiffness_exponent, self._drag.half_rho_cda, self._drag.foliage,
                         self._mass * self._present, branch)
         self._mode_snap = None  # the branches' stiffness follows the modes: re-tune on the next step
@@ -412,6 +420,12 @@ class Simulation:
         self._season = s
         present = self._tree.leaves_present(s)
         present.setflags(write=False)
+        if self._load_path:  # leaves dropped now fall from where they are; regrown ones are back
+            fell = np.flatnonzero(self._present & ~present)
+            if len(fell):
+                self._fallen.detach(fell, self.positions, self.rotations)
+            self._fallen.remove(np.flatnonzero(present & ~self._present))
+            self._pos_out = self._rot_out = self._shown_out = None
         self._present = present
         self._derive_modes()
         if self._load_path:
@@ -421,6 +435,16 @@ class Simulation:
     def present(self) -> np.ndarray:
         """(M,) bool: objects shown at the current season (fallen leaves False)."""
         return self._present
+
+    @property
+    def shown(self) -> np.ndarray:
+        """(M,) bool: objects to draw, the present ones and the fallen leaves (see the class)."""
+        if not len(self._fallen):
+            return self._present
+        if self._shown_out is None:
+            self._shown_out = self._present | self._fallen.shown(self._M)
+            self._shown_out.setflags(write=False)
+        return self._shown_out
 
     @property
     def present_nodes(self) -> np.ndarray:
@@ -544,6 +568,7 @@ class Simulation:
         if self._pos_out is None:
             buf = self._recycled("_pos_buf", (self._N, 3))
             pos = self._cplan.positions(self._bplan.o, self._node_frames(), self._base, out=buf)
+            self._fallen.pose(pos)
             pos.setflags(write=False)
             self._pos_out = self._pos_buf = pos
         return self._pos_out
@@ -558,6 +583,7 @@ class Simulation:
         if self._rot_out is None:
             buf = self._recycled("_rot_buf", (self._N, 3, 3))
             rot = self._cplan.rotations(self._bplan.q, self._node_frames(), out=buf)
+            self._fallen.pose(None, rot)
             rot.setflags(write=False)
             self._rot_out = self._rot_buf = rot
         return self._rot_out
@@ -706,6 +732,8 @@ class Simulation:
         self._sample_prev = self._sample_pos.copy()
         self._sample_vel = np.zeros((3, M))
         self._leaf_twist.reset()
+        self._fallen.clear()
+        self._shown_out = None
         self._spread = None  # the low-passed loads along the objects (load path)
         self._pulls.clear()
         self._pos_out = None
@@ -739,6 +767,8 @@ class Simulation:
         U = self._wind_at_samples(self._time)
         if self._load_path:
             self._step_load_path(U, f3, z3, dt)
+            if len(self._fallen):
+                self._fallen.step(self._wind_at_points(self._time), dt)
         else:
             self._step_paper(U, f3, z3, dt)
         self._dt_prev = dt
@@ -760,6 +790,12 @@ class Simulation:
         if not np.isfinite(U).all():
             raise ValueError("wind.sample returned non-finite velocities (NaN or inf)")
         return U
+
+    def _wind_at_points(self, t: float):
+        """``points (n, 3) -> (n, 3)`` the wind at time ``t`` (non-finite values zeroed), or None."""
+        if self._wind is None:
+            return None
+        return lambda pts: np.nan_to_num(np.asarray(self._wind.sample(pts, t), float), posinf=0.0, neginf=0.0)
 
     def _oscillator_coefficients(self, f3: np.ndarray, z3: np.ndarray, dt: float) -> tuple:
         """The exact integrator's coefficients for ``dt`` (cached while the modes are unchanged)."""
