@@ -67,8 +67,8 @@ class FallingLeaves:
         Seed of the leaves' own draws (terminal speed, swing, spin).
     """
 
-    _BODY = ("_n", "_c", "_v", "_off", "_Q", "_age", "_landed", "_Q_land", "_par")  # per leaf
-    _NODE = ("_nodes", "_body", "_r", "_R", "_Pn", "_Rn")  # per node of a fallen leaf
+    _BODY = ("_n", "_c", "_v", "_off", "_Q", "_age", "_landed", "_Q_land", "_par", "_stale_p", "_stale_r")
+    _NODE = ("_nodes", "_body", "_r", "_R", "_Pn", "_Rn")  # per node of a fallen leaf, body by body
 
     def __init__(self, object_start: np.ndarray, object_count: np.ndarray, normal: np.ndarray, seed: int):
         self._start = np.asarray(object_start)
@@ -87,10 +87,12 @@ class FallingLeaves:
         self._Q, self._Q_land = np.zeros((0, 3, 3)), np.zeros((0, 3, 3))
         self._age, self._landed = np.zeros(0), np.zeros(0)
         self._par = np.zeros((0, 7))  # k, ω, A, θ, spin, phase, swing axis (angle)
+        self._stale_p, self._stale_r = np.zeros(0, bool), np.zeros(0, bool)  # moved since posed
         # per node: index, body, offset from the centre and rotation when it fell, pose now
         self._nodes, self._body = np.zeros(0, np.int64), np.zeros(0, np.int64)
         self._r, self._Pn = np.zeros((0, 3)), np.zeros((0, 3))
         self._R, self._Rn = np.zeros((0, 3, 3)), np.zeros((0, 3, 3))
+        self._first = np.zeros(0, np.int64)  # each body's first node in those
 
     def __len__(self) -> int:
         return len(self.objects)
@@ -132,10 +134,11 @@ class FallingLeaves:
         zero3 = np.zeros((F, 3))
         new = dict(_n=n, _c=c, _v=zero3, _off=zero3, _Q=eye, _age=np.zeros(F), _landed=np.full(F, -1.0),
                    _Q_land=eye, _par=par, _nodes=nodes, _body=body + len(self.objects), _r=P - c[body], _R=R,
-                   _Pn=P, _Rn=R)
+                   _Pn=P, _Rn=R, _stale_p=np.zeros(F, bool), _stale_r=np.zeros(F, bool))
         self.objects = np.concatenate([self.objects, objects])
         for name in self._BODY + self._NODE:
             setattr(self, name, np.concatenate([getattr(self, name), new[name]]))
+        self._first = np.searchsorted(self._body, np.arange(len(self.objects)))
 
     def remove(self, objects: np.ndarray) -> None:
         """Forget the fallen ``objects`` (leaves back on the tree)."""
@@ -150,17 +153,21 @@ class FallingLeaves:
         for name in self._NODE:
             setattr(self, name, getattr(self, name)[node_keep])
         self._body = renumber[self._body]
+        self._first = np.searchsorted(self._body, np.arange(len(self.objects)))
 
     def _swing(self, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The swing offset (F′, 3) and rotation since falling (F′, 3, 3) of leaves ``idx``."""
         k, w, A, theta, spin, phase, axis_angle = self._par[idx].T
         age = self._age[idx]
         s = np.sin(w * age + phase) * -np.expm1(-age / RAMP_TIME)  # grows in as it lets go
+        ca, sa = np.cos(axis_angle), np.sin(axis_angle)
         zero = np.zeros_like(age)
-        axis = np.stack([np.cos(axis_angle), zero, np.sin(axis_angle)], axis=1)
-        across = np.stack([-axis[:, 2], zero, axis[:, 0]], axis=1)  # y × axis: the swing
-        up = np.broadcast_to([0.0, 1.0, 0.0], axis.shape)
-        return (A * s)[:, None] * across, _axis_angle(up, spin * age) @ _axis_angle(axis, theta * s)
+        axis = np.stack([ca, zero, sa], axis=1)
+        across = np.stack([-sa, zero, ca], axis=1)  # y × axis: the swing
+        turn = np.zeros((len(idx), 3, 3))  # about the vertical
+        cs, ss = np.cos(spin * age), np.sin(spin * age)
+        turn[:, 0, 0], turn[:, 0, 2], turn[:, 1, 1], turn[:, 2, 0], turn[:, 2, 2] = cs, ss, 1.0, -ss, cs
+        return (A * s)[:, None] * across, turn @ _axis_angle(axis, theta * s)
 
     def step(self, wind_at, dt: float) -> None:
         """Advance every fallen leaf by ``dt`` seconds.
@@ -172,48 +179,40 @@ class FallingLeaves:
         dt : float
             Step length (s), > 0.
         """
-        air = np.flatnonzero(self._landed < 0.0)
-        if len(air):
-            c, v, k = self._c[air], self._v[air], self._par[air, 0]
-            U = np.zeros_like(c) if wind_at is None else np.asarray(wind_at(c + self._off[air]), float)
+        air = self._landed < 0.0
+        settle = (self._landed >= 0.0) & (self._landed < SETTLE_TIME)
+        if not (air.any() or settle.any()):
+            return
+        ia = np.flatnonzero(air)
+        if len(ia):
+            c, v, k = self._c[ia], self._v[ia], self._par[ia, 0]
+            U = np.zeros_like(c) if wind_at is None else np.asarray(wind_at(c + self._off[ia]), float)
             kdt = (k * np.linalg.norm(U - v, axis=1) * dt)[:, None]
             v = v + kdt * U  # dv/dt = g + k|U − v|(U − v), the drag implicit in v
             v[:, 1] -= GRAVITY * dt
             v /= 1.0 + kdt
             v = np.clip(np.nan_to_num(v), -MAX_SPEED, MAX_SPEED)
-            self._v[air] = v
-            self._c[air] = c + v * dt
-            self._age[air] += dt
-            self._off[air], self._Q[air] = self._swing(air)
-        settle = np.flatnonzero((self._landed >= 0.0) & (self._landed < SETTLE_TIME))
-        if len(settle):
-            self._settle(settle, dt)
-        if len(air):  # landing: the swing is folded into the drift, the body stops
-            hit = air[self._lowest(air) <= 0.0]
-            self._c[hit] += self._off[hit]
-            self._off[hit] = 0.0
-            self._landed[hit] = 0.0
-            self._Q_land[hit] = self._Q[hit]
-            self._settle(hit, 0.0)  # lifted onto the ground at once
-        moving = np.union1d(air, settle)
-        if len(moving):
-            sel = np.flatnonzero(np.isin(self._body, moving))
-            b = self._body[sel]
-            self._Pn[sel] = self._c[b] + self._off[b] + np.einsum("nij,nj->ni", self._Q[b], self._r[sel])
-            self._Rn[sel] = self._Q[b] @ self._R[sel]
+            self._v[ia] = v
+            self._c[ia] = c + v * dt
+            self._age[ia] += dt
+            self._off[ia], self._Q[ia] = self._swing(ia)
+        if settle.any():
+            self._turn_flat(np.flatnonzero(settle), dt)
+        self._stale_p |= air | settle
+        self._stale_r |= air | settle
+        y = np.einsum("nj,nj->n", self._Q[self._body, 1], self._r)  # the nodes' heights above c
+        low = np.minimum.reduceat(y, self._first) + self._c[:, 1] + self._off[:, 1]
+        hit = air & (low <= 0.0)  # landing: the swing folds into the drift, the body stops
+        self._c[hit] += self._off[hit]
+        self._off[hit] = 0.0
+        self._landed[hit] = 0.0
+        self._Q_land[hit] = self._Q[hit]
+        lift = np.where(hit | settle, REST_LIFT - low, 0.0)  # landed leaves lie on the ground
+        self._c[:, 1] += lift
 
-    def _lowest(self, idx: np.ndarray) -> np.ndarray:
-        """(F′,) the height of the lowest node of each leaf ``idx`` as it is posed now."""
-        low = np.full(len(self.objects), np.inf)
-        sel = np.flatnonzero(np.isin(self._body, idx))
-        b = self._body[sel]
-        np.minimum.at(low, b, np.einsum("nj,nj->n", self._Q[b, 1], self._r[sel]))
-        return low[idx] + self._c[idx, 1] + self._off[idx, 1]
-
-    def _settle(self, idx: np.ndarray, dt: float) -> None:
-        """Turn the landed leaves ``idx`` flat (the lamina's normal to ±y) over
-        :data:`SETTLE_TIME`, pivoting on the ground: their lowest node stays at
-        :data:`REST_LIFT`."""
+    def _turn_flat(self, idx: np.ndarray, dt: float) -> None:
+        """Turn the landed leaves ``idx`` toward flat (the lamina's normal to ±y) over
+        :data:`SETTLE_TIME`; :meth:`step` then sets their lowest node on the ground."""
         t = np.minimum(self._landed[idx] + dt, SETTLE_TIME)
         self._landed[idx] = t
         s = t / SETTLE_TIME
@@ -226,7 +225,6 @@ class FallingLeaves:
         angle = np.arctan2(sin, np.einsum("fi,fi->f", n, up))
         axis = np.where(sin[:, None] > 1e-12, axis / np.maximum(sin, 1e-300)[:, None], [1.0, 0.0, 0.0])
         self._Q[idx] = _axis_angle(axis, s * angle) @ Ql
-        self._c[idx, 1] += REST_LIFT - self._lowest(idx)
 
     def shown(self, M: int) -> np.ndarray:
         """(M,) bool: the fallen leaves."""
@@ -238,6 +236,13 @@ class FallingLeaves:
         """Write the fallen leaves' nodes into ``positions`` (N, 3) and ``rotations``
         (N, 3, 3) (either may be None), in place."""
         if positions is not None:
+            sel = np.flatnonzero(self._stale_p[self._body])  # nodes of leaves moved since posed
+            b = self._body[sel]
+            self._Pn[sel] = self._c[b] + self._off[b] + np.einsum("nij,nj->ni", self._Q[b], self._r[sel])
+            self._stale_p[:] = False
             positions[self._nodes] = self._Pn
         if rotations is not None:
+            sel = np.flatnonzero(self._stale_r[self._body])
+            self._Rn[sel] = self._Q[self._body[sel]] @ self._R[sel]
+            self._stale_r[:] = False
             rotations[self._nodes] = self._Rn
