@@ -17,7 +17,8 @@ thread (``cpu``), which a busy shared machine disturbs much less than the wall c
 
 Each preset is timed twice: with the paper's model (``load_path=False``, each object on its
 own) and with the load path (the default, DESIGN §12), whose ratio to the paper's step is the
-last column (issue #10: at most 1.3).
+last column (issue #10: at most 1.3). ``--falling`` adds a row for the load path while the
+leaves fall after the season jumps to winter (issue #12), timed from the moment they let go.
 
 Targets (issue #4): large_cherry <= 3 ms, grassland <= 2 ms, small_cherry <= 1 ms per step.
 Where a preset cannot be loaded (presets not installed) a synthetic tree of the same size is
@@ -90,13 +91,16 @@ def load(name: str):
         return synthetic(name), True
 
 
-def bench(tree, steps: int, warmup: int, speed: float, dt: float, load_path: bool = True) -> dict:
+def bench(tree, steps: int, warmup: int, speed: float, dt: float, load_path: bool = True,
+          falling: bool = False) -> dict:
     from treeanim.physics.simulation import Simulation
     from treeanim.physics.wind import WindField
 
     sim = Simulation(tree, wind=WindField(speed=speed, seed=1), load_path=load_path)
     for _ in range(warmup):
         sim.step(dt)
+    if falling:  # the season slider to winter: the leaves let go (each timing loop starts so)
+        sim.season = 1.0
     clock = time.perf_counter
     cpu = time.thread_time  # CPU time of this thread: robust on a shared, busy machine
     t_step, c_step = np.empty(steps), np.empty(steps)
@@ -105,6 +109,9 @@ def bench(tree, steps: int, warmup: int, speed: float, dt: float, load_path: boo
         sim.step(dt)
         c_step[k], t_step[k] = cpu() - c0, clock() - t0
     t_pose, c_pose = np.empty(steps), np.empty(steps)
+    if falling:  # back on the tree, and off again
+        sim.season = 0.0
+        sim.season = 1.0
     for k in range(steps):
         t0, c0 = clock(), cpu()
         sim.step(dt)
@@ -129,6 +136,9 @@ def main(argv=None) -> None:
     ap.add_argument("--warmup", type=int, default=60)
     ap.add_argument("--speed", type=float, default=5.0, help="wind speed at the tree top (m/s)")
     ap.add_argument("--dt", type=float, default=1 / 60)
+    ap.add_argument("--falling", action="store_true",
+                    help="also time the load path while the leaves fall (season set to winter after the "
+                         "warm-up; use --steps of about 2 s, while they are in the air)")
     args = ap.parse_args(argv)
     print(f"# {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
           f"numpy {np.__version__}, one thread, wind {args.speed} m/s, dt {args.dt:.4g} s, "
@@ -138,12 +148,14 @@ def main(argv=None) -> None:
     for name in args.presets:
         tree, synth = load(name)
         paper_cpu = None
-        for model in ("paper", "load path"):
-            r = bench(tree, args.steps, args.warmup, args.speed, args.dt, load_path=model == "load path")
+        models = ("paper", "load path") + (("leaves falling",) if args.falling and (tree.kind == "leaf").any() else ())
+        for model in models:
+            r = bench(tree, args.steps, args.warmup, args.speed, args.dt, load_path=model != "paper",
+                      falling=model == "leaves falling")
             label = f"{name}{' (synthetic)' if synth else ''}, {model}"
             target = TARGETS_MS.get(name)
             ratio = "" if paper_cpu is None else f"{r['step_cpu'] / paper_cpu:.2f}"
-            paper_cpu = r["step_cpu"]
+            paper_cpu = paper_cpu or r["step_cpu"]
             print(f"{label:<32}{tree.n_objects:>8}{tree.n_nodes:>8}{r['step']:>10.2f}{r['step_p90']:>7.2f}"
                   f"{r['step_cpu']:>7.2f}{r['pose']:>14.2f}{r['pose_p90']:>7.2f}{r['pose_cpu']:>7.2f}"
                   f"{(f'{target:.1f}' if target else '-'):>8}{ratio:>8}" + ("" if r["finite"] else "  NON-FINITE!"),
