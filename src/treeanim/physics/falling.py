@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.geometry import unit
+
 __all__ = ["FallingLeaves"]
 
 GRAVITY = 9.81
@@ -221,10 +223,8 @@ class FallingLeaves:
         n = np.einsum("fij,fj->fi", Ql, self._n[idx])
         up = np.where(n[:, 1:2] >= 0.0, 1.0, -1.0) * np.array([0.0, 1.0, 0.0])
         axis = np.cross(n, up)
-        sin = np.linalg.norm(axis, axis=1)
-        angle = np.arctan2(sin, np.einsum("fi,fi->f", n, up))
-        axis = np.where(sin[:, None] > 1e-12, axis / np.maximum(sin, 1e-300)[:, None], [1.0, 0.0, 0.0])
-        self._Q[idx] = _axis_angle(axis, s * angle) @ Ql
+        angle = np.arctan2(np.linalg.norm(axis, axis=1), np.einsum("fi,fi->f", n, up))
+        self._Q[idx] = _axis_angle(unit(axis, np.broadcast_to([1.0, 0.0, 0.0], axis.shape)), s * angle) @ Ql
 
     def shown(self, M: int) -> np.ndarray:
         """(M,) bool: the fallen leaves."""

@@ -893,7 +893,7 @@ class Simulation:
         p_free, pd_free, gain, gain_d = self._oscillator_response(f3, z3, dt, held)
         g = self._g_prev
         slots = self._lp.inward(F_own, F_pull, held, g_extra, (p_free, gain), g)
-        self._advance(g, p_free, pd_free, gain, gain_d, c_air * dt, held)
+        self._advance(g, p_free, pd_free, gain, gain_d, c_air, dt, held)
         self._c_air = c_air
         self._L = g.copy()
         F_own, F_tip, dT, slots = self._distributed_loads(F_own, F_pull, slots, g - g_extra, dt)
@@ -975,9 +975,7 @@ class Simulation:
         # the last step (in a gale it holds a light twig back far more than its own ζ does)
         acc = self._g_prev - self._p
         acc *= w2
-        damp = self._c_air / self._lp.K
-        damp = damp * w2
-        damp[1] = 0.0  # (the air damps the bending modes only)
+        damp = self._air_damping(self._c_air)
         damp += self._two_zeta_w
         acc -= damp * self._pd
         a_u, a_w = self._lp.base_acceleration(acc)
@@ -1013,17 +1011,24 @@ class Simulation:
                 arr[:, held] = val
         return out
 
-    def _advance(self, g, p_free, pd_free, gain, gain_d, c_dt, held) -> None:
+    def _air_damping(self, c_air: np.ndarray) -> np.ndarray:
+        """(3, M) the air's damping rate ω²c/K on every mode (the bending modes only: row v 0)."""
+        damp = self._w2 * (c_air / self._lp.K)
+        damp[1] = 0.0
+        return damp
+
+    def _advance(self, g, p_free, pd_free, gain, gain_d, c_air, dt, held) -> None:
         """Set the oscillators' state after the step under the input g, with the air's damping
         split off and implicit: ṗ /= 1 + ω²c·dt/K (stable however light a twig)."""
         np.multiply(gain, g, out=self._p)
         self._p += p_free
         np.multiply(gain_d, g, out=self._pd)
         self._pd += pd_free
-        damp = c_dt / self._lp.K
-        damp[held] = 0.0  # a held object approaches its pull critically damped, as it is
-        for row in (0, 2):
-            self._pd[row] /= 1.0 + self._w2[row] * damp
+        damp = self._air_damping(c_air)
+        damp[:, held] = 0.0  # a held object approaches its pull critically damped, as it is
+        damp *= dt
+        damp += 1.0
+        self._pd /= damp
 
 
 def _unshared_refs() -> int:
