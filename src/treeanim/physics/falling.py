@@ -81,7 +81,7 @@ class FallingLeaves:
 
     def clear(self) -> None:
         """No leaf has fallen (and the draws start again from the seed)."""
-        self._rng = np.random.default_rng([self._seed, 0x1EAF])
+        self._rng = np.random.default_rng([self._seed, 0xFA11])  # not the flutter's stream (0x1EAF)
         self.objects = np.zeros(0, np.int64)  # (F,) the fallen leaves
         # per leaf: rest normal now, drift centre, velocity, swing offset, rotation since it
         # fell, age, time since landing (−1: in the air), rotation at landing, own draws
