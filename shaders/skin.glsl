@@ -22,17 +22,44 @@ void node_transform(int j, out vec3 p, out mat3 R) {
              b.y, c.x, c.w);  // column 2
 }
 
-// The rotation a vertex follows: node's, or at an inner joint the blend of the two
-// segments' rotations made orthonormal again (Gram-Schmidt), so tubes bend smoothly.
-void skin_transform(int node, int node2, float weight, out vec3 p, out mat3 R) {
-    node_transform(node, p, R);
+mat3 orthonormal(mat3 m) {  // Gram-Schmidt on the columns
+    vec3 c0 = normalize(m[0]);
+    vec3 c1 = normalize(m[1] - dot(m[1], c0) * c0);
+    return mat3(c0, c1, cross(c0, c1));
+}
+
+// Where a mesh vertex goes and the frame it turns with (render/mesh.py's notes; TreeMesh.skin
+// is the same on the CPU). The vertex lies at t along the segment leaving `node`; T0 is the
+// segment's frame at the node (R[node] blended with R[prev], the ground's identity for
+// prev < 0), T1 at its far end (a joint's mean, or at an object's tip 1.5 R - 0.5 T0). Inside
+// a segment the vertex rides the cubic Hermite curve between the ends with tangents T0 c and
+// T1 c, c the segment's rest chord, turned by the frame that carries c onto the curve's tangent.
+void skin_transform(int node, int prev, float weight, vec2 curve, vec3 offset, out vec3 world, out mat3 R) {
+    vec3 p0;
+    mat3 Rs;
+    node_transform(node, p0, Rs);
+    mat3 T0 = Rs;
     if (weight > 0.0) {
-        vec3 p2;
-        mat3 R2;
-        node_transform(node2, p2, R2);
-        mat3 m = R * (1.0 - weight) + R2 * weight;
-        vec3 c0 = normalize(m[0]);
-        vec3 c1 = normalize(m[1] - dot(m[1], c0) * c0);
-        R = mat3(c0, c1, cross(c0, c1));
+        vec3 pp;
+        mat3 Rp = mat3(1.0);
+        if (prev >= 0) node_transform(prev, pp, Rp);
+        T0 = orthonormal(Rs * (1.0 - weight) + Rp * weight);
     }
+    float t = curve.x;
+    if (t <= 0.0) {
+        R = T0;
+        world = p0 + R * offset;
+        return;
+    }
+    vec3 p1;
+    mat3 R1;
+    node_transform(node + 1, p1, R1);
+    vec3 c = transpose(Rs) * (p1 - p0);
+    mat3 T1 = orthonormal(curve.y > 0.5 ? 1.5 * Rs - 0.5 * T0 : 0.5 * (Rs + R1));
+    float t2 = t * t;
+    float t3 = t2 * t;
+    vec3 centre = (2.0 * t3 - 3.0 * t2 + 1.0) * p0 + (3.0 * t2 - 2.0 * t3) * p1
+                + (t3 - 2.0 * t2 + t) * (T0 * c) + (t3 - t2) * (T1 * c);
+    R = orthonormal((3.0 * t2 - 4.0 * t + 1.0) * T0 + (6.0 * t - 6.0 * t2) * Rs + (3.0 * t2 - 2.0 * t) * T1);
+    world = centre + R * (offset - t * c);
 }

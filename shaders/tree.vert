@@ -3,11 +3,12 @@
 
 #include "skin.glsl"
 
-in ivec4 in_ids;     // node, node2, object, material
+in ivec4 in_ids;     // node, prev, object, material
 in vec3 in_offset;   // rest offset from the node
 in vec3 in_normal;   // rest normal
-in vec4 in_extra;    // weight of node2, per-object jitter, ambient occlusion, key
+in vec4 in_extra;    // weight of prev, per-object jitter, ambient occlusion, key
 in vec2 in_uv;       // surface coordinates (see render/mesh.py)
+in vec2 in_curve;    // t along the segment, 1 where it ends at the object's tip
 
 uniform mat4 u_view_proj;
 uniform sampler2D u_objects;   // per object: r = visible, g = highlight
@@ -59,10 +60,8 @@ void main() {
         gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
         return;
     }
-    vec3 p;
     mat3 R;
-    skin_transform(in_ids.x, in_ids.y, in_extra.x, p, R);
-    v_world = p + R * in_offset;
+    skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, v_world, R);
     v_normal = R * in_normal;
     gl_Position = u_view_proj * vec4(v_world, 1.0);
 

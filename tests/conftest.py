@@ -96,6 +96,15 @@ def beam_tree() -> "Tree":  # noqa: F821
     return assemble([ObjectSpec(pts, np.linspace(0.1, 0.03, 9), "branch", 1)], name="beam_test")
 
 
+def twig_tree(length: float = 0.6) -> "Tree":  # noqa: F821
+    """A 1 m trunk carrying one straight one-segment twig along +x at its top."""
+    trunk = _curve((0, 0, 0), (0, 1, 0), 1.0, 3)
+    twig = np.array([trunk[2], trunk[2] + (length, 0.0, 0.0)])
+    return assemble([ObjectSpec(trunk, np.linspace(0.08, 0.05, 3), "branch", 1),
+                     ObjectSpec(twig, np.array([0.03, 0.015]), "branch", 2, parent=0, attach=2)],
+                    name="twig_test")
+
+
 @pytest.fixture(scope="session")
 def tree():
     return small_tree()

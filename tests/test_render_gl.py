@@ -143,6 +143,46 @@ def test_inner_joint_bend_keeps_the_tube_closed(offscreen):
     assert mask[xy[:, 1], xy[:, 0]].all()
 
 
+def test_a_hard_pulled_one_segment_twig_is_drawn_as_a_curve(offscreen):
+    """Pull a one-segment twig's tip down with the simulation: the drawn twig leaves the trunk
+    level and bows above its chord (a rod under a tip load, not a stick hinged at the trunk),
+    where the CPU skinning puts it."""
+    from conftest import twig_tree
+
+    from treeanim.physics.simulation import Simulation
+
+    offscreen.resize(W, H)
+    tree = twig_tree()
+    r = offscreen.load(tree)
+    sim = Simulation(tree)
+    sim.pull(1, (0.0, -0.2, 0.0))
+    for _ in range(300):
+        sim.step(1 / 60)
+    P, R = sim.positions, sim.rotations
+    base, tip = P[tree.object_start[1]], P[tree.object_start[1] + 1]
+    assert 25 < np.degrees(np.arctan2(base[1] - tip[1], tip[0] - base[0])) < 60  # the chord's slope
+    cam = OrbitCamera(target=0.5 * (base + tip), distance=1.2, azimuth=0.0, elevation=0.0)
+    bg = background(offscreen, r, cam)
+    offscreen.update(P, R, present=np.array([False, True]))  # the twig alone
+    twig = changed(offscreen.render(cam), bg)
+    (bx, by), (tx, ty) = cam.project(np.array([base, tip]), W, H)[:, :2]
+    cols = np.arange(int(bx) + 4, int(tx) - 4)
+    assert len(cols) > 40
+    rows = np.array([np.nonzero(twig[:, c])[0].mean() for c in cols])
+    chord = by + (cols + 0.5 - bx) * (ty - by) / (tx - bx)
+    bow = chord - (rows + 0.5)  # pixels above the chord (image rows grow downwards)
+    assert bow.max() > 4, bow.max()
+    assert 0.25 < np.argmax(bow) / len(cols) < 0.6  # widest at 0.42 of the way, as a rod's
+    # The GPU draws where TreeMesh.skin puts the twig's axis.
+    mesh = r.mesh
+    pts, _ = mesh.skin(P, R)
+    t = mesh.vertices["curve"][:, 0]
+    inner = [pts[(mesh.object == 1) & (t == ti)].mean(axis=0) for ti in (0.25, 0.5, 0.75)]
+    for x, y in cam.project(np.array(inner), W, H)[:, :2]:
+        drawn = np.nonzero(twig[:, int(x)])[0].mean() + 0.5
+        assert abs(drawn - y) < 1.0, (x, y, drawn)
+
+
 # ------------------------------------------------------------------------------ leaves, season
 def bare(off, r, cam, season=0.0):
     """The tree with every leaf hidden."""

@@ -6,8 +6,9 @@ import re
 
 import numpy as np
 import pytest
-from conftest import beam_tree, grass_patch, small_tree
+from conftest import beam_tree, grass_patch, small_tree, twig_tree
 
+from treeanim.model.geometry import unit as _unit
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.mesh import (
     MATERIAL_BARK,
@@ -59,7 +60,11 @@ def test_per_kind_triangles_follow_the_papers_rule():
     n = tree.object_count
     branch = tree.kind == "branch"
     leaf = tree.kind == "leaf"
-    assert np.all(mesh.object_triangles[branch] == 32 * n[branch])
+    # Branch tubes: 2 x 16 triangles a band, at least four bands (a twig of one or two
+    # segments is split along its curve), plus two 16-triangle end fans.
+    segments = n[branch] - 1
+    bands = segments * np.ceil(4 / segments)
+    assert np.all(mesh.object_triangles[branch] == 32 * bands + 32)
     lam = len(tree.lamina.triangles)
     assert np.all(mesh.object_triangles[leaf] == 2 * tree.petiole_sides * (n[leaf] - 1) + lam)
     grass = grass_patch()
@@ -90,7 +95,11 @@ def test_vertex_layout():
     mesh = build_mesh(small_tree())
     v = mesh.vertices
     assert set(np.unique(mesh.material)) == {MATERIAL_BARK, MATERIAL_PETIOLE, MATERIAL_LAMINA}
-    assert np.all((v["extra"][:, 0] == 0) | (v["extra"][:, 0] == 0.5))
+    assert np.all(np.isin(v["extra"][:, 0], [0.0, 0.5, 1.0]))
+    t, end = v["curve"][:, 0], v["curve"][:, 1]
+    assert np.all((t >= 0) & (t <= 1)) and np.all(np.isin(end, [0.0, 1.0]))
+    assert np.all((t == 0) | (mesh.material == MATERIAL_BARK))  # only branches curve
+    assert np.all((end == 0) | (mesh.material == MATERIAL_BARK))
     assert np.all((v["extra"][:, 1] >= 0) & (v["extra"][:, 1] < 1))
     assert np.all((v["extra"][:, 2] > 0) & (v["extra"][:, 2] <= 1))
     assert np.allclose(np.linalg.norm(v["normal"], axis=1), 1, atol=1e-5)
@@ -112,13 +121,22 @@ def test_rest_geometry():
     mesh = build_mesh(tree)
     pts, normals = mesh.skin(tree.rest_positions, identity(tree))
     node = mesh.node
-    # Tube rings lie at the node's radius (cap centres, whose offset runs along their normal,
-    # are left out).
-    off = mesh.vertices["offset"]
-    bark = (mesh.material == MATERIAL_BARK) & (np.linalg.norm(np.cross(off, mesh.vertices["normal"]), axis=1) > 1e-6)
-    assert bark.sum() == 16 * tree.object_count[tree.kind == "branch"].sum()
-    ring_r = np.linalg.norm(pts[bark] - tree.rest_positions[node[bark]], axis=1)
-    assert np.allclose(ring_r, 0.5 * tree.node_diameter[node[bark]], rtol=1e-5)
+    # Tube rings lie on the segments' chords at the tapering radius (the end fans' centres, on
+    # the axis, are left out): one ring at every band's ends.
+    P, r = tree.rest_positions, 0.5 * tree.node_diameter
+    t = mesh.vertices["curve"][:, 0]
+    bark = np.flatnonzero(mesh.material == MATERIAL_BARK)
+    j = node[bark]
+    axis = P[np.minimum(j + 1, len(P) - 1)] - P[j]
+    centre = P[j] + t[bark, None] * axis
+    dist = np.linalg.norm(pts[bark] - centre, axis=1)
+    ring = np.linalg.norm(np.cross(pts[bark] - centre, _unit(axis)), axis=1) > 1e-6
+    n = tree.object_count[tree.kind == "branch"]
+    assert ring.sum() == 16 * np.sum((n - 1) * np.ceil(4 / (n - 1)) + 1)
+    radius = (1 - t[bark]) * r[j] + t[bark] * r[np.minimum(j + 1, len(P) - 1)]
+    assert np.allclose(dist[ring], radius[ring], rtol=1e-5)
+    inside = ring & (t[bark] > 0)  # rings inside a segment stand square to it
+    assert inside.any() and np.allclose(np.sum((pts[bark] - centre)[inside] * axis[inside], axis=1), 0, atol=1e-7)
     # The lamina's tip (0, 1) sits one lamina length along the petiole's last segment.
     leaves = np.flatnonzero(tree.kind == "leaf")
     tipn, u, v, w = lamina_frames(tree, leaves)
@@ -140,14 +158,21 @@ def test_rest_geometry():
 
 
 def test_rigid_motion_is_skinned_exactly():
+    """Turn every node rigidly: every vertex turns with it, but the trunk's base, which the
+    ground holds (its first segment curves away from the ground's frame)."""
     tree = small_tree()
     mesh = build_mesh(tree)
     rest_pts, rest_n = mesh.skin(tree.rest_positions, identity(tree))
     R = rot((0.3, 1.0, -0.2), 0.9)
     t = np.array([0.4, -0.1, 2.0])
     pts, normals = mesh.skin(tree.rest_positions @ R.T + t, np.broadcast_to(R, (tree.n_nodes, 3, 3)))
-    assert np.allclose(pts, rest_pts @ R.T + t, atol=1e-6)
-    assert np.allclose(normals, rest_n @ R.T, atol=1e-6)
+    ground = mesh.vertices["ids"][:, 1] == -1
+    assert ground.any() and np.all(tree.parent[mesh.object[ground]] == -1)
+    assert np.allclose(pts[~ground], rest_pts[~ground] @ R.T + t, atol=1e-6)
+    assert np.allclose(normals[~ground], rest_n[~ground] @ R.T, atol=1e-6)
+    held = ground & (mesh.vertices["curve"][:, 0] == 0)
+    base = mesh.node[held]
+    assert np.allclose(pts[held] - (tree.rest_positions[base] @ R.T + t), rest_pts[held] - tree.rest_positions[base])
 
 
 def test_joint_rings_follow_both_segments():
@@ -171,6 +196,40 @@ def test_joint_rings_follow_both_segments():
     # Rings away from the joint follow their own segment rigidly.
     after = (mesh.node == j + 2) & (mesh.material == MATERIAL_BARK)
     assert np.allclose(pts[after] - positions[j + 2], mesh.vertices["offset"][after] @ R.T, atol=1e-6)
+
+
+def test_a_pulled_one_segment_twig_bends_as_a_rod():
+    """Turn a one-segment twig's segment down by θ about its base (a pull at its tip): its tube
+    leaves the trunk along the trunk's frame, sags t²(3 − t)/2 of the tip's drop at t (a
+    cantilever under a tip load) and ends turned 1.5 θ, where a straight stick would hinge."""
+    tree = twig_tree()
+    mesh = build_mesh(tree)
+    theta, L = 0.05, 0.6
+    R = rot((0, 0, 1), -theta)
+    P = tree.rest_positions.copy()
+    rotations = np.array(identity(tree))
+    base, tip = tree.object_start[1], tree.object_start[1] + 1
+    P[tip] = P[base] + (P[tip] - P[base]) @ R.T
+    rotations[base:] = R
+    pts, normals = mesh.skin(P, rotations)
+    twig = (mesh.object == 1) & (np.linalg.norm(np.cross(mesh.vertices["offset"], [1.0, 0, 0]), axis=1) > 1e-6)
+    t = mesh.vertices["curve"][twig, 0]
+    rings = np.unique(t)
+    assert len(rings) == 5  # four bands
+    centre = np.array([pts[twig][t == ti].mean(axis=0) for ti in rings])
+    drop = centre[:, 1] - P[base, 1]
+    assert np.allclose(drop, -L * np.sin(theta) * rings ** 2 * (3 - rings) / 2, atol=0.03 * L * theta)
+    assert np.allclose(centre[:, 0] - P[base, 0], L * rings, atol=0.01 * L)
+    # A straight stick's middle would sit at half the drop; the rod's sits at 5/16 of it.
+    assert drop[2] == pytest.approx(-L * np.sin(theta) * 5 / 16, rel=0.03)
+
+    def ring_axis(ti):  # the normal of the ring's plane, from its vertices' spread
+        q = pts[twig][t == ti]
+        return np.linalg.svd(q - q.mean(axis=0))[2][-1]
+
+    assert abs(ring_axis(0.0) @ [1.0, 0, 0]) == pytest.approx(1, abs=1e-9)  # welded to the trunk's frame
+    tip_axis = ring_axis(1.0)
+    assert np.degrees(np.arccos(abs(tip_axis @ [1.0, 0, 0]))) == pytest.approx(np.degrees(1.5 * theta), rel=0.02)
 
 
 def test_mesh_of_a_leafy_tree():

@@ -224,9 +224,13 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     nrm = v["normal"].astype(np.float64)
     nrm = (nrm / np.linalg.norm(nrm, axis=1, keepdims=True)).astype(np.float32)
     col = np.round(vertex_colours(tree, mesh, season)[used] * 255).astype(np.uint8)
-    w2 = v["extra"][:, 0].astype(np.float64)
+    # Linear-blend skinning: a vertex at t along a branch's segment leans from its base frame
+    # T₀ toward its segment's joint as a cantilever, by t(3 − t)/2 (the renderer's Hermite
+    # curve, without the tip's overshoot, which blend weights cannot express).
+    t = v["curve"][:, 0].astype(np.float64)
+    w2 = v["extra"][:, 0].astype(np.float64) * (1.0 - 0.5 * t * (3.0 - t))
     j1 = skel.node_joint[ids[:, 0]]
-    j2 = skel.node_joint[ids[:, 1]]
+    j2 = np.where(ids[:, 1] >= 0, skel.node_joint[np.maximum(ids[:, 1], 0)], 0)  # -1: the ground
     single = (w2 <= 0) | (j1 == j2)
     joints = np.zeros((len(v), 4), np.uint16)
     weights = np.zeros((len(v), 4), np.uint8)  # normalised: each vertex's weights sum to 255

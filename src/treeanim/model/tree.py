@@ -18,9 +18,23 @@ from .params import PhysicsParams
 
 KINDS = ("branch", "leaf", "blade")
 
-#: Sides of a branch tube: 2 x 16 triangles per segment plus a 16-triangle fan at each end,
-#: i.e. the paper's 32 triangles per node.
+#: Sides of a branch tube: 2 x 16 triangles per band of the tube plus a 16-triangle fan at
+#: each end (the paper's 32 triangles per node when every segment is one band).
 BRANCH_SIDES = 16
+
+#: A branch's tube has at least this many bands along its length, so that a bent branch is
+#: drawn as a curve however few segments it has (see :func:`curve_bands`).
+CURVE_BANDS = 4
+
+
+def curve_bands(object_count: np.ndarray) -> np.ndarray:
+    """Bands per segment of a branch tube with ``object_count`` nodes: ⌈4 / segments⌉.
+
+    A one-segment twig is drawn in four bands along the beam's deflection curve, a limb of
+    four or more segments in one band per segment.
+    """
+    segments = np.maximum(np.asarray(object_count) - 1, 1)
+    return -(-CURVE_BANDS // segments)
 
 
 @dataclass(frozen=True)
@@ -203,7 +217,8 @@ class Tree:
     def triangles_per_object(self) -> np.ndarray:
         """(M,) int: triangles the renderer draws for each object.
 
-        Branch: a 16-sided tube over its segments closed by a fan at each end, i.e. 32 per node.
+        Branch: a 16-sided tube in :func:`curve_bands` bands per segment, closed by a fan at
+        each end (32 per node for branches of four or more segments, as the paper's tubes).
         Leaf: a petiole tube (``petiole_sides``) plus the lamina triangulation.
         Blade: a two-sided strip over its segments plus a tip triangle.
         """
@@ -211,7 +226,7 @@ class Tree:
         lamina_tris = 0 if self.lamina is None else len(self.lamina.triangles)
         return np.select(
             [self.kind == "branch", self.kind == "leaf"],
-            [2 * BRANCH_SIDES * n, 2 * self.petiole_sides * (n - 1) + lamina_tris],
+            [2 * BRANCH_SIDES * ((n - 1) * curve_bands(n) + 1), 2 * self.petiole_sides * (n - 1) + lamina_tris],
             2 * (n - 1) + 1,
         )
 

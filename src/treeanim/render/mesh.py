@@ -2,38 +2,53 @@
 
 A tree's mesh never changes while it animates: every vertex stores the node whose transform
 it follows and its offset from that node at rest, and the vertex shader (``shaders/skin.glsl``)
-places it each frame from the node positions and rotations the simulation produces::
+places it each frame from the node positions and rotations the simulation produces
+(DESIGN §6, §10). :meth:`TreeMesh.skin` is the same formula on the CPU.
 
-    world = positions[node] + R @ offset,   R = orthonormalise(mix(R[node], R[node2], weight))
+A vertex lies on the segment that leaves its node j, at a fraction t of its length (t = 0 at
+the node). Its segment's end frames are T₀ = orthonormalise(mix(R[j], R[prev], weight)) —
+``prev`` is the previous node at an inner joint (weight ½), the parent's attach node at a
+branch's base (weight 1; ``prev = −1``, the ground, for a root), else ``prev = j`` — and
+T₁ = orthonormalise(½(R[j] + R[j+1])) at an inner joint or, where the segment ends at the
+object's tip, orthonormalise(1.5·R[j] − ½·T₀) (a cantilever's tip turns 1.5 times its chord).
+A vertex with t = 0 is placed at ``positions[j] + T₀ @ offset``. One with t > 0 (the rings
+inside a branch's segments, and its tip) follows the cubic Hermite curve between the segment's
+ends with tangents T₀c and T₁c (c = R[j]ᵀ(p[j+1] − p[j]), the segment's rest chord), turned by
+the frame orthonormalise((3t²−4t+1)·T₀ + (6t−6t²)·R[j] + (3t²−2t)·T₁), the rotation that
+carries c onto the curve's tangent::
 
-(DESIGN §6, §10). Rings at an object's inner joints follow both segments that meet there
-(weight 0.5), so tubes bend smoothly; every other vertex has ``node2 == node`` and weight 0.
+    world = H(t) + F(t) @ (offset − t·c)
+
+so a one-segment twig pulled by its tip bends as a rod, t²(3 − t)/2 of its tip deflection
+at t, welded to its parent's (or the ground's) direction at its base.
 
 Geometry per object kind (triangle counts equal :meth:`Tree.triangles_per_object`):
 
-- branch: a ``BRANCH_SIDES`` (16)-sided tapered tube with a ring of 16 vertices at every node,
-  closed by a 16-triangle fan at each end (the tip fan is a low cone, so tips look rounded;
-  the base fan closes the tube inside its parent): 2·16·(n−1) + 2·16 = 32·n triangles, the
-  paper's 32 per node.
-- leaf: a ``tree.petiole_sides``-sided petiole tube over its segments (no caps), plus the
-  species' lamina triangulation placed on the petiole's tip node: v = direction of the
+- branch: a ``BRANCH_SIDES`` (16)-sided tapered tube whose segments are split in
+  :func:`~treeanim.model.tree.curve_bands` bands each (four along a one-segment twig), a ring
+  of 16 vertices at each band's ends, closed by a 16-triangle fan at each end (the tip fan is
+  a low cone, so tips look rounded; the base fan closes the tube inside its parent).
+- leaf: a ``tree.petiole_sides``-sided petiole tube with a ring at each node (no caps, no
+  curve: the lamina is rigid on the petiole's tip node), plus the species' lamina
+  triangulation placed on the petiole's tip node: v = direction of the
   petiole's last segment, w = ``tree.rest_w`` orthogonalised against v, u = v × w; a lamina
   point (x, y) sits at ``L·(x·u + y·v + curl·x²·w)`` from the tip, L = ``lamina_length``.
 - blade: a strip with 2 vertices per node across the blade's w axis (width =
   ``node_diameter``; the strip's face contains the blade's tangent and faces along the bending
   plane), plus one tip triangle to an apex half a segment beyond the tip: 2·(n−1) + 1.
 
-Vertex layout (:data:`VERTEX_DTYPE`, 64 bytes, interleaved, attribute format
+Vertex layout (:data:`VERTEX_DTYPE`, 72 bytes, interleaved, attribute format
 :data:`VERTEX_FORMAT`)::
 
-    in_ids    ivec4  (node, node2, object, material)
-    in_offset vec3   rest offset from rest_positions[node], metres
+    in_ids    ivec4  (node j, prev, object, material)
+    in_offset vec3   rest offset from rest_positions[j], metres
     in_normal vec3   rest normal (unit)
-    in_extra  vec4   (weight of node2's rotation, per-object jitter in [0, 1),
+    in_extra  vec4   (weight of prev's rotation in T₀, per-object jitter in [0, 1),
                       ambient occlusion in (0, 1], key)
     in_uv     vec2   surface coordinates: bark and petioles (turn around the tube in [0, 1),
                      metres along the object); laminas (x, y) in leaf units; blades
                      (−1 / +1 across, fraction along)
+    in_curve  vec2   (t along the segment, 1 where the segment ends at the object's tip)
 
 ``key`` depends on the material: for lamina and petiole vertices the leaf's drop order
 normalised to [0, 1] (0 falls first, and turns colour first); for blades the fraction along
@@ -50,7 +65,7 @@ import numpy as np
 from ..model.geometry import arc_length, lamina_frames
 from ..model.geometry import perpendicular as _perpendicular
 from ..model.geometry import unit as _unit
-from ..model.tree import BRANCH_SIDES, Tree
+from ..model.tree import BRANCH_SIDES, Tree, curve_bands
 
 MATERIAL_BARK = 0
 MATERIAL_PETIOLE = 1
@@ -59,11 +74,11 @@ MATERIAL_BLADE = 3
 
 VERTEX_DTYPE = np.dtype(
     [("ids", "<i4", (4,)), ("offset", "<f4", (3,)), ("normal", "<f4", (3,)), ("extra", "<f4", (4,)),
-     ("uv", "<f4", (2,))]
+     ("uv", "<f4", (2,)), ("curve", "<f4", (2,))]
 )
 #: moderngl buffer format and attribute names matching :data:`VERTEX_DTYPE`.
-VERTEX_FORMAT = "4i 3f 3f 4f 2f"
-VERTEX_ATTRIBUTES = ("in_ids", "in_offset", "in_normal", "in_extra", "in_uv")
+VERTEX_FORMAT = "4i 3f 3f 4f 2f 2f"
+VERTEX_ATTRIBUTES = ("in_ids", "in_offset", "in_normal", "in_extra", "in_uv", "in_curve")
 
 
 @dataclass(eq=False)
@@ -131,13 +146,31 @@ class TreeMesh:
         -------
         points, normals : (V, 3) float64
         """
-        ids, extra = self.vertices["ids"], self.vertices["extra"]
-        positions = np.asarray(positions, float)
-        rotations = np.asarray(rotations, float)
-        w = extra[:, 0, None, None].astype(float)
-        R = blend_rotations(rotations[ids[:, 0]] * (1.0 - w) + rotations[ids[:, 1]] * w)
-        points = positions[ids[:, 0]] + np.einsum("vij,vj->vi", R, self.vertices["offset"].astype(float))
-        normals = np.einsum("vij,vj->vi", R, self.vertices["normal"].astype(float))
+        v = self.vertices
+        j, prev = v["ids"][:, 0], v["ids"][:, 1]
+        w = v["extra"][:, 0, None, None].astype(float)
+        t = v["curve"][:, 0].astype(float)
+        offset = v["offset"].astype(float)
+        P = np.asarray(positions, float)
+        R = np.asarray(rotations, float)
+        Rs = R[j]
+        Rp = np.where(prev[:, None, None] >= 0, R[np.maximum(prev, 0)], np.eye(3))
+        F = np.where(w > 0, blend_rotations(Rs * (1.0 - w) + Rp * w), Rs)  # T₀
+        points = P[j] + np.einsum("vij,vj->vi", F, offset)
+        m = np.flatnonzero(t > 0)
+        if len(m):
+            jm, tm, T0, Rm = j[m], t[m, None], F[m], Rs[m]
+            c = np.einsum("vji,vj->vi", Rm, P[jm + 1] - P[jm])  # rest chord
+            tip = (v["curve"][m, 1] > 0.5)[:, None, None]
+            T1 = blend_rotations(np.where(tip, 1.5 * Rm - 0.5 * T0, 0.5 * (Rm + R[jm + 1])))
+            t2, t3 = tm * tm, tm * tm * tm
+            centre = ((2 * t3 - 3 * t2 + 1) * P[jm] + (3 * t2 - 2 * t3) * P[jm + 1]
+                      + (t3 - 2 * t2 + tm) * np.einsum("vij,vj->vi", T0, c)
+                      + (t3 - t2) * np.einsum("vij,vj->vi", T1, c))
+            t2, tm = t2[:, :, None], tm[:, :, None]
+            F[m] = blend_rotations((3 * t2 - 4 * tm + 1) * T0 + (6 * tm - 6 * t2) * Rm + (3 * t2 - 2 * tm) * T1)
+            points[m] = centre + np.einsum("vij,vj->vi", F[m], offset[m] - tm[:, 0] * c)
+        normals = np.einsum("vij,vj->vi", F, v["normal"].astype(float))
         return points, normals
 
 
@@ -181,15 +214,16 @@ class _Parts:
         self.tri_obj: list[np.ndarray] = []
         self.count = 0
 
-    def add(self, node, node2, obj, material, offset, normal, weight, jitter, key, uv=0.0) -> int:
+    def add(self, node, prev, obj, material, offset, normal, weight, jitter, key, uv=0.0, curve=0.0) -> int:
         v = np.zeros(len(node), VERTEX_DTYPE)
-        v["ids"] = np.stack([node, node2, obj, np.broadcast_to(material, node.shape)], axis=1)
+        v["ids"] = np.stack([node, prev, obj, np.broadcast_to(material, node.shape)], axis=1)
         v["offset"] = offset
         v["normal"] = normal
         v["extra"][:, 0] = weight
         v["extra"][:, 1] = jitter
         v["extra"][:, 3] = key
         v["uv"] = uv
+        v["curve"] = curve
         base = self.count
         self.verts.append(v)
         self.count += len(v)
@@ -200,61 +234,94 @@ class _Parts:
         self.tri_obj.append(np.broadcast_to(obj, tris.shape[:-1]).reshape(-1))
 
 
-def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, caps: bool, material: int,
+def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool, material: int,
            jitter: np.ndarray, key: np.ndarray) -> None:
-    """Tapered tubes with ``sides`` sides over the segments of objects ``objs``."""
+    """Tapered tubes with ``sides`` sides over the segments of objects ``objs``.
+
+    ``curved`` (branches): :func:`curve_bands` bands per segment on the deflection curve, the
+    base turning with the parent (the ground for a root), and a fan closing each end. Else
+    (petioles): a ring at every node, no fans.
+    """
     if len(objs) == 0:
         return
     P = tree.rest_positions
     nodes, k, obj = _object_nodes(tree, objs)
-    t, base, tip, nxt, prv = _node_tangents(tree, nodes, k, obj)
+    tangent, base, tip, nxt, prv = _node_tangents(tree, nodes, k, obj)
     r = 0.5 * tree.node_diameter
-    span = np.linalg.norm(P[nxt] - P[prv], axis=1)
-    slope = np.where(span > 1e-12, (r[nxt] - r[prv]) / np.where(span > 1e-12, span, 1.0), 0.0)
+    inner = ~(base | tip)
+    # T₀ of the segment leaving each node (module notes).
+    prev = np.where(inner, nodes - 1, nodes)
+    weight = np.where(inner, 0.5, 0.0)
+    if curved:
+        prev = np.where(base, np.where(tree.parent[obj] >= 0, tree.attach_node[obj], -1), prev)
+        weight = np.where(base, 1.0, weight)
+
+    # Rings: bands per segment from each non-tip node, then the object's end ring (t = 1 on
+    # the last segment where curved, else the tip node's own ring).
+    bands = curve_bands(tree.object_count[obj]) if curved else np.ones(len(nodes), np.int64)
+    reps = np.where(tip, 1, bands)
+    src = np.repeat(np.arange(len(nodes)), reps)
+    t = (np.arange(len(src)) - np.repeat(np.cumsum(reps) - reps, reps)) / bands[src]
+    last = tip[src]  # each object's end ring
+    first = base[src] & (t == 0)
+    if curved:
+        src = np.where(last, src - 1, src)
+        t = np.where(last, 1.0, t)
+    n0, n1 = nodes[src], nxt[src]
+    chord = P[n1] - P[n0]
+    seg_len = np.linalg.norm(chord, axis=1)
+    seg_slope = (r[n1] - r[n0]) / np.where(seg_len > 1e-12, seg_len, 1.0)
+    span = np.linalg.norm(P[nxt] - P[prv], axis=1)[src]
+    node_slope = np.where(span > 1e-12, (r[nxt] - r[prv])[src] / np.where(span > 1e-12, span, 1.0), 0.0)
+    at_node = t == 0
+    tan = np.where(at_node[:, None], tangent[src], _unit(chord, tangent[src]))
+    slope = np.where(at_node, node_slope, seg_slope)
+    radius = (1.0 - t) * r[n0] + t * r[n1]
+    ring_obj = obj[src]
 
     # Ring frame: the object's w axis projected off the tangent (continuous along a planar
     # object, no twist); a fixed perpendicular where w runs along the tangent.
-    w = tree.rest_w[obj]
-    a = _unit(w - np.sum(w * t, axis=1, keepdims=True) * t, _perpendicular(t))
-    b = np.cross(t, a)
+    w = tree.rest_w[ring_obj]
+    a = _unit(w - np.sum(w * tan, axis=1, keepdims=True) * tan, _perpendicular(tan))
+    b = np.cross(tan, a)
     ang = 2.0 * np.pi * np.arange(sides) / sides
     radial = np.cos(ang)[None, :, None] * a[:, None, :] + np.sin(ang)[None, :, None] * b[:, None, :]
-    offset = r[nodes, None, None] * radial
-    normal = _unit(radial - slope[:, None, None] * t[:, None, :])
+    offset = t[:, None, None] * chord[:, None, :] + radius[:, None, None] * radial
+    normal = _unit(radial - slope[:, None, None] * tan[:, None, :])
 
-    inner = ~(base | tip)
-    node2 = np.where(inner, nodes - 1, nodes)
-    weight = np.where(inner, 0.5, 0.0)
-    along = arc_length(tree)[nodes]
-    uv = np.stack([np.broadcast_to(np.arange(sides) / sides, (len(nodes), sides)),
-                   np.broadcast_to(along[:, None], (len(nodes), sides))], -1).reshape(-1, 2)
-    rep = lambda x: np.repeat(x, sides)  # noqa: E731
-    v0 = parts.add(rep(nodes), rep(node2), rep(obj), material, offset.reshape(-1, 3),
-                   normal.reshape(-1, 3), rep(weight), rep(jitter[obj]), rep(key[obj]), uv)
+    along = arc_length(tree)[n0] + t * seg_len
+    ends_at_tip = curved & tip[np.minimum(src + 1, len(nodes) - 1)]
+    curve = np.stack([t, ends_at_tip.astype(float)], -1)
+    uv = np.stack([np.broadcast_to(np.arange(sides) / sides, (len(src), sides)),
+                   np.broadcast_to(along[:, None], (len(src), sides))], -1).reshape(-1, 2)
+    rep = lambda x: np.repeat(x, sides, axis=0)  # noqa: E731
+    v0 = parts.add(rep(n0), rep(prev[src]), rep(ring_obj), material, offset.reshape(-1, 3),
+                   normal.reshape(-1, 3), rep(weight[src]), rep(jitter[ring_obj]), rep(key[ring_obj]),
+                   uv, rep(curve))
 
-    ring = v0 + sides * np.arange(len(nodes))  # first vertex of each node's ring
+    ring = v0 + sides * np.arange(len(src))  # first vertex of each ring
     s0 = np.arange(sides)
     s1 = (s0 + 1) % sides
-    seg = np.flatnonzero(~tip)  # a band from each non-tip node's ring to the next
-    i0, i1 = ring[seg, None], ring[seg, None] + sides
+    band = np.flatnonzero(~last)  # a band from each ring to the next, within an object
+    i0, i1 = ring[band, None], ring[band, None] + sides
     quads = np.stack(
         [np.stack([i0 + s0, i0 + s1, i1 + s1], -1), np.stack([i0 + s0, i1 + s1, i1 + s0], -1)], axis=2
-    )  # (segments, sides, 2, 3)
-    parts.triangles(quads, obj[seg, None, None])
+    )  # (bands, sides, 2, 3)
+    parts.triangles(quads, ring_obj[band, None, None])
 
-    if caps:
-        ib, it = np.flatnonzero(base), np.flatnonzero(tip)
+    if curved:  # a fan at each end: flat inside the parent, a low cone at the tip
+        ib, it = np.flatnonzero(first), np.flatnonzero(last)
         ends = np.concatenate([ib, it])
-        apex = np.concatenate([np.zeros((len(ib), 3)), 0.5 * r[nodes[it], None] * t[it]])
-        c0 = parts.add(nodes[ends], nodes[ends], obj[ends], material, apex,
-                       np.concatenate([-t[ib], t[it]]), 0.0, jitter[obj[ends]], key[obj[ends]],
-                       np.stack([np.zeros(len(ends)), along[ends]], -1))
+        apex = np.concatenate([np.zeros((len(ib), 3)), chord[it] + 0.5 * radius[it, None] * tan[it]])
+        c0 = parts.add(n0[ends], prev[src[ends]], ring_obj[ends], material, apex,
+                       np.concatenate([-tan[ib], tan[it]]), weight[src[ends]], jitter[ring_obj[ends]],
+                       key[ring_obj[ends]], np.stack([np.zeros(len(ends)), along[ends]], -1), curve[ends])
         cb = c0 + np.arange(len(ib))[:, None]
         ct = c0 + len(ib) + np.arange(len(it))[:, None]
         parts.triangles(np.stack([np.broadcast_to(cb, (len(ib), sides)), ring[ib, None] + s1,
-                                  ring[ib, None] + s0], -1), obj[ib, None])
+                                  ring[ib, None] + s0], -1), ring_obj[ib, None])
         parts.triangles(np.stack([np.broadcast_to(ct, (len(it), sides)), ring[it, None] + s0,
-                                  ring[it, None] + s1], -1), obj[it, None])
+                                  ring[it, None] + s1], -1), ring_obj[it, None])
 
 
 def _laminas(parts: _Parts, tree: Tree, leaves: np.ndarray, jitter: np.ndarray, key: np.ndarray) -> None:
@@ -289,12 +356,12 @@ def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray) -
     half = 0.5 * tree.node_diameter[nodes, None] * across
     frac = k / (tree.object_count[obj] - 1)
     inner = ~(base | tip)
-    node2 = np.where(inner, nodes - 1, nodes)
+    prev = np.where(inner, nodes - 1, nodes)
     weight = np.where(inner, 0.5, 0.0)
     rep = lambda a: np.repeat(a, 2, axis=0)  # noqa: E731
     offset = np.stack([-half, half], axis=1).reshape(-1, 3)
     uv = np.stack([np.tile([-1.0, 1.0], len(nodes)), rep(frac)], -1)
-    v0 = parts.add(rep(nodes), rep(node2), rep(obj), MATERIAL_BLADE, offset, rep(normal),
+    v0 = parts.add(rep(nodes), rep(prev), rep(obj), MATERIAL_BLADE, offset, rep(normal),
                    rep(weight), rep(jitter[obj]), rep(frac), uv)
     pair = v0 + 2 * np.arange(len(nodes))
     seg = np.flatnonzero(~tip)
