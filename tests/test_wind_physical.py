@@ -114,6 +114,21 @@ def test_spectrum_at_a_point_follows_f_to_the_minus_beta(beta_u, beta_vw):
     assert fitted_slope(x[..., 0], fs, 0.3, 2.0) == pytest.approx(-beta_u, abs=0.15)
 
 
+@pytest.mark.parametrize("speed", [5.0, 12.0, 20.0])
+def test_the_inertial_range_keeps_its_slope_as_the_wind_rises(speed):
+    """Above the energy-containing eddies (f > 3·U / (2π·1.339·L), the von Kármán knee, which
+    rises with U: 0.18 Hz at 5 m/s, 0.71 Hz at 20 m/s) the spectrum falls as f^−5/3 at every
+    speed; below the knee it flattens, as measured spectra do."""
+    fs = 10.0
+    wind = WindField(speed=speed, seed=1, gust_strength=0.0)
+    x = series(wind, across(0.0, H), 1200.0, fs)
+    knee = speed / (2 * np.pi * 1.339 * wind.length_scale)
+    assert fitted_slope(x[..., 0], fs, 3 * knee, 2.0) == pytest.approx(-5 / 3, abs=0.2)
+    assert fitted_slope(x[..., 2], fs, 3 * knee, 2.0) == pytest.approx(-5 / 3, abs=0.2)
+    if knee > 0.1:  # enough of the spectrum below the knee to fit: flatter there
+        assert fitted_slope(x[..., 0], fs, 0.05, knee) > -1.0
+
+
 # ----------------------------------------------------------------------------- profile
 
 

@@ -1169,17 +1169,19 @@ def _physical_table(beta_u: float, beta_vw: float, seed: int) -> np.ndarray:
     return uv, w
 
 
-@lru_cache(maxsize=2)
 def _tile_corners() -> np.ndarray:
+    """(8, 1) int32 flat offsets of a cell's corners in the padded tile."""
     nx, ny, nz = _TILE
     d = np.arange(2)
     off = (d[:, None, None] * (ny + 1) + d[None, :, None]) * (nz + 1) + d[None, None, :]
-    return off.reshape(8)
+    return off.reshape(8, 1).astype(np.int32)
 
 
+# Index arithmetic in int32 (the padded tile has 613,000 cells): half the memory traffic.
 _TILE_DIMS = np.array(_TILE, dtype=np.float64)[:, None]
-_TILE_INT = np.array(_TILE, dtype=np.intp)[:, None]
+_TILE_INT = np.array(_TILE, dtype=np.int32)[:, None]
 _TILE_LAST = _TILE_INT - 1
+_TILE_CORNERS = _tile_corners()
 
 
 def _trilinear(tables, q: np.ndarray, offsets, weights) -> tuple[np.ndarray, np.ndarray]:
@@ -1194,21 +1196,19 @@ def _trilinear(tables, q: np.ndarray, offsets, weights) -> tuple[np.ndarray, np.
     fl = np.floor(q / _TILE_DIMS)
     fl *= _TILE_DIMS
     q -= fl
-    i = q.astype(np.intp)
-    np.minimum(i, _TILE_LAST, out=i)
-    np.maximum(i, 0, out=i)
+    i = q.astype(np.int32)  # q ≥ −ε here: truncation gives 0 for it
+    np.minimum(i, _TILE_LAST, out=i)  # q may round up to the tile's size
     fr = np.subtract(q, i, dtype=np.float32)
     nx, ny, nz = _TILE
-    corners = _tile_corners()[:, None]
     blend_uv = blend_w = None
     for off, wt in zip(offsets, weights):
-        ij = i + off[:, None]
+        ij = i + off
         ij -= (ij > _TILE_LAST) * _TILE_INT
-        base = ij[0] * (ny + 1)
+        base = ij[0] * np.int32(ny + 1)
         base += ij[1]
-        base *= nz + 1
+        base *= np.int32(nz + 1)
         base += ij[2]
-        idx = np.add(corners, base)
+        idx = np.add(_TILE_CORNERS, base).astype(np.intp)
         vuv = tab_uv.take(idx, mode="clip")
         vw = tab_w.take(idx, mode="clip")
         vuv *= np.float32(wt)
@@ -1234,8 +1234,9 @@ def _trilinear(tables, q: np.ndarray, offsets, weights) -> tuple[np.ndarray, np.
     return out[0], out[1]
 
 
-def _gusts(wind: "WindField", along: np.ndarray, g: float, length: float) -> np.ndarray:
-    """Sum of gust envelopes minus their mean, at along-wind positions ``along`` (m).
+def _gusts(wind: "WindField", along: np.ndarray, unit: float, g: float, length: float) -> np.ndarray:
+    """Sum of gust envelopes minus their mean, at along-wind positions ``along`` (in units of
+    ``unit`` metres).
 
     Gusts are plane fronts, so the sum is a function of ``along`` only: it is evaluated on
     a 1-D grid of spacing GUST_RISE·L/8 over the points' span and interpolated (relative
@@ -1247,7 +1248,7 @@ def _gusts(wind: "WindField", along: np.ndarray, g: float, length: float) -> np.
     sr = min(GUST_RISE * length * per_m, _GUST_MAX_WIDTH[0])
     sd = min(GUST_DECAY * length * per_m, _GUST_MAX_WIDTH[1])
     step = 0.125 * sr / per_m  # metres, on a lattice fixed in space (chunk-independent)
-    f = along * (1.0 / step)
+    f = along * (unit / step)
     lo, hi = float(f.min()), float(f.max())
     if -(2.0**50) < lo and hi < 2.0**50 and hi - lo <= 4096:  # (a lattice of int64 indices)
         lo_i = math.floor(lo)
@@ -1262,7 +1263,7 @@ def _gusts(wind: "WindField", along: np.ndarray, g: float, length: float) -> np.
         out *= f
         out += y0
         return out
-    return _gust_sum(wind.seed, g - along * per_m, sr, sd)
+    return _gust_sum(wind.seed, g - along * (unit * per_m), sr, sd)
 
 
 def _gust_sum(seed: int, gam: np.ndarray, sr: float, sd: float) -> np.ndarray:
@@ -1283,6 +1284,15 @@ def _gust_sum(seed: int, gam: np.ndarray, sr: float, sd: float) -> np.ndarray:
     return total
 
 
+@lru_cache(maxsize=8)
+def _layer_offset(seed: int, layer: int, cycle: int) -> np.ndarray:
+    """(3, 1) int32 whole-cell shift of a layer of the tile during one of its cycles."""
+    where = _hash_uniform(seed, 20 + layer, np.array([cycle]), 3)[0] * _TILE
+    off = np.minimum(where.astype(np.int32), np.array(_TILE, np.int32) - 1)[:, None]
+    off.setflags(write=False)
+    return off
+
+
 def _sample_physical(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray) -> None:
     for start in range(0, p.shape[0], _CHUNK):
         stop = min(start + _CHUNK, p.shape[0])
@@ -1300,15 +1310,16 @@ def _physical_chunk(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray)
     cell = length / _CELLS_PER_L
     k = p.shape[0]
     pc = np.clip(p, -_COORD_CLIP, _COORD_CLIP)
-    local = frame @ pc.T  # (3, k) metres along, up, across the wind
+    q = (frame * (1.0 / cell)) @ pc.T  # (3, k) cells along, up, across the wind
+    gust = None
+    if wind.gust_strength > 0.0 and wind.gust_rate > 0.0:
+        gust = _gusts(wind, q[0], cell, g, length)
     weights, offsets = [], []
     for j in (0, 1):
         phase = min(max(s + 0.5 * j, -2.0**62), 2.0**62)
         cycle = math.floor(phase)
         weights.append(math.sin(math.pi * (phase - cycle)))
-        where = _hash_uniform(wind.seed, 20 + j, np.array([cycle]), 3)[0] * _TILE
-        offsets.append(np.minimum(where.astype(np.intp), np.array(_TILE) - 1))
-    q = local * (1.0 / cell)
+        offsets.append(_layer_offset(wind.seed, j, cycle))
     q[0] -= math.fmod(a / cell, _TILE[0])
     uv, lat = _trilinear(table, q, offsets, weights)
     mean, sigma = _canopy(p[:, 1], top)
@@ -1318,7 +1329,9 @@ def _physical_chunk(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray)
         np.multiply(x, sigma, out=comps[:, c])
         if ratio != 1.0:
             comps[:, c] *= ratio
-    if wind.gust_strength > 0.0 and wind.gust_rate > 0.0:
-        mean *= 1.0 + wind.gust_strength * _gusts(wind, local[0], g, length)
+    if gust is not None:
+        gust *= wind.gust_strength
+        gust += 1.0
+        mean *= gust
     comps[:, 0] += speed * mean
     np.matmul(comps, frame, out=out)
