@@ -1284,6 +1284,11 @@ def _gust_sum(seed: int, gam: np.ndarray, sr: float, sd: float) -> np.ndarray:
     return total
 
 
+def _ratio_frame(frame: np.ndarray) -> np.ndarray:
+    """The wind frame's rows (along, up, across) scaled by the components' σ ratios."""
+    return frame * np.asarray(SIGMA_RATIOS)[:, None]
+
+
 @lru_cache(maxsize=8)
 def _layer_offset(seed: int, layer: int, cycle: int) -> np.ndarray:
     """(3, 1) int32 whole-cell shift of a layer of the tile during one of its cycles."""
@@ -1324,14 +1329,13 @@ def _physical_chunk(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray)
     uv, lat = _trilinear(table, q, offsets, weights)
     mean, sigma = _canopy(p[:, 1], top)
     sigma *= wind.turbulence * speed
-    comps = np.empty((k, 3))
-    for c, (x, ratio) in enumerate(zip((uv.real, uv.imag, lat), SIGMA_RATIOS)):
-        np.multiply(x, sigma, out=comps[:, c])
-        if ratio != 1.0:
-            comps[:, c] *= ratio
+    comps = np.empty((3, k))  # along, up, across, each over its σ ratio
+    for c, x in enumerate((uv.real, uv.imag, lat)):
+        np.multiply(x, sigma, out=comps[c])
     if gust is not None:
         gust *= wind.gust_strength
         gust += 1.0
         mean *= gust
-    comps[:, 0] += speed * mean
-    np.matmul(comps, frame, out=out)
+    mean *= speed / SIGMA_RATIOS[0]
+    comps[0] += mean
+    np.matmul(comps.T, _ratio_frame(frame), out=out)
