@@ -136,3 +136,66 @@ def test_cli_out_of_range_one_line(tmp_path, args, words):
     assert "Traceback" not in res.stderr
     assert len(res.stderr.strip().splitlines()) == 1 and words in res.stderr
     assert not list(tmp_path.iterdir())
+
+
+# ------------------------------------------------------------------ files that never end
+def load_in_time(path, seconds=10.0):
+    """load_tree(path) in a thread: the PresetError it raised, failing if it blocks."""
+    import threading
+
+    result = {}
+
+    def run():
+        try:
+            ta.load_tree(path)
+        except PresetError as e:
+            result["error"] = e
+
+    th = threading.Thread(target=run, daemon=True)
+    th.start()
+    th.join(seconds)
+    assert not th.is_alive(), f"loading {path} blocked"
+    assert "error" in result, f"{path} was accepted"
+    msg = str(result["error"])
+    assert "\n" not in msg and str(path) in msg
+    return msg
+
+
+@pytest.mark.parametrize("target", ["/dev/zero", "/dev/urandom"])
+def test_a_preset_path_to_an_endless_device_is_refused_unread(tmp_path, target):
+    link = tmp_path / "endless.toml"
+    link.symlink_to(target)
+    assert "not a regular file" in load_in_time(link)
+
+
+def test_a_fifo_is_refused_without_blocking(tmp_path):
+    fifo = tmp_path / "pipe.toml"
+    import os
+
+    os.mkfifo(fifo)
+    assert "not a regular file" in load_in_time(fifo)
+
+
+def test_a_huge_preset_file_is_refused_unread(tmp_path):
+    path = tmp_path / "huge.toml"
+    with open(path, "wb") as f:
+        f.truncate(3 << 30)  # 3 GB, sparse: reading it would take the memory
+    assert "bytes; a preset file may have at most 1,048,576" in load_in_time(path)
+
+
+@pytest.mark.parametrize("nested", ["x = " + "[" * 1000 + "]" * 1000,
+                                    "x = " + "{a = " * 1000 + "1" + "}" * 1000,
+                                    "x = " + "[" * 200 + "]" * 200])
+def test_deeply_nested_values_are_refused_in_one_line(tmp_path, nested):
+    path = write(tmp_path, nested + "\n" + GOOD)
+    msg = load_in_time(path)
+    assert "nested too deeply" in msg or "'x'" in msg
+
+
+def test_cli_refuses_a_device_in_one_line(tmp_path):
+    link = tmp_path / "zero.toml"
+    link.symlink_to("/dev/zero")
+    r = subprocess.run([sys.executable, "-m", "treeanim", "info", str(link)], capture_output=True, text=True,
+                       timeout=60)
+    assert r.returncode == 2
+    assert r.stderr.strip().count("\n") == 0 and "not a regular file" in r.stderr and "Traceback" not in r.stderr

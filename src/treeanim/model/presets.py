@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import os
+import stat
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -114,19 +116,42 @@ def load_tree(path: str | Path) -> Tree:
     return tree
 
 
+#: A preset file larger than this is refused unread (the shipped ones are under 4 KB).
+MAX_PRESET_BYTES = 1 << 20
+
+
+def _read_text(path: Path) -> str:
+    """The file's text: a regular file only (not a FIFO, a device or a directory, which could
+    block or never end), at most :data:`MAX_PRESET_BYTES`, UTF-8."""
+    try:
+        info = os.stat(path)
+        if not stat.S_ISREG(info.st_mode):
+            raise PresetError(f"{path}: not a regular file (a preset must be a .toml text file)")
+        if info.st_size > MAX_PRESET_BYTES:
+            raise PresetError(f"{path}: {info.st_size:,} bytes; a preset file may have at most "
+                              f"{MAX_PRESET_BYTES:,}")
+        with open(path, "rb") as f:
+            raw = f.read(MAX_PRESET_BYTES + 1)  # (it may have grown since)
+    except OSError as e:
+        raise PresetError(f"{path}: cannot read preset file ({e.strerror or e})") from None
+    if len(raw) > MAX_PRESET_BYTES:
+        raise PresetError(f"{path}: more than {MAX_PRESET_BYTES:,} bytes; a preset file may have at most that")
+    try:
+        return raw.decode("utf-8")
+    except UnicodeDecodeError:
+        raise PresetError(f"{path}: not a UTF-8 text file") from None
+
+
 def read_spec(path: str | Path) -> TreeSpec:
     """Parse and check a preset file into a :class:`TreeSpec` (no generation)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as e:
-        raise PresetError(f"{path}: cannot read preset file ({e.strerror or e})") from None
-    except UnicodeDecodeError:
-        raise PresetError(f"{path}: not a UTF-8 text file") from None
+    text = _read_text(path)
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
         raise PresetError(f"{path}: not valid TOML ({e})") from None
+    except RecursionError:  # tomllib parses nested arrays and tables recursively
+        raise PresetError(f"{path}: arrays or tables nested too deeply to be a preset") from None
     try:
         spec = _tree_spec(data, str(path))
         _check_leaves(spec)
