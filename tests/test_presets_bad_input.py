@@ -199,3 +199,19 @@ def test_cli_refuses_a_device_in_one_line(tmp_path):
                        timeout=60)
     assert r.returncode == 2
     assert r.stderr.strip().count("\n") == 0 and "not a regular file" in r.stderr and "Traceback" not in r.stderr
+
+
+def test_cli_output_cut_short_by_its_reader_stops_quietly():
+    """`treeanim info small_cherry | head -c 10` where the reader has gone before the table is
+    written: no BrokenPipeError traceback, exit 141 (the shell's code for a closed pipe)."""
+    import os
+
+    r, w = os.pipe()
+    os.close(r)  # the reader is gone before anything is written
+    try:
+        p = subprocess.run([sys.executable, "-m", "treeanim", "info", "small_cherry"], stdout=w,
+                           stderr=subprocess.PIPE, timeout=60)
+    finally:
+        os.close(w)
+    assert p.returncode == 141, p.stderr.decode()
+    assert p.stderr == b""

@@ -6,6 +6,7 @@ Every subcommand reports bad input as one line on stderr and exits with status 2
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 #: The paper's Table 1, per preset: rows of (kind, objects, nodes, triangles, fmin, fmax, ζmin, ζmax).
@@ -563,13 +564,28 @@ def main(argv: list[str] | None = None) -> int:
     if args.command is None:
         args = parser.parse_args(DEFAULT_COMMAND)
     try:
-        return int(args.func(args) or 0)
+        code = int(args.func(args) or 0)
+        sys.stdout.flush()
+        return code
+    except BrokenPipeError:  # the reader went away (`treeanim info | head`): stop quietly
+        _stdout_to_devnull()
+        return 141
     except (PresetError, UsageError) as e:
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("treeanim: interrupted", file=sys.stderr)
         return 130
+
+
+def _stdout_to_devnull() -> None:
+    """Point standard output at /dev/null, so that the interpreter's last flush of what is
+    left in its buffer cannot fail again on the way out."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # no file descriptor behind stdout
+        pass
 
 
 if __name__ == "__main__":  # pragma: no cover
