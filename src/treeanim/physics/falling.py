@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.geometry import unit
+from .rotation import qmat
 
 __all__ = ["FallingLeaves"]
 
@@ -47,13 +48,9 @@ MAX_SPEED = 200.0
 
 
 def _axis_angle(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """(F, 3, 3) rotations by ``angle`` (F,) about the unit ``axis`` (F, 3) (Rodrigues)."""
-    x, y, z = axis.T
-    K = np.zeros((len(angle), 3, 3))
-    K[:, 0, 1], K[:, 0, 2], K[:, 1, 2] = -z, y, -x
-    K[:, 1, 0], K[:, 2, 0], K[:, 2, 1] = z, -y, x
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3) + s * K + (1.0 - c) * (K @ K)
+    """(F, 3, 3) rotations by ``angle`` (F,) about the unit ``axis`` (F, 3)."""
+    half = 0.5 * np.asarray(angle, float)
+    return qmat(np.vstack([np.cos(half), np.sin(half) * np.asarray(axis, float).T]))
 
 
 class FallingLeaves:
@@ -166,9 +163,7 @@ class FallingLeaves:
         zero = np.zeros_like(age)
         axis = np.stack([ca, zero, sa], axis=1)
         across = np.stack([-sa, zero, ca], axis=1)  # y × axis: the swing
-        turn = np.zeros((len(idx), 3, 3))  # about the vertical
-        cs, ss = np.cos(spin * age), np.sin(spin * age)
-        turn[:, 0, 0], turn[:, 0, 2], turn[:, 1, 1], turn[:, 2, 0], turn[:, 2, 2] = cs, ss, 1.0, -ss, cs
+        turn = _axis_angle(np.broadcast_to([0.0, 1.0, 0.0], axis.shape), spin * age)  # about the vertical
         return (A * s)[:, None] * across, turn @ _axis_angle(axis, theta * s)
 
     def step(self, wind_at, dt: float) -> None:

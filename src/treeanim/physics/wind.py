@@ -1187,7 +1187,7 @@ _TILE_CORNERS = _tile_corners()
 def _trilinear(tables, q: np.ndarray, offsets, weights) -> tuple[np.ndarray, np.ndarray]:
     """Periodic trilinear look-up of the tile, blending layers before the interpolation.
 
-    ``q`` (3, n) cell coordinates (overwritten); ``offsets`` whole-cell shifts (3,) of each
+    ``q`` (3, n) cell coordinates (overwritten); ``offsets`` whole-cell shifts (3, 1) int32 of each
     layer and ``weights`` their weights. Whole-cell offsets share the fractions, so the
     layers' corner values blend first and one interpolation serves them all. Returns
     ((n,) complex64 u + i·v, (n,) float32 w)."""
