@@ -1,6 +1,7 @@
 #version 330 core
-// Sky gradient with the sun's glow, and the ground plane y = 0 found by casting each pixel's
-// view ray: grass with soft variation, bare earth round the trunk, the crown's soft shadow,
+// Sky gradient with the sun's disc and glow, and the ground plane y = 0 found by casting each
+// pixel's view ray: grass with soft variation, bare earth round the trunk, the tree's shadow
+// from the sun's shadow map, the sky the crown hides and a contact shadow at the trunk's foot,
 // an optional 1 m grid, hazed into the horizon. One full-screen pass.
 
 #include "common.glsl"
@@ -11,8 +12,9 @@ uniform int u_show_sky;         // 0: flat horizon colour above the ground
 uniform int u_show_ground;      // 0: sky (haze) below the horizon too
 uniform vec3 u_ground_centre;   // the trunk's foot
 uniform float u_earth_radius;   // bare earth around the trunk (0: none)
-uniform vec3 u_shadow_centre;   // where the crown's shadow falls
-uniform float u_shadow_radius;  // 0: no shadow
+uniform vec3 u_occlusion_centre;  // below the crown's centre: the sky is hidden there
+uniform float u_occlusion_radius; // 0: none
+uniform float u_trunk_radius;     // contact shadow round the trunk's foot (0: none)
 uniform float u_grid;           // 0: no grid; else grid line strength (1 m cells)
 out vec4 f_color;
 
@@ -22,7 +24,8 @@ vec3 sky_color(vec3 dir) {
     vec3 c = mix(u_sky_horizon, u_sky_zenith, pow(clamp(h, 0.0, 1.0), 0.6));
     c = mix(c, u_sky_horizon * 0.92, smoothstep(0.0, -0.2, h));   // below the horizon: haze
     float s = max(dot(dir, u_sun_dir), 0.0);
-    return c + u_sun_color * (0.05 * pow(s, 8.0) + 0.6 * pow(s, 600.0));
+    float disc = smoothstep(0.99985, 0.99993, s);            // about 1.4 degrees across
+    return c + u_sun_color * (0.05 * pow(s, 8.0) + 0.35 * pow(s, 600.0) + 2.5 * disc);
 }
 
 vec3 ground_color(vec2 xz, float fade) {
@@ -36,10 +39,14 @@ vec3 ground_color(vec2 xz, float fade) {
     float bare = 1.0 - smoothstep(0.4 * u_earth_radius, u_earth_radius, r + 0.3 * u_earth_radius * (n2 - 0.5));
     vec3 albedo = mix(grass, earth, bare * step(1e-6, u_earth_radius));
 
-    float ds = length(xz - u_shadow_centre.xz) / max(u_shadow_radius, 1e-6);
-    float shadow = 0.6 * exp(-2.5 * ds * ds) * step(1e-6, u_shadow_radius);
-    vec3 light = hemisphere(vec3(0.0, 1.0, 0.0)) + u_sun_color * max(u_sun_dir.y, 0.0) * (1.0 - shadow);
-    return albedo * light * (1.0 - 0.35 * shadow);
+    vec3 up = vec3(0.0, 1.0, 0.0);
+    float sun = sun_visibility(vec3(xz.x, 0.0, xz.y), up);
+    float ds = length(xz - u_occlusion_centre.xz) / max(u_occlusion_radius, 1e-6);
+    float sky = 1.0 - 0.45 * exp(-2.0 * ds * ds) * step(1e-6, u_occlusion_radius);
+    float dt = max(r - u_trunk_radius, 0.0) / max(1.5 * u_trunk_radius, 1e-6);
+    float contact = 1.0 - 0.6 * exp(-dt * dt) * step(1e-6, u_trunk_radius);
+    vec3 light = hemisphere(up) * sky + u_sun_color * max(u_sun_dir.y, 0.0) * sun;
+    return albedo * light * contact;
 }
 
 void main() {

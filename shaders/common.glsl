@@ -1,4 +1,5 @@
-// Shared lighting: one sun plus a sky/ground hemisphere, distance haze, sRGB output.
+// Shared lighting: one sun with its shadow map, a sky/ground hemisphere, distance haze, sRGB
+// output.
 
 uniform vec3 u_sun_dir;        // unit, towards the sun
 uniform vec3 u_sun_color;      // linear
@@ -9,6 +10,10 @@ uniform float u_ambient;       // strength of the sky/ground hemisphere light
 uniform vec3 u_camera_pos;
 uniform float u_haze_distance; // metres at which haze reaches 63 %
 uniform float u_exposure;
+uniform sampler2DShadow u_shadow_map;  // depth seen from the sun (render/shadow.py)
+uniform mat4 u_light_view_proj;        // world -> the shadow map's clip space
+uniform int u_shadow_on;               // 0: everything in sunlight
+uniform float u_shadow_texel;          // one shadow-map texel, metres
 
 vec3 srgb_to_linear(vec3 c) { return pow(c, vec3(2.2)); }
 
@@ -21,6 +26,26 @@ vec3 apply_haze(vec3 c, vec3 world) {
     float d = length(world - u_camera_pos);
     float f = 1.0 - exp(-d / u_haze_distance);
     return mix(c, u_sky_horizon, f);
+}
+
+// How much of the sun reaches a surface at `world` with normal `n` (0 shadowed .. 1 lit):
+// percentage-closer filtering over 4 x 4 bilinear taps (a soft edge about four texels wide).
+// The point is pushed off the surface towards the sun's side by a texel and a half, so a
+// surface never shadows itself (acne) and a leaf lit from behind is looked up on its lit face.
+float sun_visibility(vec3 world, vec3 n) {
+    if (u_shadow_on == 0) return 1.0;
+    vec3 towards = dot(n, u_sun_dir) < 0.0 ? -n : n;
+    vec4 p = u_light_view_proj * vec4(world + 1.5 * u_shadow_texel * towards + 0.5 * u_shadow_texel * u_sun_dir, 1.0);
+    vec3 s = p.xyz / p.w * 0.5 + 0.5;
+    if (s.z >= 1.0) return 1.0;                              // beyond everything that casts
+    vec2 texel = 1.0 / vec2(textureSize(u_shadow_map, 0));
+    float lit = 0.0;
+    for (int i = 0; i < 4; i++) {
+        for (int j = 0; j < 4; j++) {
+            lit += texture(u_shadow_map, vec3(s.xy + (vec2(i, j) - 1.5) * texel, s.z));
+        }
+    }
+    return lit / 16.0;
 }
 
 float hash12(vec2 p) {

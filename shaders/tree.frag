@@ -9,6 +9,7 @@ in float v_ao;
 in vec2 v_uv;
 flat in int v_material;
 flat in float v_highlight;
+uniform float u_translucency;   // 0: leaves pass no sunlight through
 
 out vec4 f_color;
 
@@ -33,15 +34,16 @@ void main() {
     } else if (v_material == 3) {
         albedo *= 0.85 + 0.3 * (1.0 - abs(v_uv.x));
     }
+    float sun = sun_visibility(v_world, n);
     vec3 c = albedo * hemisphere(n) * v_ao;
-    c += albedo * u_sun_color * max(ndl, 0.0) * mix(0.55, 1.0, v_ao);
+    c += albedo * u_sun_color * max(ndl, 0.0) * mix(0.55, 1.0, v_ao) * sun;
     if (foliage) {
         // Light through the leaf: its unlit face glows in the sun's colour, tinted by the leaf.
         float back = max(-ndl, 0.0) * (0.55 + 0.45 * pow(max(dot(-V, u_sun_dir), 0.0), 2.0));
-        c += albedo * sqrt(albedo) * u_sun_color * 1.1 * back * v_ao;
+        c += albedo * sqrt(albedo) * u_sun_color * 1.1 * back * v_ao * sun * u_translucency;
         c += albedo * hemisphere(n) * v_ao * 0.25;   // sky light scattered through the crown
         vec3 H = normalize(V + u_sun_dir);
-        c += u_sun_color * 0.06 * pow(max(dot(n, H), 0.0), 40.0) * step(0.0, ndl);
+        c += u_sun_color * 0.06 * pow(max(dot(n, H), 0.0), 40.0) * step(0.0, ndl) * sun;
     }
     c = mix(c, vec3(1.0, 0.45, 0.05) * 1.5, 0.55 * v_highlight);
     f_color = to_display(apply_haze(c, v_world));

@@ -12,6 +12,9 @@ texel i at (i mod width, i div width), read with texelFetch):
   r the rotation relative to rest, row-major.
 - objects, RGBA32F, 1 texel an object: ``(visible, highlight, 0, 0)``; rewritten only when
   the visibility or highlight changes.
+
+Each frame draws the sun's shadow map first (:mod:`treeanim.render.shadow`), then the tree,
+then sky and ground behind it, then the overlays.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from .camera import OrbitCamera
 from .mesh import VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh, build_mesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
 from .shaders import load_program
+from .shadow import ShadowMap
 
 #: Width in texels of the node and object textures (GL 3.3 guarantees 1024).
 TEXTURE_WIDTH = 1024
@@ -35,6 +39,11 @@ TEXTURE_WIDTH = 1024
 
 def _lin(rgb) -> tuple[float, float, float]:
     return tuple(float(c) ** 2.2 for c in rgb)
+
+
+def _bound_framebuffer(ctx: moderngl.Context) -> moderngl.Framebuffer:
+    """The framebuffer bound now (moderngl's record of it, else the one GL reports)."""
+    return ctx.fbo if ctx.fbo is not None else ctx.detect_framebuffer()
 
 
 @dataclass
@@ -53,7 +62,9 @@ class Scene:
     ground_grid: float = 0.0            # strength of a 1 m grid on the ground (0: none)
     show_sky: bool = True
     show_ground: bool = True
-    shadow: bool = True
+    shadow: bool = True                 # the sun's shadows (tree on ground and on itself)
+    shadow_size: int = 2048             # shadow-map texels a side (read when the renderer is made)
+    translucency: float = 1.0           # sunlight through the leaves (0: opaque leaves)
 
 
 class _Lines:
@@ -102,6 +113,7 @@ class Renderer:
         self.tree_prog = self.bg_prog = self.line_prog = None
         self.vbo = self.ibo = self.vao = self.bg_vao = None
         self.node_texture = self.object_texture = None
+        self.shadow: ShadowMap | None = None
         self._lines: dict[int, _Lines] = {}
         try:
             self.tree_prog = load_program(ctx, "tree.vert", "tree.frag")
@@ -115,6 +127,9 @@ class Renderer:
                 self.vao = ctx.vertex_array(self.tree_prog, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRIBUTES)],
                                             index_buffer=self.ibo, index_element_size=4)
             self._n_indices = 3 * self.mesh.triangle_count
+            bound = _bound_framebuffer(ctx)
+            self.shadow = ShadowMap(ctx, self.vbo, self.ibo, self.scene.shadow_size)
+            bound.use()  # making the map's framebuffer bound it
 
             # --- per-frame textures
             N, M = tree.n_nodes, tree.n_objects
@@ -131,6 +146,10 @@ class Renderer:
             for prog in (self.tree_prog, self.line_prog):
                 self._uniform(prog, "u_nodes", 0)
             self._uniform(self.tree_prog, "u_objects", 1)
+            self._uniform(self.shadow.prog, "u_objects", 1)
+            self._uniform(self.shadow.prog, "u_nodes", 0)
+            for prog in (self.tree_prog, self.bg_prog):
+                self._uniform(prog, "u_shadow_map", 2)
 
             # --- sky and ground: one full-screen triangle
             self.bg_vao = ctx.vertex_array(self.bg_prog, [])
@@ -181,7 +200,8 @@ class Renderer:
         pts = P[np.isin(tree.node_object, np.flatnonzero(leafy))] if leafy.any() else P
         self.crown_centre = pts.mean(axis=0)
         spread = np.percentile(np.linalg.norm(pts[:, [0, 2]] - self.crown_centre[[0, 2]], axis=1), 85)
-        self.shadow_radius = float(max(1.1 * spread, 0.1 * size))
+        self.occlusion_radius = float(max(1.1 * spread, 0.1 * size))
+        self.trunk_radius = float(0.5 * tree.node_diameter[trunks].max()) if len(trunks) else 0.0
 
     def _apply_scene(self) -> None:
         s = self.scene
@@ -209,11 +229,20 @@ class Renderer:
         self._uniform(g, "u_show_ground", int(s.show_ground))
         self._uniform(g, "u_ground_centre", tuple(self.ground_centre))
         self._uniform(g, "u_earth_radius", float(self.earth_radius))
-        c = self.crown_centre
-        shadow_at = c - np.asarray(sun) * (c[1] / max(sun[1], 0.2))
-        self._uniform(g, "u_shadow_centre", tuple(shadow_at))
-        self._uniform(g, "u_shadow_radius", float(self.shadow_radius if s.shadow else 0.0))
+        c = self.crown_centre  # the crown hides the sky straight above the ground under it
+        self._uniform(g, "u_occlusion_centre", (float(c[0]), 0.0, float(c[2])))
+        self._uniform(g, "u_occlusion_radius", float(self.occlusion_radius if s.shadow else 0.0))
+        self._uniform(g, "u_trunk_radius", float(self.trunk_radius if s.shadow else 0.0))
         self._uniform(g, "u_grid", float(s.ground_grid))
+        self._uniform(self.tree_prog, "u_translucency", float(s.translucency))
+        if s.shadow:
+            self.shadow.fit(sun, *self.bounds())
+        else:
+            self.shadow.clear()
+        for prog in (self.tree_prog, self.bg_prog):
+            self._uniform(prog, "u_shadow_on", int(s.shadow))
+            self._uniform(prog, "u_shadow_texel", float(self.shadow.texel))
+            self._write((prog,), "u_light_view_proj", self.shadow.matrix.tobytes())
 
     # ------------------------------------------------------------------ per frame
     def update(self, positions: np.ndarray, rotations: np.ndarray, present: np.ndarray | None = None,
@@ -288,12 +317,17 @@ class Renderer:
         if width <= 0 or height <= 0:
             return
         ctx = self.ctx
-        if framebuffer is not None:
-            framebuffer.use()
-        ctx.viewport = (0, 0, width, height)
+        target = framebuffer if framebuffer is not None else _bound_framebuffer(ctx)
         self._apply_scene()
         season = float(np.clip(season, 0.0, 1.0))
         self._upload_objects(season)
+        self.node_texture.use(0)
+        self.object_texture.use(1)
+        if self.scene.shadow:
+            ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
+            self.shadow.draw(self._n_indices)
+        target.use()
+        ctx.viewport = (0, 0, width, height)
 
         vp = camera.view_projection(width, height)
         vp_bytes = vp.tobytes()
@@ -309,8 +343,7 @@ class Renderer:
         ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
-        self.node_texture.use(0)
-        self.object_texture.use(1)
+        self.shadow.texture.use(2)
         if self.vao is not None:
             self.vao.render(moderngl.TRIANGLES, vertices=self._n_indices)
         # Background last, at the far plane: only pixels the tree left uncovered are shaded.
@@ -370,6 +403,8 @@ class Renderer:
         for b in self._lines.values():
             b.release()
         self._lines.clear()
+        if self.shadow is not None:
+            self.shadow.release()
         for o in (self.vao, self.vbo, self.ibo, self.bg_vao, self.node_texture, self.object_texture,
                   self.tree_prog, self.bg_prog, self.line_prog):
             if o is not None:

@@ -1,0 +1,154 @@
+"""The sun's shadow map: the skinned tree's depth seen from the sun, drawn each frame before the
+scene, and sampled with percentage-closer filtering by the tree and the ground
+(``sun_visibility`` in ``shaders/common.glsl``), so the crown shades the ground and itself.
+
+The sun's orthographic view is fitted once per sun direction to a box round the tree that
+leaves room for it to sway, and to that box's shadow on the ground: the map's texels stay
+fixed in the world while the tree moves (no swimming edges).
+"""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from .mesh import VERTEX_ATTRIBUTES, VERTEX_DTYPE, VERTEX_FORMAT
+from .shaders import load_program
+
+#: Attributes the shadow pass reads; the rest of each vertex is skipped.
+SHADOW_ATTRIBUTES = ("in_ids", "in_offset", "in_extra", "in_curve")
+#: The box round the tree at rest grows by this fraction of its size each way (sway room).
+SWAY_MARGIN = 0.15
+#: The lowest sun elevation the map is fitted for (sin of it): lower suns cast the shadow of
+#: a sun at this height, not an endless one.
+MIN_SUN_HEIGHT = 0.15
+
+
+def _skipping_format() -> str:
+    """:data:`VERTEX_FORMAT` with the attributes the shadow pass does not read as padding."""
+    parts = []
+    for fmt, name in zip(VERTEX_FORMAT.split(), VERTEX_ATTRIBUTES):
+        if name in SHADOW_ATTRIBUTES:
+            parts.append(fmt)
+        else:
+            parts.append(f"{VERTEX_DTYPE[name[3:]].itemsize}x")
+    return " ".join(parts)
+
+
+def light_view_projection(sun: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, float]:
+    """The sun's orthographic view-projection for a tree in the box ``lo`` .. ``hi``.
+
+    Parameters
+    ----------
+    sun : (3,) float
+        Unit vector towards the sun.
+    lo, hi : (3,) float
+        Corners of the box that holds every caster (world, y up, ground at y = 0).
+
+    Returns
+    -------
+    matrix : (4, 4) float32
+        World → clip, column-major bytes order as GLSL reads it (``matrix.tobytes()``).
+    extent : float
+        The larger side of the map's footprint (metres), for the texel size.
+    """
+    sun = np.asarray(sun, float)
+    sun = sun / np.linalg.norm(sun)
+    if sun[1] < MIN_SUN_HEIGHT:  # keep the shadow on a finite ground
+        h = np.hypot(sun[0], sun[2])
+        flat = sun[[0, 2]] / h if h > 0 else np.array([1.0, 0.0])
+        c = np.sqrt(1.0 - MIN_SUN_HEIGHT**2)
+        sun = np.array([c * flat[0], MIN_SUN_HEIGHT, c * flat[1]])
+    forward = -sun  # the sun looks along -sun
+    up = np.array([0.0, 1.0, 0.0]) if abs(sun[1]) < 0.99 else np.array([0.0, 0.0, 1.0])
+    right = np.cross(forward, up)
+    right /= np.linalg.norm(right)
+    up = np.cross(right, forward)
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    ground = corners - np.outer(np.maximum(corners[:, 1], 0.0) / sun[1], sun)  # their shadows at y = 0
+    pts = np.vstack([corners, ground])
+    x, y, d = pts @ right, pts @ up, pts @ forward  # d: distance along the sun's rays
+    x0, x1, y0, y1 = x.min(), x.max(), y.min(), y.max()
+    pad = 0.02 * max(x1 - x0, y1 - y0)
+    x0, x1, y0, y1 = x0 - pad, x1 + pad, y0 - pad, y1 + pad
+    near, far = d.min() - pad, d.max() + pad
+    view = np.eye(4)
+    view[0, :3], view[1, :3], view[2, :3] = right, up, -forward  # a right-handed eye space
+    ortho = np.diag([2.0 / (x1 - x0), 2.0 / (y1 - y0), -2.0 / (far - near), 1.0])
+    ortho[:3, 3] = [-(x1 + x0) / (x1 - x0), -(y1 + y0) / (y1 - y0), -(far + near) / (far - near)]
+    # eye z = -d, so d = near maps to -1 and d = far to +1
+    m = ortho @ view
+    return np.ascontiguousarray(m.T, dtype=np.float32), float(max(x1 - x0, y1 - y0))
+
+
+class ShadowMap:
+    """A depth texture of the tree seen from the sun, and the pass that draws it.
+
+    Parameters
+    ----------
+    ctx : moderngl.Context
+    vbo, ibo : moderngl.Buffer
+        The tree's static mesh (:class:`~treeanim.render.mesh.TreeMesh` layout).
+    size : int
+        Texels a side (clamped to the context's largest texture).
+    """
+
+    def __init__(self, ctx: moderngl.Context, vbo, ibo, size: int) -> None:
+        self.ctx = ctx
+        self.size = int(min(max(size, 16), ctx.info["GL_MAX_TEXTURE_SIZE"]))
+        self.prog = self.texture = self.fbo = self.vao = None
+        try:
+            self.prog = load_program(ctx, "shadow.vert", "shadow.frag")
+            self.texture = ctx.depth_texture((self.size, self.size))
+            self.texture.compare_func = "<="  # sampler2DShadow: 1 where the point is nearest
+            self.texture.filter = (moderngl.LINEAR, moderngl.LINEAR)  # 2 x 2 PCF per tap
+            self.texture.repeat_x = self.texture.repeat_y = False
+            self.fbo = ctx.framebuffer(depth_attachment=self.texture)
+            if vbo is not None:
+                self.vao = ctx.vertex_array(self.prog, [(vbo, _skipping_format(), *SHADOW_ATTRIBUTES)],
+                                            index_buffer=ibo, index_element_size=4)
+        except BaseException:
+            self.release()
+            raise
+        self.matrix = np.eye(4, dtype=np.float32)
+        self.texel = 1.0
+        self._fitted: tuple | None = None
+        self.clear()
+
+    def fit(self, sun, lo, hi) -> None:
+        """Fit the sun's view to the box ``lo`` .. ``hi`` grown by :data:`SWAY_MARGIN` (cached)."""
+        key = (tuple(np.round(sun, 9)), tuple(lo), tuple(hi))
+        if key == self._fitted:
+            return
+        self._fitted = key
+        lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+        grow = SWAY_MARGIN * (hi - lo).max()
+        self.matrix, extent = light_view_projection(sun, lo - grow, hi + grow)
+        self.texel = extent / self.size
+        self.prog["u_light_view_proj"].write(self.matrix.tobytes())
+
+    def clear(self) -> None:
+        """Nothing in the map: everything lit."""
+        self.fbo.clear(depth=1.0)
+
+    def draw(self, count: int) -> None:
+        """Draw the first ``count`` indices of the mesh into the map (the node and object
+        textures bound to units 0 and 1, as for the scene). Leaves the map's framebuffer bound."""
+        ctx = self.ctx
+        self.fbo.use()
+        ctx.viewport = (0, 0, self.size, self.size)
+        self.fbo.clear(depth=1.0)
+        if self.vao is None or not count:
+            return
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<"
+        ctx.polygon_offset = 1.5, 2.0  # slope-scaled bias against acne on grazing faces
+        self.vao.render(moderngl.TRIANGLES, vertices=count)
+        ctx.polygon_offset = 0.0, 0.0
+
+    def release(self) -> None:
+        """Free the GL objects (idempotent)."""
+        for o in (self.vao, self.fbo, self.texture, self.prog):
+            if o is not None:
+                o.release()
+        self.vao = self.fbo = self.texture = self.prog = None

@@ -1,0 +1,126 @@
+"""The look (issue #13) tested by the pixels of real renders through EGL: the sun's shadows on
+the ground and in the crown, and light through the leaves."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import treeanim as ta
+from treeanim.render.camera import OrbitCamera
+from treeanim.render.renderer import Scene
+
+W, H = 200, 150
+
+
+def rest(tree):
+    return tree.rest_positions, np.broadcast_to(np.eye(3), (tree.n_nodes, 3, 3))
+
+
+def luminance(img):
+    return img.astype(float) @ np.array([0.2126, 0.7152, 0.0722])
+
+
+def render(off, tree, cam, present=None, **scene):
+    off.resize(W, H)
+    r = off.load(tree, scene=Scene(**scene))
+    off.update(*rest(tree), present=present)
+    return off.render(cam)
+
+
+def overhead(tree):
+    """A camera high above the tree, looking down at it and the ground round it."""
+    return OrbitCamera(target=(0.0, 0.0, 0.0), distance=7.0, azimuth=20.0, elevation=70.0)
+
+
+def cast_on_ground(points, sun):
+    """Where the sun casts ``points`` on the ground y = 0."""
+    sun = np.asarray(sun, float) / np.linalg.norm(sun)
+    return points - np.outer(points[:, 1] / sun[1], sun)
+
+
+def shadow_pixels(off, tree, cam, sun):
+    """Ground pixels the tree's shadow darkens: shadowed render against unshadowed, away from
+    the tree's own pixels."""
+    lit = render(off, tree, cam, shadow=False, sun_direction=sun)
+    shaded = render(off, tree, cam, shadow=True, sun_direction=sun)
+    bare = render(off, tree, cam, present=np.zeros(tree.n_objects, bool), shadow=False, sun_direction=sun)
+    on_tree = np.abs(lit.astype(int) - bare.astype(int)).max(axis=2) > 6
+    darker = luminance(lit) - luminance(shaded)
+    return (darker > 12) & ~on_tree, darker, on_tree, lit, shaded
+
+
+@pytest.mark.parametrize("sun", [(0.6, 0.75, 0.2), (-0.6, 0.75, -0.1)])
+def test_the_tree_shadows_the_ground_where_the_sun_casts_it(offscreen, tree, sun):
+    cam = overhead(tree)
+    dark, darker, on_tree, *_ = shadow_pixels(offscreen, tree, cam, sun)
+    assert dark.sum() > 150, dark.sum()
+    # The crown's cast outline on the ground, projected to the screen: the dark pixels lie there.
+    leafy = np.isin(tree.node_object, np.flatnonzero(tree.kind == "leaf"))
+    cast = cam.project(cast_on_ground(tree.rest_positions[leafy], sun), W, H)[:, :2]
+    ys, xs = np.nonzero(dark)
+    assert np.hypot(xs.mean() - cast[:, 0].mean(), ys.mean() - cast[:, 1].mean()) < 0.06 * W
+    # Ground far from any cast point (and off the tree) is not darkened.
+    gy, gx = np.mgrid[0:H, 0:W]
+    near = np.min(np.hypot(gx[..., None] - cast[:, 0], gy[..., None] - cast[:, 1]), axis=2)
+    far = (near > 0.15 * W) & ~on_tree
+    assert far.sum() > 1000 and np.abs(darker[far]).mean() < 1.5, np.abs(darker[far]).mean()
+
+
+def test_the_shadow_moves_when_the_sun_moves(offscreen, tree):
+    cam = overhead(tree)
+    centres = []
+    for sun in [(0.6, 0.75, 0.2), (-0.6, 0.75, -0.1)]:
+        dark = shadow_pixels(offscreen, tree, cam, sun)[0]
+        ys, xs = np.nonzero(dark)
+        centres.append(np.array([xs.mean(), ys.mean()]))
+    # The two suns cast on opposite sides of the trunk: the shadow moved across the screen by
+    # about the distance between the two cast crowns.
+    foot = cam.project([[0.0, 0.0, 0.0]], W, H)[0, :2]
+    a, b = centres[0] - foot, centres[1] - foot
+    assert np.dot(a, b) < 0, (a, b)
+    assert np.linalg.norm(centres[0] - centres[1]) > 0.2 * W
+
+
+@pytest.mark.parametrize("sun", [(0.2, 0.9, 0.35), (0.1, 0.9, -0.4)])  # high, in front and behind
+def test_the_crown_shades_itself(offscreen, sun):
+    tree = ta.load_preset("small_cherry")
+    lo, hi = tree.rest_positions.min(axis=0), tree.rest_positions.max(axis=0)
+    cam = OrbitCamera(target=tuple(0.5 * (lo + hi)), distance=1.6 * float((hi - lo).max()), elevation=10.0)
+    *_, on_tree, lit, shaded = shadow_pixels(offscreen, tree, cam, sun)
+    drop = luminance(lit)[on_tree] - luminance(shaded)[on_tree]
+    assert on_tree.sum() > 1000
+    assert np.mean(drop > 8) > 0.12, np.mean(drop > 8)  # the upper leaves shade the inner crown
+    assert np.mean(drop < -8) < 0.01  # and shade never brightens
+
+
+def test_a_leaf_lit_from_behind_glows_with_translucency(offscreen, tree):
+    cam = OrbitCamera(target=(0.0, 1.5, 0.0), distance=2.5, azimuth=0.0, elevation=5.0)
+    leaves = tree.kind == "leaf"
+    bare = render(offscreen, tree, cam, present=~leaves, shadow=False)
+    for sun, least in [((0.0, 0.45, -1.0), 1.15), ((0.0, 0.45, 1.0), None)]:  # behind, then in front
+        glow = render(offscreen, tree, cam, shadow=False, sun_direction=sun, translucency=1.0)
+        flat = render(offscreen, tree, cam, shadow=False, sun_direction=sun, translucency=0.0)
+        leaf = np.abs(glow.astype(int) - bare.astype(int)).max(axis=2) > 24
+        assert leaf.sum() > 300
+        ratio = luminance(glow)[leaf].mean() / luminance(flat)[leaf].mean()
+        if least is not None:
+            assert ratio > least, ratio
+        else:  # lit from the camera's side the faces we see take the sun directly
+            assert 1.0 <= ratio < 1.1, ratio
+
+
+def test_shadows_off_is_the_same_picture_without_the_shadow_pass(offscreen, tree):
+    cam = overhead(tree)
+    sun = (0.6, 0.75, 0.2)
+    a = render(offscreen, tree, cam, shadow=False, sun_direction=sun)
+    b = render(offscreen, tree, cam, shadow=False, sun_direction=sun, shadow_size=64)
+    np.testing.assert_array_equal(a, b)
+
+
+def test_scene_defaults_have_shadows_and_translucency():
+    s = Scene()
+    assert s.shadow and s.translucency == 1.0 and s.shadow_size >= 1024
+    assert dataclasses.replace(s, shadow=False).shadow is False
