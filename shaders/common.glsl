@@ -28,24 +28,24 @@ vec3 apply_haze(vec3 c, vec3 world) {
     return mix(c, u_sky_horizon, f);
 }
 
-// How much of the sun reaches a surface at `world` with normal `n` (0 shadowed .. 1 lit):
-// percentage-closer filtering over 4 x 4 bilinear taps (a soft edge about four texels wide).
-// The point is pushed off the surface towards the sun's side by a texel and a half, so a
-// surface never shadows itself (acne) and a leaf lit from behind is looked up on its lit face.
-float sun_visibility(vec3 world, vec3 n) {
-    if (u_shadow_on == 0) return 1.0;
+// Where `world` (normal `n`) falls in the shadow map: pushed off the surface towards the sun's
+// side by a texel and a half, so a surface never shadows itself (acne) and a leaf lit from
+// behind is looked up on its lit face.
+vec3 shadow_coord(vec3 world, vec3 n) {
     vec3 towards = dot(n, u_sun_dir) < 0.0 ? -n : n;
     vec4 p = u_light_view_proj * vec4(world + 1.5 * u_shadow_texel * towards + 0.5 * u_shadow_texel * u_sun_dir, 1.0);
-    vec3 s = p.xyz / p.w * 0.5 + 0.5;
-    if (s.z >= 1.0) return 1.0;                              // beyond everything that casts
-    vec2 texel = 1.0 / vec2(textureSize(u_shadow_map, 0));
-    float lit = 0.0;
-    for (int i = 0; i < 4; i++) {
-        for (int j = 0; j < 4; j++) {
-            lit += texture(u_shadow_map, vec3(s.xy + (vec2(i, j) - 1.5) * texel, s.z));
-        }
-    }
-    return lit / 16.0;
+    return p.xyz / p.w * 0.5 + 0.5;
+}
+
+// How much of the sun reaches a surface (0 shadowed .. 1 lit): percentage-closer filtering,
+// four bilinear taps a texel apart (a soft edge about three texels wide). A software rasteriser
+// runs every branch, so there is no early exit for pixels off the map or with shadows off.
+float sun_visibility(vec3 world, vec3 n) {
+    vec3 s = shadow_coord(world, n);
+    vec2 d = 0.5 / vec2(textureSize(u_shadow_map, 0));
+    float lit = 0.25 * (texture(u_shadow_map, vec3(s.x - d.x, s.y - d.y, s.z)) + texture(u_shadow_map, vec3(s.x + d.x, s.y - d.y, s.z))
+                      + texture(u_shadow_map, vec3(s.x - d.x, s.y + d.y, s.z)) + texture(u_shadow_map, vec3(s.x + d.x, s.y + d.y, s.z)));
+    return u_shadow_on == 0 || s.z >= 1.0 ? 1.0 : lit;
 }
 
 float hash12(vec2 p) {

@@ -17,8 +17,8 @@ void main() {
         gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
         return;
     }
-    vec3 world;
+    vec3 world, centre;
     mat3 R;
-    skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, world, R);
+    skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, world, R, centre);
     gl_Position = u_light_view_proj * vec4(world, 1.0);
 }

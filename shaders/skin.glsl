@@ -34,7 +34,10 @@ mat3 orthonormal(mat3 m) {  // Gram-Schmidt on the columns
 // prev < 0), T1 at its far end (a joint's mean, or at an object's tip 1.5 R - 0.5 T0). Inside
 // a segment the vertex rides the cubic Hermite curve between the ends with tangents T0 c and
 // T1 c, c the segment's rest chord, turned by the frame that carries c onto the curve's tangent.
-void skin_transform(int node, int prev, float weight, vec2 curve, vec3 offset, out vec3 world, out mat3 R) {
+// `centre` is the point on the segment's axis (the node itself where t = 0) the vertex is
+// offset from.
+void skin_transform(int node, int prev, float weight, vec2 curve, vec3 offset, out vec3 world, out mat3 R,
+                    out vec3 centre) {
     vec3 p0;
     mat3 Rs;
     node_transform(node, p0, Rs);
@@ -48,6 +51,7 @@ void skin_transform(int node, int prev, float weight, vec2 curve, vec3 offset, o
     float t = curve.x;
     if (t <= 0.0) {
         R = T0;
+        centre = p0;
         world = p0 + R * offset;
         return;
     }
@@ -58,7 +62,7 @@ void skin_transform(int node, int prev, float weight, vec2 curve, vec3 offset, o
     mat3 T1 = orthonormal(curve.y > 0.5 ? 1.5 * Rs - 0.5 * T0 : 0.5 * (Rs + R1));
     float t2 = t * t;
     float t3 = t2 * t;
-    vec3 centre = (2.0 * t3 - 3.0 * t2 + 1.0) * p0 + (3.0 * t2 - 2.0 * t3) * p1
+    centre = (2.0 * t3 - 3.0 * t2 + 1.0) * p0 + (3.0 * t2 - 2.0 * t3) * p1
                 + (t3 - 2.0 * t2 + t) * (T0 * c) + (t3 - t2) * (T1 * c);
     R = orthonormal((3.0 * t2 - 4.0 * t + 1.0) * T0 + (6.0 * t - 6.0 * t2) * Rs + (3.0 * t2 - 2.0 * t) * T1);
     world = centre + R * (offset - t * c);

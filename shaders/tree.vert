@@ -13,6 +13,10 @@ in vec2 in_curve;    // t along the segment, 1 where it ends at the object's tip
 uniform mat4 u_view_proj;
 uniform sampler2D u_objects;   // per object: r = visible, g = highlight
 uniform float u_season;        // 0 summer .. 1 winter
+uniform vec3 u_bark_color;     // sRGB
+uniform float u_pixels_per_metre;  // at one metre from the eye: a length's size on screen
+uniform float u_thin_pixels;       // twigs and blades with a half width below this (px) get soft edges
+uniform vec3 u_camera_pos;
 
 out vec3 v_world;
 out vec3 v_normal;
@@ -21,6 +25,8 @@ out float v_ao;
 out vec2 v_uv;
 flat out int v_material;
 flat out float v_highlight;
+noperspective out float v_edge;  // thin twigs and blades: distance from the axis on screen, px
+out float v_half;                // their true half width on screen, px (< 0: not thin)
 
 const int BARK = 0;
 const int PETIOLE = 1;
@@ -28,6 +34,7 @@ const int LAMINA = 2;
 const int BLADE = 3;
 
 vec3 lin(vec3 c) { return pow(c, vec3(2.2)); }
+
 
 vec3 leaf_color(float jitter, float key) {
     // Summer: saturated cherry greens, each leaf a little different in hue and value.
@@ -61,14 +68,42 @@ void main() {
         return;
     }
     mat3 R;
-    skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, v_world, R);
+    vec3 centre;
+    skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, v_world, R, centre);
     v_normal = R * in_normal;
+    v_edge = 0.0;
+    v_half = -1.0;
+    if (v_material == BARK || v_material == BLADE) {
+        // Thinner than a few pixels, a twig or a blade would fall between pixel centres and
+        // break into dots that crawl as it sways. It is drawn flat, facing the eye, a pixel
+        // wider each side, and tree.frag gives each pixel the share of it the true width
+        // covers (from its distance to the axis, v_edge, and the true half width, v_half): a
+        // soft line whose weight per pixel column stays the same wherever it falls.
+        vec3 across = v_world - centre;
+        float metres = length(across);
+        float px = metres * u_pixels_per_metre / max((u_view_proj * vec4(centre, 1.0)).w, 1e-6);
+        if (px < u_thin_pixels) {
+            vec3 p0, p1;
+            mat3 R0, R1;
+            node_transform(in_ids.x, p0, R0);
+            node_transform(in_ids.x + 1, p1, R1);   // the segment's axis
+            vec3 side = cross(p1 - p0, u_camera_pos - centre);
+            float k = dot(across, side) / max(metres * length(side), 1e-30);  // -1 .. 1 across the axis
+            float half_px = v_material == BARK ? px : abs(k) * px;            // a blade: as seen
+            float edge = v_material == BARK ? k * (px + 1.0) : sign(k) * (half_px + 1.0);
+            if (px > 0.0 && length(side) > 0.0) {
+                v_world = centre + normalize(side) * (edge * metres / px);
+                v_edge = edge;
+            }
+            v_half = px > 0.0 ? half_px : 0.0;
+        }
+    }
     gl_Position = u_view_proj * vec4(v_world, 1.0);
 
     float jitter = in_extra.y;
     float key = in_extra.w;
     if (v_material == BARK) {
-        v_albedo = lin(vec3(0.34, 0.29, 0.25)) * (0.8 + 0.4 * jitter);
+        v_albedo = lin(u_bark_color) * (0.92 + 0.16 * jitter);
     } else if (v_material == PETIOLE) {
         v_albedo = mix(leaf_color(jitter, key), lin(vec3(0.55, 0.28, 0.14)), 0.4);
     } else if (v_material == LAMINA) {

@@ -124,3 +124,52 @@ def test_scene_defaults_have_shadows_and_translucency():
     s = Scene()
     assert s.shadow and s.translucency == 1.0 and s.shadow_size >= 1024
     assert dataclasses.replace(s, shadow=False).shadow is False
+
+
+# ------------------------------------------------------------------------------ thin twigs
+def thin_twig():
+    """One 3 m twig, 1 cm thick, rising at 40° from the ground."""
+    from treeanim.model.build import ObjectSpec, assemble
+
+    d = np.array([np.cos(np.radians(40)), np.sin(np.radians(40)), 0.0])
+    pts = np.outer(np.linspace(0.0, 3.0, 4), d) + (-1.2, 0.2, 0.0)
+    return assemble([ObjectSpec(pts, np.full(4, 0.01), "branch", 1)], name="thin_twig")
+
+
+def twig_coverage(off, tree, cam, shift, thin_pixels):
+    """Per screen column along the twig (at rest): how much it darkens the sky there (summed
+    over the column's pixels), for the twig moved by ``shift`` metres."""
+    off.resize(W, H)
+    off.load(tree, scene=Scene(shadow=False, thin_pixels=thin_pixels))
+    P = tree.rest_positions + shift
+    R = np.broadcast_to(np.eye(3), (tree.n_nodes, 3, 3))
+    off.update(P, R, present=np.zeros(tree.n_objects, bool))
+    sky = luminance(off.render(cam))
+    off.update(P, R)
+    dark = np.clip(sky - luminance(off.render(cam)), 0.0, None)
+    ends = cam.project(tree.rest_positions[[0, -1]], W, H)
+    cols = np.arange(int(np.ceil(ends[:, 0].min())) + 2, int(ends[:, 0].max()) - 2)
+    return dark[:, cols].sum(axis=0)
+
+
+def test_a_thin_twig_stays_continuous_from_frame_to_frame(offscreen):
+    """Thinner than a pixel (0.2 px here, 10 m away), a twig is drawn as a soft line about two
+    pixels wide and faint in proportion: every column along it is covered, in two frames a
+    third of a pixel apart, with about the same weight; drawn at its true width it breaks up."""
+    tree = thin_twig()
+    cam = OrbitCamera(target=(0.0, 1.2, 0.0), distance=10.0, elevation=0.0)
+    off = type(offscreen)(W, H, samples=0, ctx=offscreen.ctx)  # no MSAA, as the viewer on llvmpipe
+    try:
+        frames = [twig_coverage(off, tree, cam, (dx, 0.0, 0.0), 1.5) for dx in (0.0, 0.016)]
+        true_width = twig_coverage(off, tree, cam, (0.0, 0.0, 0.0), 0.0)
+    finally:
+        off.release()
+    assert len(frames[0]) > 40
+    for cov in frames:
+        assert np.all(cov > 3.0), np.flatnonzero(cov <= 3.0)  # no gap along the twig
+    # The twig's weight per column stays put as it moves by a fraction of a pixel
+    ratio = frames[1] / frames[0]
+    assert 0.9 < frames[1].sum() / frames[0].sum() < 1.1
+    assert np.percentile(np.abs(ratio - 1.0), 90) < 0.3, ratio
+    # Without the minimum width it falls apart into dots
+    assert np.mean(true_width > 3.0) < 0.8, np.mean(true_width > 3.0)

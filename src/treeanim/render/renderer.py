@@ -26,12 +26,13 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from ..model.look import Bark
 from ..model.tree import Tree
 from .camera import OrbitCamera
 from .mesh import VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh, build_mesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
 from .shaders import load_program
-from .shadow import ShadowMap
+from .shadow import ShadowMap, shadow_indices
 
 #: Width in texels of the node and object textures (GL 3.3 guarantees 1024).
 TEXTURE_WIDTH = 1024
@@ -65,6 +66,7 @@ class Scene:
     shadow: bool = True                 # the sun's shadows (tree on ground and on itself)
     shadow_size: int = 2048             # shadow-map texels a side (read when the renderer is made)
     translucency: float = 1.0           # sunlight through the leaves (0: opaque leaves)
+    thin_pixels: float = 1.5            # twigs and blades of a half width below this (px) get soft edges (0: none)
 
 
 class _Lines:
@@ -128,7 +130,7 @@ class Renderer:
                                             index_buffer=self.ibo, index_element_size=4)
             self._n_indices = 3 * self.mesh.triangle_count
             bound = _bound_framebuffer(ctx)
-            self.shadow = ShadowMap(ctx, self.vbo, self.ibo, self.scene.shadow_size)
+            self.shadow = ShadowMap(ctx, self.vbo, shadow_indices(self.mesh, tree), self.scene.shadow_size)
             bound.use()  # making the map's framebuffer bound it
 
             # --- per-frame textures
@@ -235,6 +237,10 @@ class Renderer:
         self._uniform(g, "u_trunk_radius", float(self.trunk_radius if s.shadow else 0.0))
         self._uniform(g, "u_grid", float(s.ground_grid))
         self._uniform(self.tree_prog, "u_translucency", float(s.translucency))
+        bark = getattr(self.tree, "bark", None) or Bark()
+        self._uniform(self.tree_prog, "u_bark_color", tuple(float(c) for c in bark.color))
+        self._uniform(self.tree_prog, "u_bark", (float(bark.furrows), float(bark.depth), float(bark.interlace),
+                                                 float(bark.lenticels)))
         if s.shadow:
             self.shadow.fit(sun, *self.bounds())
         else:
@@ -325,7 +331,7 @@ class Renderer:
         self.object_texture.use(1)
         if self.scene.shadow:
             ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
-            self.shadow.draw(self._n_indices)
+            self.shadow.draw()
         target.use()
         ctx.viewport = (0, 0, width, height)
 
@@ -336,21 +342,24 @@ class Renderer:
         for prog in (self.tree_prog, self.bg_prog):
             self._uniform(prog, "u_camera_pos", eye)
         self._uniform(self.tree_prog, "u_season", season)
+        self._uniform(self.tree_prog, "u_pixels_per_metre", 0.5 * height / math.tan(math.radians(camera.fov_y) / 2))
+        self._uniform(self.tree_prog, "u_thin_pixels", float(self.scene.thin_pixels))
 
         s = self.scene
         hz = _lin(s.sky_horizon)
         ctx.clear(hz[0] ** (1 / 2.2), hz[1] ** (1 / 2.2), hz[2] ** (1 / 2.2), 1.0, depth=1.0)
-        ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
+        ctx.disable(moderngl.CULL_FACE | moderngl.BLEND | moderngl.DEPTH_TEST)
+        # Sky and ground first (no depth): the tree's faint thin twigs blend over them.
+        self.bg_prog["u_inv_view_proj"].write(np.linalg.inv(vp.astype(np.float64)).astype(np.float32).tobytes())
+        self.shadow.texture.use(2)
+        self.bg_vao.render(moderngl.TRIANGLES, vertices=3)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
-        self.shadow.texture.use(2)
-        if self.vao is not None:
+        if self.vao is not None:  # blended: twigs thinner than a pixel are drawn faint
+            ctx.enable(moderngl.BLEND)
+            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
             self.vao.render(moderngl.TRIANGLES, vertices=self._n_indices)
-        # Background last, at the far plane: only pixels the tree left uncovered are shaded.
-        ctx.depth_func = "<="
-        self.bg_prog["u_inv_view_proj"].write(np.linalg.inv(vp.astype(np.float64)).astype(np.float32).tobytes())
-        self.bg_vao.render(moderngl.TRIANGLES, vertices=3)
-        ctx.depth_func = "<"
+            ctx.disable(moderngl.BLEND)
         overlays = [o for o in overlays if o is not None]
         if overlays:
             self._draw_overlays(overlays, width, height)

@@ -12,7 +12,9 @@ from __future__ import annotations
 import moderngl
 import numpy as np
 
-from .mesh import VERTEX_ATTRIBUTES, VERTEX_DTYPE, VERTEX_FORMAT
+from ..model.lamina import ear_clip
+from ..model.tree import Tree
+from .mesh import MATERIAL_LAMINA, MATERIAL_PETIOLE, VERTEX_ATTRIBUTES, VERTEX_DTYPE, VERTEX_FORMAT, TreeMesh
 from .shaders import load_program
 
 #: Attributes the shadow pass reads; the rest of each vertex is skipped.
@@ -22,6 +24,8 @@ SWAY_MARGIN = 0.15
 #: The lowest sun elevation the map is fitted for (sin of it): lower suns cast the shadow of
 #: a sun at this height, not an endless one.
 MIN_SUN_HEIGHT = 0.15
+#: Corners of a lamina's outline kept for its shadow (its teeth are far below a texel).
+SHADOW_LAMINA_CORNERS = 12
 
 
 def _skipping_format() -> str:
@@ -33,6 +37,32 @@ def _skipping_format() -> str:
         else:
             parts.append(f"{VERTEX_DTYPE[name[3:]].itemsize}x")
     return " ".join(parts)
+
+
+def shadow_indices(mesh: TreeMesh, tree: Tree) -> np.ndarray:
+    """The triangles the shadow pass draws: the mesh's, without petioles (a few millimetres
+    across, far below a texel) and with each lamina outlined by :data:`SHADOW_LAMINA_CORNERS`
+    of its corners (a lamina's vertices are its outline's, in order, per leaf).
+
+    Returns
+    -------
+    (T', 3) uint32
+        Indices into ``mesh.vertices``.
+    """
+    material = mesh.material
+    first = material[mesh.indices[:, 0]]
+    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA)]]
+    lamina = np.flatnonzero(material == MATERIAL_LAMINA)
+    if len(lamina):
+        outline = tree.lamina.outline
+        K = len(outline)
+        corners = np.unique(np.linspace(0, K, SHADOW_LAMINA_CORNERS, endpoint=False).round().astype(int))
+        try:
+            tris = corners[ear_clip(outline[corners])]
+        except ValueError:  # the coarse outline crosses itself: keep the full lamina
+            tris = np.asarray(tree.lamina.triangles)
+        keep.append(lamina.reshape(-1, K)[:, tris].reshape(-1, 3))
+    return np.ascontiguousarray(np.concatenate(keep), dtype=np.uint32)
 
 
 def light_view_projection(sun: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, float]:
@@ -87,16 +117,19 @@ class ShadowMap:
     Parameters
     ----------
     ctx : moderngl.Context
-    vbo, ibo : moderngl.Buffer
-        The tree's static mesh (:class:`~treeanim.render.mesh.TreeMesh` layout).
+    vbo : moderngl.Buffer or None
+        The tree's static vertices (:class:`~treeanim.render.mesh.TreeMesh` layout).
+    indices : (T, 3) uint32
+        The triangles to cast shadows (:func:`shadow_indices`).
     size : int
         Texels a side (clamped to the context's largest texture).
     """
 
-    def __init__(self, ctx: moderngl.Context, vbo, ibo, size: int) -> None:
+    def __init__(self, ctx: moderngl.Context, vbo, indices: np.ndarray, size: int) -> None:
         self.ctx = ctx
         self.size = int(min(max(size, 16), ctx.info["GL_MAX_TEXTURE_SIZE"]))
-        self.prog = self.texture = self.fbo = self.vao = None
+        self.count = 3 * len(indices)
+        self.prog = self.texture = self.fbo = self.vao = self.ibo = None
         try:
             self.prog = load_program(ctx, "shadow.vert", "shadow.frag")
             self.texture = ctx.depth_texture((self.size, self.size))
@@ -104,9 +137,10 @@ class ShadowMap:
             self.texture.filter = (moderngl.LINEAR, moderngl.LINEAR)  # 2 x 2 PCF per tap
             self.texture.repeat_x = self.texture.repeat_y = False
             self.fbo = ctx.framebuffer(depth_attachment=self.texture)
-            if vbo is not None:
+            if vbo is not None and self.count:
+                self.ibo = ctx.buffer(np.ascontiguousarray(indices, np.uint32).tobytes())
                 self.vao = ctx.vertex_array(self.prog, [(vbo, _skipping_format(), *SHADOW_ATTRIBUTES)],
-                                            index_buffer=ibo, index_element_size=4)
+                                            index_buffer=self.ibo, index_element_size=4)
         except BaseException:
             self.release()
             raise
@@ -131,24 +165,24 @@ class ShadowMap:
         """Nothing in the map: everything lit."""
         self.fbo.clear(depth=1.0)
 
-    def draw(self, count: int) -> None:
-        """Draw the first ``count`` indices of the mesh into the map (the node and object
-        textures bound to units 0 and 1, as for the scene). Leaves the map's framebuffer bound."""
+    def draw(self) -> None:
+        """Draw the tree into the map (the node and object textures bound to units 0 and 1, as
+        for the scene). Leaves the map's framebuffer bound."""
         ctx = self.ctx
         self.fbo.use()
         ctx.viewport = (0, 0, self.size, self.size)
         self.fbo.clear(depth=1.0)
-        if self.vao is None or not count:
+        if self.vao is None:
             return
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         ctx.polygon_offset = 1.5, 2.0  # slope-scaled bias against acne on grazing faces
-        self.vao.render(moderngl.TRIANGLES, vertices=count)
+        self.vao.render(moderngl.TRIANGLES, vertices=self.count)
         ctx.polygon_offset = 0.0, 0.0
 
     def release(self) -> None:
         """Free the GL objects (idempotent)."""
-        for o in (self.vao, self.fbo, self.texture, self.prog):
+        for o in (self.vao, self.ibo, self.fbo, self.texture, self.prog):
             if o is not None:
                 o.release()
-        self.vao = self.fbo = self.texture = self.prog = None
+        self.vao = self.ibo = self.fbo = self.texture = self.prog = None
