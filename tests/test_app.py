@@ -24,6 +24,7 @@ from treeanim.app.settings import physics_toml, preset_text, save_preset
 from treeanim.app.viewer import MAX_FRAME_DT, Viewer, run
 from treeanim.app.window import Window
 from treeanim.model.params import ModeRange
+from treeanim.render.renderer import Scene, sun_angles
 
 W, H = 480, 360
 DT = 1.0 / 60.0
@@ -326,6 +327,43 @@ def test_panel_slider_and_checkbox_change_the_scene(viewer):
     assert v.ctx.error == "GL_NO_ERROR"
     assert np.linalg.norm(v.sim.tip_position(0) - t0) > 0
     v.show_wind = False
+
+
+def test_panel_light_moves_the_sun_and_its_shadow_and_survives_a_new_tree(viewer):
+    v = viewer
+    v.show_panel = True
+    v.frame(DT)
+    v.frame(DT)
+    for section in ("Wind", "Physics", "Simulation"):  # fold these: the light section comes into view
+        _click(v, *_centre(v.panel.item_rects[section]))
+    _click(v, *_reveal(v, "Light"))
+    x0, y0, x1, y1 = v.panel.item_rects["sun azimuth"]
+    v.show_panel = False
+    v.frame(DT)
+    before = v.read_pixels()
+    v.show_panel = True
+    v.frame(DT)
+    _click(v, x0 + 0.1 * (x1 - x0), 0.5 * (y0 + y1))  # a tenth of 360° (less the grab's margin)
+    az, el = sun_angles(v.scene.sun_direction)
+    assert 10.0 < az < 40.0 and az < sun_angles(Scene().sun_direction)[0] - 8.0, az
+    assert v.renderer.scene is v.scene
+    v.show_panel = False
+    v.frame(DT)
+    after = v.read_pixels()
+    moved = np.abs(before.astype(int) - after.astype(int)).max(axis=2) > 24
+    assert moved[H // 2:].mean() > 0.01  # the shadow on the ground moved with the sun
+    assert v.panel.apply("shadows", False) and not v.scene.shadow
+    assert v.panel.apply("translucency", 3.0) and v.scene.translucency == 1.0
+    assert v.panel.apply("sun_elevation", 1.0)  # clamped to the slider's 5°
+    assert sun_angles(v.scene.sun_direction)[1] == pytest.approx(5.0)
+    v.load_tree(ta.load_preset("beam"))  # the light stays with the viewer
+    assert v.renderer.scene is v.scene and not v.scene.shadow
+    v.frame(DT)
+    assert v.ctx.error == "GL_NO_ERROR"
+    v.scene.shadow, v.scene.translucency = True, 1.0
+    v.scene.sun_direction = Scene().sun_direction
+    for section in ("Wind", "Physics", "Simulation", "Light"):
+        _click(v, *_reveal(v, section))
 
 
 def test_panel_apply_sets_physics_season_and_time(viewer):

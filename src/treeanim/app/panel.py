@@ -19,6 +19,7 @@ from ..model.params import ModeRange
 from ..model.tree import KINDS
 from ..physics.simulation import INTEGRATORS
 from ..physics.wind import WIND_PRESETS
+from ..render.renderer import sun_angles, sun_direction
 from .settings import save_preset
 from .viewer import PANEL_WIDTH, wind_angle
 
@@ -38,6 +39,9 @@ RANGES = {
     "c4": (0.0, 2.0, "%.2f", False),
     "ei_max": (0.0, 0.0, "%.3g N·m²", True),  # set per tree: the preset's value ÷ or × EI_SPAN
     "time_scale": (0.05, 2.0, "%.2f×", True),
+    "sun_azimuth": (0.0, 360.0, "%.0f°", False),
+    "sun_elevation": (5.0, 90.0, "%.0f°", False),
+    "translucency": (0.0, 1.0, "%.2f", False),
 }
 #: The EI_max slider spans the preset's value divided or multiplied by this.
 EI_SPAN = 30.0
@@ -122,7 +126,8 @@ class Panel:
         (degrees about +y), ``wind_preset`` (calm, breeze, windy, gale, storm), ``turbulence``,
         ``gust_strength``, ``gust_rate``, ``length_scale``, ``beta_u``, ``beta_vw``, ``c3``, ``c4``, ``ei_max``,
         ``f:KIND`` and ``zeta:KIND`` ((min, max) of the edited season's table), ``time_scale``,
-        ``integrator``, ``coupling``, ``load_path``, ``paused``, ``show_trace``, ``show_frames``, ``show_wind``.
+        ``integrator``, ``coupling``, ``load_path``, ``paused``, ``show_trace``, ``show_frames``, ``show_wind``,
+        ``sun_azimuth`` and ``sun_elevation`` (degrees), ``shadows``, ``translucency``.
         """
         v = self.viewer
         sim = v.sim
@@ -168,6 +173,15 @@ class Panel:
                 sim.load_path = bool(value)
             elif name in ("paused", "show_trace", "show_frames", "show_wind"):
                 setattr(v, name, bool(value))
+            elif name in ("sun_azimuth", "sun_elevation"):
+                az, el = sun_angles(v.scene.sun_direction)
+                az, el = (float(value), el) if name == "sun_azimuth" else (az, float(value))
+                lo, hi = RANGES["sun_elevation"][:2]
+                v.scene.sun_direction = sun_direction(az % 360.0, min(max(el, lo), hi))
+            elif name == "shadows":
+                v.scene.shadow = bool(value)
+            elif name == "translucency":
+                v.scene.translucency = min(max(float(value), 0.0), 1.0)
             else:
                 raise ValueError(f"unknown setting {name!r}")
         except (ValueError, OSError) as e:
@@ -381,6 +395,14 @@ class Panel:
             imgui.same_line()
             self._check("local frames", "show_frames", v.show_frames)
             self._check("wind slices + arrow", "show_wind", v.show_wind)
+
+        # --- light
+        if self._header("Light"):
+            az, el = sun_angles(v.scene.sun_direction)
+            self._slider("sun azimuth", "sun_azimuth", az)
+            self._slider("sun elevation", "sun_elevation", el)
+            self._slider("translucency", "translucency", v.scene.translucency)
+            self._check("shadows", "shadows", v.scene.shadow)
 
         # --- preset file
         if self._header("Preset file"):

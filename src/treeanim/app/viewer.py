@@ -35,7 +35,7 @@ from ..physics.wind import wind_preset as wind_preset_kwargs
 from ..render.camera import OrbitCamera
 from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
 from ..render.picking import Picker
-from ..render.renderer import Renderer
+from ..render.renderer import Renderer, Scene
 from .gui import Gui
 from .window import Window
 
@@ -236,6 +236,7 @@ class Viewer:
         self._load_path = True
         self.sim: Simulation | None = None
         self.renderer: Renderer | None = None
+        self.scene = Scene()  # sun, shadows and leaves' translucency, kept across trees
         named = wind_preset_kwargs(wind_preset) if wind_preset else {}
         if wind_speed is not None:
             named["speed"] = float(wind_speed)
@@ -274,7 +275,7 @@ class Viewer:
         self._end_drag()
         sim = Simulation(tree, wind=_clone_wind(self._wind), season=self._season, seed=self.seed,
                          integrator=self._integrator, coupling=self._coupling, load_path=self._load_path)
-        renderer = Renderer(self.ctx, tree)
+        renderer = Renderer(self.ctx, tree, scene=self.scene)
         if self.renderer is not None:
             self.renderer.release()
         self.sim, self.renderer = sim, renderer

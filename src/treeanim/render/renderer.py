@@ -42,6 +42,20 @@ def _lin(rgb) -> tuple[float, float, float]:
     return tuple(float(c) ** 2.2 for c in rgb)
 
 
+def sun_direction(azimuth: float, elevation: float) -> tuple[float, float, float]:
+    """Unit vector towards a sun at ``azimuth`` degrees about +y (0: towards +z, 90: towards +x)
+    and ``elevation`` degrees above the horizon."""
+    a, e = math.radians(azimuth), math.radians(elevation)
+    return (math.cos(e) * math.sin(a), math.sin(e), math.cos(e) * math.cos(a))
+
+
+def sun_angles(direction) -> tuple[float, float]:
+    """Inverse of :func:`sun_direction`: (azimuth in [0, 360), elevation in [-90, 90]) degrees."""
+    d = np.asarray(direction, float)
+    d = d / np.linalg.norm(d)
+    return math.degrees(math.atan2(d[0], d[2])) % 360.0, math.degrees(math.asin(np.clip(d[1], -1.0, 1.0)))
+
+
 def _bound_framebuffer(ctx: moderngl.Context) -> moderngl.Framebuffer:
     """The framebuffer bound now (moderngl's record of it, else the one GL reports)."""
     return ctx.fbo if ctx.fbo is not None else ctx.detect_framebuffer()
