@@ -268,6 +268,13 @@ BAD = [
     (["bench", "--json", "b.txt"], "unknown extension"),
     (["bench", "--size", "1280x"], "WIDTHxHEIGHT"),
     (["bench", "--frames", "0"], "positive"),
+    (["render", "beam", "--pull", "0:2e9,0,0@0-1", "--out", "x.png"], "at most 1e+09 N"),
+    (["export", "beam", "--pull", "0:0,-2e9,0@0-1", "--out", "x.glb"], "at most 1e+09 N"),
+    (["trace", "beam", "--pull", "0,0,2e9", "--out", "t.csv"], "at most 1e+09 N"),
+    (["render", "beam", "--samples", "3", "--out", "x.png"], "one of 0, 1, 2, 4, 8, 16"),
+    (["view", "beam", "--samples", "3"], "one of 0, 1, 2, 4, 8, 16"),
+    (["render", "beam", "--out", "a" * 300 + ".png"], "bytes long"),
+    (["export", "beam", "--out", "b" * 300 + ".glb"], "bytes long"),
 ]
 
 
@@ -285,3 +292,41 @@ def test_bad_input_one_line_exit_2_no_file(tmp_path, monkeypatch, capsys, args, 
     assert len(lines) == 1, err
     assert words in lines[0] and "Traceback" not in err
     assert sorted(os.listdir(tmp_path)) == ["notes.txt"], "no file is left behind"
+
+
+@pytest.mark.parametrize("args", [["export", "beam", "--out", "{d}.glb"],  # (render takes a folder: its frames)
+                                  ["trace", "beam", "--pull", "1,0,0", "--out", "{d}.csv"],
+                                  ["bench", "--presets", "beam", "--json", "{d}.json"]])
+def test_an_output_that_is_a_folder_is_refused_before_the_job(tmp_path, monkeypatch, capsys, args):
+    monkeypatch.chdir(tmp_path)
+    for suffix in (".glb", ".csv", ".json"):
+        (tmp_path / f"out{suffix}").mkdir()
+    args = [a.format(d="out") for a in args]
+    t0 = time.perf_counter()
+    code = cli.main(args)
+    err = capsys.readouterr().err
+    assert code == 2 and len(err.strip().splitlines()) == 1 and "is a folder" in err, err
+    assert time.perf_counter() - t0 < 5.0  # refused up front, not after simulating and rendering
+
+
+def test_a_still_after_the_tiniest_time_is_the_rest_pose(tmp_path, capsys):
+    out = tmp_path / "still.png"
+    assert cli.main(["render", "beam", "--seconds", "5e-324", "--size", "32x24", "--out", str(out), "--quiet"]) == 0
+    assert out.stat().st_size > 0
+
+
+def test_standard_output_on_a_full_disk_is_one_line_and_exit_1():
+    with open("/dev/full", "w") as full:
+        res = subprocess.run([sys.executable, "-m", "treeanim", "list"], stdout=full, stderr=subprocess.PIPE,
+                             text=True, timeout=120)
+    assert res.returncode == 1
+    assert res.stderr.strip().splitlines() == ["treeanim: error: No space left on device"], res.stderr
+
+
+def test_ctrl_c_while_the_command_line_starts_is_a_quiet_exit_130(monkeypatch, capsys):
+    def interrupted():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "build_parser", interrupted)
+    assert cli.main(["list"]) == 130
+    assert capsys.readouterr().err.strip() == "treeanim: interrupted"

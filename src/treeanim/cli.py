@@ -100,6 +100,12 @@ def _vector(what: str):
     return _checked(lambda text: parse_vector(text, what))
 
 
+def _force(text: str):
+    from treeanim.scripted import parse_force
+
+    return _checked(lambda t: parse_force(t, "force"))(text)
+
+
 def _pull(text: str):
     from treeanim.scripted import parse_pull
 
@@ -206,7 +212,7 @@ def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
     if path.suffix.lower() not in suffixes:
         raise UsageError(f"{option} {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
     try:
-        offline.check_folder(path.parent, text)
+        offline.check_file(path, text)
     except offline.InputError as e:
         raise UsageError(str(e).replace("--out ", f"{option} ", 1)) from None
     return path
@@ -269,7 +275,18 @@ def _finite(text: str) -> float:
     return value
 
 
-_samples = _number(int, 0, 64, lo_open=False)
+#: MSAA sample counts a GL implementation may offer (more are clamped to what it has).
+SAMPLES = (0, 1, 2, 4, 8, 16)
+
+
+def _samples(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value not in SAMPLES:
+        raise argparse.ArgumentTypeError(f"expected one of {', '.join(map(str, SAMPLES))}, got {text!r}")
+    return value
 
 
 def _mb(n: int) -> str:
@@ -499,7 +516,7 @@ def build_parser() -> argparse.ArgumentParser:
         "second: the Lissajous / harmonograph trace of the paper's Figs. 1 and 4.")
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
     p.add_argument("--object", type=int, default=0, metavar="I", help="object index (default 0, e.g. the beam)")
-    p.add_argument("--pull", type=_vector("force"), required=True, metavar="FX,FY,FZ",
+    p.add_argument("--pull", type=_force, required=True, metavar="FX,FY,FZ",
                    help="world force on the tip in newtons, e.g. 1.5,0,1.2 for the beam")
     p.add_argument("--hold", type=_positive(float), default=2.0, metavar="SECONDS",
                    help="how long the pull is held before release (default 2)")
@@ -542,8 +559,9 @@ def build_parser() -> argparse.ArgumentParser:
                    default=None, metavar="NAME", help="a named wind: calm, breeze, windy, gale, storm (by Beaufort)")
     p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH",
                    help="window size (default 1280x720)")
-    p.add_argument("--samples", type=int, choices=range(0, 17), default=None, metavar="N",
-                   help="MSAA samples, 0-16 (default 4, or 0 on a software renderer such as llvmpipe)")
+    p.add_argument("--samples", type=_samples, default=None, metavar="N",
+                   help="MSAA samples: 0, 1, 2, 4, 8 or 16 (default 4, or 0 on a software renderer such as "
+                        "llvmpipe)")
     p.add_argument("--frames", type=_positive(int), default=None, metavar="N",
                    help="quit after N frames (for scripted runs)")
     p.set_defaults(func=cmd_view)
@@ -559,11 +577,11 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``treeanim`` console script."""
     from treeanim.model.errors import PresetError
 
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    if args.command is None:
-        args = parser.parse_args(DEFAULT_COMMAND)
-    try:
+    try:  # building the parser imports the wind's presets: Ctrl-C may come that early
+        parser = build_parser()
+        args = parser.parse_args(argv)
+        if args.command is None:
+            args = parser.parse_args(DEFAULT_COMMAND)
         code = int(args.func(args) or 0)
         sys.stdout.flush()
         return code
@@ -573,6 +591,12 @@ def main(argv: list[str] | None = None) -> int:
     except (PresetError, UsageError) as e:
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 2
+    except OSError as e:  # a write that failed (disk full, name too long ...): the old file is kept
+        if e.filename is None:  # standard output itself (`treeanim list > /dev/full`)
+            _stdout_to_devnull()
+        where = f"{e.filename}: " if e.filename is not None else ""
+        print(f"treeanim: error: {where}{e.strerror or e}", file=sys.stderr)
+        return 1
     except KeyboardInterrupt:
         print("treeanim: interrupted", file=sys.stderr)
         return 130

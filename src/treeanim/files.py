@@ -19,7 +19,8 @@ def temp_beside(path: str | Path, suffix: str = "") -> Path:
     """A new hidden, empty file beside ``path`` (same folder, so a rename replaces ``path`` at
     once), with the permissions a plain new file would get."""
     path = Path(path)
-    fd, name = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".part{suffix}", dir=path.parent)
+    # The name's first 100 characters: a name near the 255-byte limit leaves room for the rest
+    fd, name = tempfile.mkstemp(prefix=f".{path.name[:100]}.", suffix=f".part{suffix}", dir=path.parent)
     try:
         os.fchmod(fd, 0o666 & ~_umask())
     finally:

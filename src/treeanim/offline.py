@@ -110,6 +110,31 @@ def check_folder(folder: Path, text: str) -> None:
         raise InputError(f"--out {text}: cannot create files in {folder} ({e.strerror or e})") from None
 
 
+def _exists(path: Path, folder: bool = False) -> bool:
+    """Whether ``path`` exists (as a folder), False where the name cannot be looked up (too long)."""
+    try:
+        return path.is_dir() if folder else path.exists()
+    except OSError:
+        return False
+
+
+def check_file(path: Path, text: str) -> None:
+    """InputError unless ``path`` can be written as a file: its folder takes new files
+    (:func:`check_folder`), its name fits the file system's limit, and it is not a folder."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    check_folder(folder, text)
+    try:
+        most = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError):
+        most = 255
+    if len(os.fsencode(path.name)) > most:
+        raise InputError(f"--out {text[:60]}…: the file name is {len(os.fsencode(path.name))} bytes long; "
+                         f"at most {most}")
+    if _exists(path, folder=True):
+        raise InputError(f"--out {text}: {path} is a folder; name a file")
+
+
 def render_target(text: str) -> Target:
     """Classify and check ``--out``: a .mp4 or .gif video, a .png still, or a folder of frames
     (a path ending in '/', an existing folder, or a new name with no extension).
@@ -122,10 +147,10 @@ def render_target(text: str) -> Target:
     if not text.strip():
         raise InputError("--out is empty")
     path = Path(text)
-    if text.endswith(("/", os.sep)) or path.is_dir() or (path.suffix == "" and not path.exists()):
-        if path.exists() and not path.is_dir():
+    if text.endswith(("/", os.sep)) or _exists(path, folder=True) or (path.suffix == "" and not _exists(path)):
+        if _exists(path) and not _exists(path, folder=True):
             raise InputError(f"--out {text}: {path} exists and is not a folder")
-        if path.is_dir():
+        if _exists(path, folder=True):
             check_folder(path, text)
         else:
             check_folder(path.parent, text)
@@ -134,7 +159,7 @@ def render_target(text: str) -> Target:
     if suffix not in VIDEO_SUFFIXES + (STILL_SUFFIX,):
         raise InputError(f"--out {text}: unknown extension {path.suffix or '(none)'!r}; expected .mp4 or .gif "
                          f"(video), .png (one still) or a folder ending in / (PNG frames)")
-    check_folder(path.parent, text)
+    check_file(path, text)
     return Target("video" if suffix in VIDEO_SUFFIXES else "still", path)
 
 
@@ -483,7 +508,7 @@ def run_render(job: RenderJob, tree, sim, log=print) -> RenderResult:
 
         if target.kind == "still":
             T = job.start + job.seconds
-            for _ in scripted.frames(sim, 2 * T, 1 / T, job.pulls):  # frames at 0 and T
+            for _ in scripted.frames(sim, 2 * T, 1 / max(T, 1e-9), job.pulls):  # frames at 0 and T (T > 0)
                 pass
             write_png(target.path, shoot())
             return RenderResult(1, 1, True, False, target.path, (job.width, job.height), target.path.stat().st_size)

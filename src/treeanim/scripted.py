@@ -38,6 +38,17 @@ def parse_vector(text: str, what: str) -> tuple[float, float, float]:
     return values  # type: ignore[return-value]
 
 
+def parse_force(text: str, what: str) -> tuple[float, float, float]:
+    """``'FX,FY,FZ'`` newtons: three finite floats of magnitude at most the simulation's
+    ``MAX_PULL``; ValueError naming ``what`` otherwise."""
+    from .physics.simulation import MAX_PULL
+
+    force = parse_vector(text, what)
+    if not math.hypot(*force) <= MAX_PULL:
+        raise ValueError(f"{what}: a force of at most {MAX_PULL:g} N, got {text!r}")
+    return force
+
+
 def parse_pull(text: str) -> Pull:
     """Parse ``OBJECT:FX,FY,FZ@T0-T1``.
 
@@ -50,7 +61,7 @@ def parse_pull(text: str) -> Pull:
     m = _PULL.match(text)
     if not m:
         raise ValueError(f"--pull {text!r}: {form}")
-    force = parse_vector(m.group(2), f"--pull {text!r}")
+    force = parse_force(m.group(2), f"--pull {text!r}")
     try:
         t0, t1 = float(m.group(3)), float(m.group(4))
     except ValueError:

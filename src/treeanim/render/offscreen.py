@@ -45,7 +45,7 @@ class OffscreenRenderer:
     width, height : int
         Image size in pixels (0 gives empty images).
     samples : int
-        MSAA samples (clamped to what the context supports; 0 or 1: none).
+        MSAA samples (down to a power of two and to what the context supports; 0 or 1: none).
     ctx : moderngl.Context or None
         An existing context to render with (None creates an EGL one, owned and released here).
 
@@ -60,7 +60,8 @@ class OffscreenRenderer:
     def __init__(self, width: int, height: int, samples: int = 4, ctx: moderngl.Context | None = None) -> None:
         self._own_ctx = ctx is None
         self.ctx = create_egl_context() if ctx is None else ctx
-        self.samples = 0 if samples <= 1 else min(int(samples), int(self.ctx.max_samples))
+        most = min(int(samples), int(self.ctx.max_samples))
+        self.samples = 0 if most <= 1 else 1 << (most.bit_length() - 1)
         self.renderer: Renderer | None = None
         self._fbos: list = []
         self.fbo = self.resolve_fbo = None
