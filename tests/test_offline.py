@@ -330,3 +330,29 @@ def test_ctrl_c_while_the_command_line_starts_is_a_quiet_exit_130(monkeypatch, c
     monkeypatch.setattr(cli, "build_parser", interrupted)
     assert cli.main(["list"]) == 130
     assert capsys.readouterr().err.strip() == "treeanim: interrupted"
+
+
+@pytest.mark.parametrize("out", ["clip.mp4", "still.png", "tree.glb"])
+def test_a_write_that_fails_part_way_keeps_the_old_file_and_says_so(tmp_path, out):
+    """A full disk, played by a file-size limit on the command and its ffmpeg (EFBIG on the
+    first write past 20 kB): exit 1, one line naming the file, the previous file untouched and
+    no temporary file left."""
+    import resource
+
+    target = tmp_path / out
+    old = b"the previous file" * 100
+    target.write_bytes(old)
+    cmd = "export" if out.endswith(".glb") else "render"
+    extra = ["--seconds", "2", "--size", "320x240", "--quiet"] if cmd == "render" else ["--seconds", "1", "--quiet"]
+
+    def limited():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
+
+    res = subprocess.run([sys.executable, "-m", "treeanim", cmd, "small_cherry", "--out", str(target), *extra],
+                         preexec_fn=limited, capture_output=True, text=True, timeout=300)
+    assert res.returncode == 1, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"treeanim: error: {target}") and "Traceback" not in res.stderr
+    assert "wrote" not in res.stdout
+    assert target.read_bytes() == old
+    assert sorted(p.name for p in tmp_path.iterdir()) == [out]

@@ -31,7 +31,8 @@ def temp_beside(path: str | Path, suffix: str = "") -> Path:
 @contextlib.contextmanager
 def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
     """Yield a temporary path to write; on success it is renamed over ``path``, on any error
-    (Ctrl-C included) it is removed, so ``path`` is never left half-written.
+    (Ctrl-C included) it is removed, so ``path`` is never left half-written. An OSError of the
+    write (a full disk) is raised again naming ``path``.
 
     Parameters
     ----------
@@ -44,6 +45,11 @@ def atomic_path(path: str | Path, suffix: str = "") -> Iterator[Path]:
     try:
         yield tmp
         os.replace(tmp, path)
+    except OSError as e:
+        tmp.unlink(missing_ok=True)
+        if e.filename is None or Path(e.filename) == tmp:  # name the file meant, not the temporary one
+            raise OSError(e.errno, e.strerror or str(e), str(path)) from e
+        raise
     except BaseException:
         tmp.unlink(missing_ok=True)
         raise

@@ -13,6 +13,7 @@ renamed, so an interrupted or failed run leaves either nothing or a complete, pl
 from __future__ import annotations
 
 import contextlib
+import errno
 import math
 import os
 import platform
@@ -313,14 +314,29 @@ class VideoSink:
             self.abort()
             return False
         gen, self._gen = self._gen, None
-        if gen is not None:
-            try:
+        try:
+            if gen is not None:
                 gen.close()  # ffmpeg gets EOF and writes the trailer (a playable file)
-            except BaseException:
-                self.tmp.unlink(missing_ok=True)
-                raise
+            self._check()
+        except BaseException:
+            self.tmp.unlink(missing_ok=True)
+            raise
         os.replace(self.tmp, self.path)
         return True
+
+    def _check(self) -> None:
+        """OSError unless the file ffmpeg wrote holds every frame: imageio-ffmpeg does not report
+        an encoder that died on a write error (a full disk), which leaves a truncated file."""
+        import imageio_ffmpeg
+
+        try:
+            frames, _ = imageio_ffmpeg.count_frames_and_secs(str(self.tmp))
+        except Exception:  # noqa: BLE001 - ffmpeg cannot read it back: it is broken
+            frames = -1
+        if frames != self.count:
+            self.broken = True
+            raise OSError(errno.EIO, "the video encoder could not finish it (is the disk full?); "
+                                     "any previous file is kept", str(self.path))
 
     def abort(self) -> None:
         """Stop the encoder and drop the file, quietly."""
