@@ -269,7 +269,7 @@ def busy(tree):
     return sim
 
 
-@pytest.mark.parametrize("dt", [0.0, -0.01, float("nan"), float("inf"), -float("inf"), "fast", None])
+@pytest.mark.parametrize("dt", [0.0, -0.01, float("nan"), float("inf"), -float("inf"), "fast", None, 1e154, 2e6])
 def test_bad_dt(busy, dt):
     before = snapshot(busy)
     with pytest.raises(ValueError, match="dt"):
@@ -278,7 +278,8 @@ def test_bad_dt(busy, dt):
 
 
 @pytest.mark.parametrize("name, value", [("f", 0.0), ("f", -1.0), ("f", float("nan")), ("f", float("inf")),
-                                         ("zeta", -0.01), ("zeta", float("nan")), ("zeta", float("inf"))])
+                                         ("f", 1e155), ("zeta", -0.01), ("zeta", float("nan")),
+                                         ("zeta", float("inf")), ("zeta", 1e4)])
 def test_bad_modes(busy, name, value):
     before = snapshot(busy)
     arr = getattr(busy.modes, name)
@@ -291,6 +292,28 @@ def test_bad_modes(busy, name, value):
     arr[2, 1] = old
     busy.step(1 / 60)  # fixed: steps again
     assert busy.time > before[0]
+
+
+@pytest.mark.parametrize("load_path", [True, False])
+def test_the_state_stays_finite_at_the_bounds_of_dt_f_and_zeta(tree, load_path):
+    """The longest step, the tiniest one before a normal one, the highest frequency and the
+    strongest damping accepted (Euler included) all leave a finite tree."""
+    from treeanim.physics.simulation import MAX_FREQUENCY, MAX_STEP, MAX_ZETA
+
+    for integrator in ("exact", "euler"):
+        sim = Simulation(tree, wind=Uniform((12.0, 0.0, 3.0)), load_path=load_path, integrator=integrator)
+        for dt in (1 / 60, MAX_STEP, 1e-320, 1 / 60):
+            sim.step(dt)
+        assert np.isfinite(sim.positions).all(), integrator
+        sim.modes.f[:] = MAX_FREQUENCY
+        sim.modes.zeta[:] = MAX_ZETA
+        for _ in range(10):
+            sim.step(1 / 60)
+        assert np.isfinite(sim.positions).all() and np.isfinite(sim.rotations).all(), integrator
+        sim.modes.f[:], sim.modes.zeta[:] = 1.0, 25.0  # Euler once diverged above ζ ≈ 25
+        for _ in range(60):
+            sim.step(1 / 60)
+        assert np.isfinite(sim.positions).all(), integrator
 
 
 def test_bad_modes_shape(busy):

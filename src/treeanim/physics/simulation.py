@@ -24,7 +24,8 @@ from .oscillator import euler_step, exact_coefficients, exact_step
 from .rotation import Workspace, qrot
 from .wind import DEFAULT_BOUNDS
 
-__all__ = ["Simulation", "trace_tips", "INTEGRATORS", "MAX_PULL", "MAX_TRACE_VALUES"]
+__all__ = ["Simulation", "trace_tips", "INTEGRATORS", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA",
+           "MAX_TRACE_VALUES"]
 
 #: Oscillator integrators (see :mod:`treeanim.physics.oscillator`).
 INTEGRATORS = ("exact", "euler")
@@ -40,6 +41,16 @@ NOMINAL_WOOD_MODULUS = 6e9
 #: Largest pull force accepted (N): far beyond any hand on a tree (the bending stays finite
 #: and keeps lengths far above it; the cap keeps absurd inputs out).
 MAX_PULL = 1e9
+#: The longest step (s): any shorter one is stable; far longer ones overflow the oscillators'
+#: coefficients (and no animation steps by years).
+MAX_STEP = 1e6
+#: The highest modal frequency (Hz) and damping ratio accepted: far beyond any plant (and any
+#: step rate), small enough that (2πf)² and 2ζω stay finite.
+MAX_FREQUENCY = 1e4
+MAX_ZETA = 1e3
+#: Velocities and accelerations are differences over a step of at least this (s): over a
+#: shorter one (a step of 1e-320 s) the change in position is rounding noise.
+MIN_RATE_STEP = 1e-6
 
 #: Largest number of floats :func:`trace_tips` records ((steps + 1) × (3·objects + 1)),
 #: about 1 GB of float64.
@@ -371,14 +382,15 @@ class Simulation:
             raise ValueError(f"modes.f must have shape {shape}, got {fa.shape}")
         if za.shape != shape:
             raise ValueError(f"modes.zeta must have shape {shape}, got {za.shape}")
-        badf = ~(np.isfinite(fa) & (fa > 0))
+        badf = ~((fa > 0) & (fa <= MAX_FREQUENCY))
         if badf.any():
             j, c = np.argwhere(badf)[0]
-            raise ValueError(f"modes.f must be finite and > 0: object {j} mode {'uvw'[c]} is {fa[j, c]!r}")
-        badz = ~(np.isfinite(za) & (za >= 0))
+            raise ValueError(f"modes.f must be > 0 and at most {MAX_FREQUENCY:g} Hz: object {j} mode {'uvw'[c]} "
+                             f"is {fa[j, c]!r}")
+        badz = ~((za >= 0) & (za <= MAX_ZETA))
         if badz.any():
             j, c = np.argwhere(badz)[0]
-            raise ValueError(f"modes.zeta must be finite and >= 0: object {j} mode {'uvw'[c]} is {za[j, c]!r}")
+            raise ValueError(f"modes.zeta must be in [0, {MAX_ZETA:g}]: object {j} mode {'uvw'[c]} is {za[j, c]!r}")
         f3, z3 = fa.T.copy(), za.T.copy()
         self._mode_snap = (f, z, fa.copy(), za.copy(), f3, z3)
         self._coef_cache.clear()
@@ -749,20 +761,20 @@ class Simulation:
         Parameters
         ----------
         dt : float
-            Step length in seconds, finite and > 0. Any length is stable: the exact integrator
-            has no step limit; Euler sub-steps (and clamps very long steps, see
-            :mod:`treeanim.physics.oscillator`).
+            Step length in seconds, > 0 and at most :data:`MAX_STEP`. Any such length is
+            stable: the exact integrator has no step limit; Euler sub-steps (and clamps very
+            long steps, see :mod:`treeanim.physics.oscillator`).
 
         Raises
         ------
         ValueError
-            Non-finite or non-positive ``dt``, invalid ``modes`` (f <= 0 or non-finite,
-            ζ < 0 or non-finite, wrong shape), or a wind whose ``sample`` returns the wrong
+            ``dt`` not in (0, MAX_STEP], invalid ``modes`` (f not in (0, MAX_FREQUENCY], ζ not
+            in [0, MAX_ZETA], wrong shape), or a wind whose ``sample`` returns the wrong
             shape or non-finite values. The state is left unchanged.
         """
         dt = finite_float("dt", dt)
-        if not dt > 0:
-            raise ValueError(f"dt must be > 0, got {dt!r}")
+        if not 0 < dt <= MAX_STEP:
+            raise ValueError(f"dt must be > 0 and at most {MAX_STEP:g} s, got {dt!r}")
         f3, z3 = self._modes_arrays()
         U = self._wind_at_samples(self._time)
         if self._load_path:
@@ -874,8 +886,8 @@ class Simulation:
         """Base accelerations for the next step's excitation, low-passed (finite at any dt)."""
         if len(self._att_nodes):
             x = self._P[:, self._att_nodes]
-            vel = (x - self._att_x) / dt
-            h = dt if self._dt_prev is None else 0.5 * (dt + self._dt_prev)
+            vel = (x - self._att_x) / max(dt, MIN_RATE_STEP)
+            h = max(dt if self._dt_prev is None else 0.5 * (dt + self._dt_prev), MIN_RATE_STEP)
             a_raw = (vel - self._att_v) / h
             alpha = -math.expm1(-dt / ACCEL_TAU)
             acc = self._att_a[:, :-1]
@@ -904,7 +916,7 @@ class Simulation:
         self._bplan.bend(None, None, gamma, self._lp.k_blocks, predict=self._predict(dt), blocks=blocks)
         self._sample_prev[...] = self._sample_pos
         self._compose()
-        self._sample_vel = (self._sample_pos - self._sample_prev) / dt
+        self._sample_vel = (self._sample_pos - self._sample_prev) / max(dt, MIN_RATE_STEP)
 
     def _distributed_loads(self, F_own, F_pull, slots, E, dt) -> tuple[np.ndarray, ...]:
         """Stage 4 (load path): the loads along each object, low-passed at its own frequency.
