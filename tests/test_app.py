@@ -475,6 +475,31 @@ def test_time_steps_are_clamped_and_fixed(viewer):
 
 
 # ---------------------------------------------------------------------------- window states
+def test_a_window_wider_than_the_gl_can_draw_is_brought_back(viewer, tmp_path):
+    v = viewer
+    most = v.window.max_pixels
+    assert 1024 <= most <= 32768
+    glfw.set_window_size(v.window.handle, most + 700, 200)  # no window manager under Xvfb to stop it
+    for _ in range(200):
+        glfw.poll_events()
+        if v.window.size[0] <= most and v._fb[0] <= most and v._fb[1] == 200:
+            break
+        glfw.wait_events_timeout(0.005)
+    assert v._fb[0] <= most and v.window.size[0] <= most, (v._fb, v.window.size)
+    assert v.frame(DT)
+    shot = v.screenshot(tmp_path / "wide.png")
+    assert iio_shape(shot)[1] <= most
+    assert v.ctx.error == "GL_NO_ERROR"
+    glfw.set_window_size(v.window.handle, W, H)
+    _settle(v, (W, H))
+
+
+def iio_shape(path):
+    import imageio.v3 as iio
+
+    return iio.imread(path).shape
+
+
 def test_resize_to_odd_sizes_and_minimise(viewer):
     v = viewer
     for w, h in ((333, 211), (1, 1), (97, 401), (W, H)):

@@ -667,8 +667,13 @@ class Viewer:
                 self.gui.mouse_pos(*self._cursor)
 
     def on_resize(self, width: int, height: int) -> None:
-        """The framebuffer is now ``width`` × ``height`` pixels (0 × 0: minimised)."""
-        self._fb = (max(int(width), 0), max(int(height), 0))
+        """The framebuffer is now ``width`` × ``height`` pixels (0 × 0: minimised). Beyond the
+        GL's largest size (no window manager kept it within) the window is shrunk back, and
+        drawn only up to that size meanwhile."""
+        most = self.window.max_pixels
+        if width > most or height > most:
+            self.window.shrink_to(most)
+        self._fb = (min(max(int(width), 0), most), min(max(int(height), 0), most))
         try:
             self._win = tuple(self.window.size)
         except Exception:  # pragma: no cover

@@ -67,6 +67,9 @@ class Window:
         self._windowed: tuple[int, int, int, int] | None = None
         self._callbacks: list = []  # keep the Python callables alive
         self._closed = False
+        scale = self.content_scale
+        most = int(self.max_pixels / scale)  # the window manager keeps the window within the GL's limits
+        glfw.set_window_size_limits(handle, glfw.DONT_CARE, glfw.DONT_CARE, most, most)
 
     # ------------------------------------------------------------------ creation
     @classmethod
@@ -163,6 +166,21 @@ class Window:
     def framebuffer_size(self) -> tuple[int, int]:
         """Framebuffer size in pixels (0 × 0 when minimised)."""
         return tuple(glfw.get_framebuffer_size(self.handle))
+
+    @property
+    def max_pixels(self) -> int:
+        """The largest side, in pixels, the GL can draw and read back (viewport, renderbuffer and
+        texture limits): a larger window is drawn only up to it."""
+        info = self.ctx.info
+        dims = info.get("GL_MAX_VIEWPORT_DIMS", (16384, 16384))
+        return int(min(min(dims), info.get("GL_MAX_RENDERBUFFER_SIZE", 16384), info.get("GL_MAX_TEXTURE_SIZE", 16384)))
+
+    def shrink_to(self, most: int) -> None:
+        """Make the window at most ``most`` pixels a side (where no window manager did)."""
+        w, h = glfw.get_window_size(self.handle)
+        fw, fh = glfw.get_framebuffer_size(self.handle)
+        scale = max(fw / max(w, 1), fh / max(h, 1), 1e-6)
+        glfw.set_window_size(self.handle, min(w, int(most / scale)), min(h, int(most / scale)))
 
     @property
     def content_scale(self) -> float:
