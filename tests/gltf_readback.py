@@ -1,5 +1,6 @@
 """Read a baked glTF back, independently of the exporter: accessors, hierarchy, joint poses."""
 
+import urllib.parse
 from pathlib import Path
 
 import numpy as np
@@ -16,7 +17,7 @@ def load(path):
     if path.suffix == ".glb":
         blob = doc.binary_blob()
     else:
-        blob = (path.parent / doc.buffers[0].uri).read_bytes()
+        blob = (path.parent / urllib.parse.unquote(doc.buffers[0].uri)).read_bytes()
     return doc, blob
 
 

@@ -152,3 +152,19 @@ def test_exported_leaf_colours_turn_with_the_season(tmp_path):
     (r0, g0, _), (r5, g5, _), (r1, g1, _) = means
     assert g0 > 2 * r0, "summer leaves are green"
     assert r5 > g5 and r1 > g1, "autumn and winter leaves are red-brown"
+
+
+def test_a_gltf_and_its_buffer_are_replaced_as_a_pair(tmp_path):
+    """The buffer is named after its content and percent-encoded in the URI; a second export
+    over the first writes a new buffer, points the .gltf at it and removes the old one."""
+    out = tmp_path / "my tree.gltf"
+    names = []
+    for seconds in ("0.2", "0.4"):
+        assert export("beam", "--seconds", seconds, "--fps", "10", "--out", str(out)).returncode == 0
+        doc, blob = load(out)
+        uri = doc.buffers[0].uri
+        assert uri.startswith("my%20tree-") and uri.endswith(".bin") and " " not in uri
+        assert len(blob) == doc.buffers[0].byteLength
+        names.append(sorted(p.name for p in tmp_path.iterdir()))
+    assert names[0] != names[1] and len(names[1]) == 2, names  # the first buffer is gone
+    assert validate(out)["numErrors"] == 0

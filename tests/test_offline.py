@@ -272,6 +272,8 @@ BAD = [
     (["export", "beam", "--pull", "0:0,-2e9,0@0-1", "--out", "x.glb"], "at most 1e+09 N"),
     (["trace", "beam", "--pull", "0,0,2e9", "--out", "t.csv"], "at most 1e+09 N"),
     (["render", "beam", "--samples", "3", "--out", "x.png"], "one of 0, 1, 2, 4, 8, 16"),
+    (["render", "beam", "--seconds", "1e6", "--fps", "0.01", "--out", "x.mp4"], "simulation steps; at most"),
+    (["export", "beam", "--seconds", "4e4", "--fps", "1", "--out", "x.glb"], "at most 2,000,000"),
     (["view", "beam", "--samples", "3"], "one of 0, 1, 2, 4, 8, 16"),
     (["render", "beam", "--out", "a" * 300 + ".png"], "bytes long"),
     (["export", "beam", "--out", "b" * 300 + ".glb"], "bytes long"),
@@ -356,3 +358,28 @@ def test_a_write_that_fails_part_way_keeps_the_old_file_and_says_so(tmp_path, ou
     assert "wrote" not in res.stdout
     assert target.read_bytes() == old
     assert sorted(p.name for p in tmp_path.iterdir()) == [out]
+
+
+def test_sigterm_during_a_render_leaves_no_temporary_file(tmp_path):
+    out = tmp_path / "clip.mp4"
+    proc = subprocess.Popen([sys.executable, "-m", "treeanim", "render", "small_cherry", "--out", str(out),
+                             "--seconds", "20", "--size", "320x240", "--quiet"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.time() + 120
+        while not any(p.name.endswith(".part.mp4") for p in tmp_path.iterdir()) and time.time() < deadline:
+            time.sleep(0.05)
+        time.sleep(0.5)  # a few frames into the video
+        proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    assert proc.returncode == 143, err
+    assert "Traceback" not in err
+    assert not [p.name for p in tmp_path.iterdir() if p.name.startswith(".")], "no hidden .part file is left"
+
+
+def test_a_trace_too_short_for_zero_crossings_says_so(tmp_path, capsys):
+    assert cli.main(["trace", "beam", "--pull", "1,0,0", "--seconds", "0.05", "--out", str(tmp_path / "t.csv")]) == 0
+    out = capsys.readouterr().out
+    assert "too few to tell" in out and "nan" not in out

@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
+import threading
 
 #: The paper's Table 1, per preset: rows of (kind, objects, nodes, triangles, fmin, fmax, ζmin, ζmax).
 TABLE1 = {
@@ -45,6 +47,8 @@ def _season(text: str) -> float:
 LIMIT = 1e6
 #: Most frames (or samples) one command may produce.
 MAX_FRAMES = 1_000_000
+#: Most simulation steps one command may take (hours of work at a few ms a step).
+MAX_STEPS = 2_000_000
 
 
 def _number(kind, lo: float, hi: float, lo_open: bool):
@@ -175,11 +179,17 @@ def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, f
                    "(default: the load path in the physical wind)")
 
 
-def check_frames(seconds: float, fps: float) -> int:
-    """The number of frames ``seconds`` at ``fps`` give; UsageError beyond :data:`MAX_FRAMES`."""
+def check_frames(seconds: float, fps: float, step_rate: float = 60.0) -> int:
+    """The number of frames ``seconds`` at ``fps`` give; UsageError beyond :data:`MAX_FRAMES`,
+    or beyond :data:`MAX_STEPS` simulation steps (one a frame, and at least ``step_rate`` a
+    second: scripted frames step at most 1/60 s at a time)."""
     n = seconds * fps
     if n > MAX_FRAMES:
         raise UsageError(f"--seconds {seconds:g} at --fps {fps:g} is {n:.3g} frames; at most {MAX_FRAMES:,}")
+    steps = seconds * max(fps, step_rate)
+    if steps > MAX_STEPS:
+        raise UsageError(f"--seconds {seconds:g} takes {steps:.3g} simulation steps; at most {MAX_STEPS:,} "
+                         f"(about {MAX_STEPS / 3600 / 60:.0f} hours of simulated time at 60 steps a second)")
     return int(round(n))
 
 
@@ -355,7 +365,7 @@ def cmd_trace(args) -> int:
     tree, sim = make_simulation(scene)
     if not 0 <= args.object < tree.n_objects:
         raise UsageError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
-    check_frames(args.hold + args.seconds, args.rate)
+    check_frames(args.hold + args.seconds, args.rate, step_rate=0.0)  # a trace steps once a sample
     try:
         tr = offline.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
     except offline.InputError as e:
@@ -370,9 +380,11 @@ def cmd_trace(args) -> int:
     fz = offline.zero_crossing_frequency(tr.times, d[:, 2] - d[-len(d) // 4:, 2].mean())
     print(f"wrote {out}: {len(tr.times)} samples of object {args.object} ({tr.kind})'s tip over {args.seconds:g} s "
           f"after release at {args.rate:g} Hz" + (f"; plot {plot}" if plot else ""))
+    crossing = ", ".join(f"{axis} {hz:.3f} Hz" if np.isfinite(hz) else f"{axis} too few to tell"
+                         for axis, hz in (("x", fx), ("z", fz)))
     print(f"held deflection {np.linalg.norm(tr.held - tr.rest) * 100:.1f} cm; modes f u,v,w = "
           f"{f[0]:.3f}, {f[1]:.3f}, {f[2]:.3f} Hz, ζ = {z[0]:.3f}, {z[1]:.3f}, {z[2]:.3f}; "
-          f"zero crossings: x {fx:.3f} Hz, z {fz:.3f} Hz")
+          f"zero crossings: {crossing}")
     return 0
 
 
@@ -577,6 +589,8 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``treeanim`` console script."""
     from treeanim.model.errors import PresetError
 
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _terminated)  # `kill`: unwind, so temporary files are removed
     try:  # building the parser imports the wind's presets: Ctrl-C may come that early
         parser = build_parser()
         args = parser.parse_args(argv)
@@ -600,6 +614,12 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("treeanim: interrupted", file=sys.stderr)
         return 130
+
+
+def _terminated(signum, frame) -> None:
+    """SIGTERM: leave through the normal unwinding (cleanups run), exit status 143."""
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # a second one ends at once
+    raise SystemExit(128 + signal.SIGTERM)
 
 
 def _stdout_to_devnull() -> None:

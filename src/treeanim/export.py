@@ -11,6 +11,9 @@ only, one float32 quaternion key per joint and frame, sharing one time accessor.
 
 from __future__ import annotations
 
+import hashlib
+import json
+import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -292,16 +295,35 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
 
 
 def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
-    """Write ``.glb`` (one file) or ``.gltf`` + ``.bin`` atomically; returns the files written."""
+    """Write ``.glb`` (one file) or ``.gltf`` + ``.bin`` atomically; returns the files written.
+
+    A ``.gltf``'s buffer is named after its content (``tree-1a2b3c4d.bin``), written first, and
+    the ``.bin`` the previous ``.gltf`` used is removed only once the new ``.gltf`` is in place:
+    a run killed at any moment leaves a matching pair (at worst plus an unused ``.bin``).
+    """
     path = Path(path)
     if path.suffix.lower() == ".glb":
         doc.buffers[0].uri = None
         doc.set_binary_blob(data)
-        payloads = [(path, b"".join(doc.save_to_bytes()))]
-    else:
-        bin_path = path.with_suffix(".bin")
-        doc.buffers[0].uri = bin_path.name
-        payloads = [(bin_path, data), (path, doc.to_json(separators=(",", ":")).encode())]
-    for target, payload in payloads:
-        write_bytes(target, payload)
-    return [p for p, _ in payloads]
+        write_bytes(path, b"".join(doc.save_to_bytes()))
+        return [path]
+    bin_path = path.with_name(f"{path.stem}-{hashlib.sha1(data).hexdigest()[:8]}.bin")
+    doc.buffers[0].uri = urllib.parse.quote(bin_path.name)
+    old_bin = _buffer_file(path)
+    write_bytes(bin_path, data)
+    write_bytes(path, doc.to_json(separators=(",", ":")).encode())
+    if old_bin is not None and old_bin != bin_path:
+        old_bin.unlink(missing_ok=True)
+    return [path, bin_path]
+
+
+def _buffer_file(gltf: Path) -> Path | None:
+    """The ``.bin`` file beside ``gltf`` that an existing ``.gltf`` there names, if any."""
+    try:
+        uri = json.loads(gltf.read_text(encoding="utf-8"))["buffers"][0]["uri"]
+    except (OSError, ValueError, KeyError, IndexError, TypeError):
+        return None
+    name = urllib.parse.unquote(str(uri))
+    if "/" in name or "\\" in name or not name.endswith(".bin"):  # only a plain file beside it
+        return None
+    return gltf.with_name(name)
