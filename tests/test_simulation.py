@@ -316,6 +316,31 @@ def test_the_state_stays_finite_at_the_bounds_of_dt_f_and_zeta(tree, load_path):
         assert np.isfinite(sim.positions).all(), integrator
 
 
+@pytest.mark.parametrize("load_path", [True, False])
+def test_lengths_hold_where_forces_and_stiffness_underflow(load_path):
+    """31 levels each 1e-5 as thick as the last (stiffness and loads down to 1e-600 and beyond,
+    far below the smallest double) and an EI_max of 1e-300: every segment keeps its length."""
+    specs, base, d, parent = [], np.zeros(3), 0.1, -1
+    for level in range(31):
+        direction = np.array([np.sin(0.3 * level), 1.0, 0.3 * np.cos(0.7 * level)])
+        pts = base + np.outer(np.linspace(0.0, 0.5, 3), direction / np.linalg.norm(direction))
+        specs.append(ObjectSpec(pts, np.array([d, 0.7 * d, 0.5 * d]), "branch", level + 1, parent, 2 if level else 0))
+        parent, base, d = len(specs) - 1, pts[-1], d * 1e-5
+    tree = assemble(specs, name="deep")
+    start, count = np.asarray(tree.object_start), np.asarray(tree.object_count)
+    seg = np.concatenate([np.arange(a, a + c - 1) for a, c in zip(start, count)])
+    rest = np.linalg.norm(np.diff(tree.rest_positions, axis=0)[seg], axis=1)
+    for ei_max in (None, 1e-300):
+        sim = Simulation(tree, wind=Uniform((15.0, 0.0, 4.0)), load_path=load_path)
+        if ei_max is not None:
+            sim.physics = dataclasses.replace(sim.physics, ei_max=ei_max)
+        for _ in range(30):
+            sim.step(1 / 60)
+        P = sim.positions
+        assert np.isfinite(P).all()
+        assert np.max(np.abs(np.linalg.norm(np.diff(P, axis=0)[seg], axis=1) / rest - 1.0)) < 1e-9
+
+
 def test_bad_modes_shape(busy):
     busy.modes.f = np.ones((3, 3))
     with pytest.raises(ValueError, match="modes.f"):
