@@ -686,6 +686,32 @@ def test_panel_load_shows_a_simulation_error_and_keeps_the_tree(viewer, monkeypa
     assert v.ctx.error == "GL_NO_ERROR"
 
 
+@pytest.mark.parametrize("what", ["fifo", "endless", "nested"])
+def test_panel_load_of_a_file_that_never_ends_or_nests_too_deep_keeps_the_tree(viewer, tmp_path, what):
+    """A FIFO (which would block the window forever), a link to /dev/zero (read without end)
+    and a 1,000-deep array (RecursionError in the TOML parser): one line in the panel, the
+    current tree stays, the window keeps drawing."""
+    import threading
+
+    v = viewer
+    sim = v.sim
+    path = tmp_path / "bad.toml"
+    if what == "fifo":
+        os.mkfifo(path)
+    elif what == "endless":
+        path.symlink_to("/dev/zero")
+    else:
+        path.write_text("x = " + "[" * 1000 + "]" * 1000 + "\n")
+    done = []
+    loader = threading.Thread(target=lambda: done.append(v.panel.load(str(path))), daemon=True)
+    loader.start()
+    loader.join(10.0)
+    assert done == [False], "the load returned (no hang) and refused the file"
+    assert v.messages[-1].startswith("error:") and str(path) in v.messages[-1]
+    assert v.sim is sim and v.tree.name == "small_cherry"
+    assert v.frame(DT) and v.ctx.error == "GL_NO_ERROR"
+
+
 def test_viewer_frees_its_gui_when_the_tree_fails(monkeypatch):
     released = []
     release = Gui.release
