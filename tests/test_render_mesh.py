@@ -122,17 +122,23 @@ def test_rest_geometry():
     pts, normals = mesh.skin(tree.rest_positions, identity(tree))
     node = mesh.node
     # Tube rings lie on the segments' chords at the tapering radius (the end fans' centres, on
-    # the axis, are left out): one ring at every band's ends.
+    # the axis, are left out): one ring at every band's ends, but where a child's base ring is
+    # its collar (tests/test_junctions.py).
     P, r = tree.rest_positions, 0.5 * tree.node_diameter
     t = mesh.vertices["curve"][:, 0]
-    bark = np.flatnonzero(mesh.material == MATERIAL_BARK)
+    obj = mesh.object
+    collar = (tree.parent[obj] >= 0) & (node == tree.object_start[obj]) & (t == 0)
+    bark = np.flatnonzero((mesh.material == MATERIAL_BARK) & ~collar)
     j = node[bark]
     axis = P[np.minimum(j + 1, len(P) - 1)] - P[j]
     centre = P[j] + t[bark, None] * axis
     dist = np.linalg.norm(pts[bark] - centre, axis=1)
     ring = np.linalg.norm(np.cross(pts[bark] - centre, _unit(axis)), axis=1) > 1e-6
-    n = tree.object_count[tree.kind == "branch"]
-    assert ring.sum() == 16 * np.sum((n - 1) * np.ceil(4 / (n - 1)) + 1)
+    branch = tree.kind == "branch"
+    n = tree.object_count[branch]
+    children = np.sum(branch & (tree.parent >= 0))
+    assert ring.sum() == 16 * (np.sum((n - 1) * np.ceil(4 / (n - 1)) + 1) - children)
+    assert np.sum(collar & (mesh.material == MATERIAL_BARK)) == 2 * 16 * children  # rim and sunk apex
     radius = (1 - t[bark]) * r[j] + t[bark] * r[np.minimum(j + 1, len(P) - 1)]
     assert np.allclose(dist[ring], radius[ring], rtol=1e-5)
     inside = ring & (t[bark] > 0)  # rings inside a segment stand square to it
@@ -215,8 +221,8 @@ def test_a_pulled_one_segment_twig_bends_as_a_rod():
     twig = (mesh.object == 1) & (np.linalg.norm(np.cross(mesh.vertices["offset"], [1.0, 0, 0]), axis=1) > 1e-6)
     t = mesh.vertices["curve"][twig, 0]
     rings = np.unique(t)
-    assert len(rings) == 5  # four bands
-    centre = np.array([pts[twig][t == ti].mean(axis=0) for ti in rings])
+    assert len(rings) == 5  # four bands (at t = 0 the collar, welded to the trunk)
+    centre = np.array([P[base]] + [pts[twig][t == ti].mean(axis=0) for ti in rings[1:]])
     drop = centre[:, 1] - P[base, 1]
     assert np.allclose(drop, -L * np.sin(theta) * rings ** 2 * (3 - rings) / 2, atol=0.03 * L * theta)
     assert np.allclose(centre[:, 0] - P[base, 0], L * rings, atol=0.01 * L)
@@ -227,7 +233,9 @@ def test_a_pulled_one_segment_twig_bends_as_a_rod():
         q = pts[twig][t == ti]
         return np.linalg.svd(q - q.mean(axis=0))[2][-1]
 
-    assert abs(ring_axis(0.0) @ [1.0, 0, 0]) == pytest.approx(1, abs=1e-9)  # welded to the trunk's frame
+    collar = pts[twig][t == 0]  # welded to the trunk's frame, which has not turned
+    rest, _ = mesh.skin(tree.rest_positions, identity(tree))
+    assert np.allclose(collar, rest[twig][t == 0], atol=1e-12)
     tip_axis = ring_axis(1.0)
     assert np.degrees(np.arccos(abs(tip_axis @ [1.0, 0, 0]))) == pytest.approx(np.degrees(1.5 * theta), rel=0.02)
 

@@ -10,7 +10,9 @@ the node). Its segment's end frames are T₀ = orthonormalise(mix(R[j], R[prev],
 ``prev`` is the previous node at an inner joint (weight ½), the parent's attach node at a
 branch's base (weight 1; ``prev = −1``, the ground, for a root), else ``prev = j`` — and
 T₁ = orthonormalise(½(R[j] + R[j+1])) at an inner joint or, where the segment ends at the
-object's tip, orthonormalise(1.5·R[j] − ½·T₀) (a cantilever's tip turns 1.5 times its chord).
+object's free tip, orthonormalise(1.5·R[j] − ½·T₀) (a cantilever's tip turns 1.5 times its
+chord; ``in_curve.y`` = 1). A tip that carries branches ends in their base frame R[j+1] = R[j]
+instead (``in_curve.y`` = 0), so a fork's rims stay on it.
 A vertex with t = 0 is placed at ``positions[j] + T₀ @ offset``. One with t > 0 (the rings
 inside a branch's segments, and its tip) follows the cubic Hermite curve between the segment's
 ends with tangents T₀c and T₁c (c = R[j]ᵀ(p[j+1] − p[j]), the segment's rest chord), turned by
@@ -26,8 +28,22 @@ Geometry per object kind (triangle counts equal :meth:`Tree.triangles_per_object
 
 - branch: a ``BRANCH_SIDES`` (16)-sided tapered tube whose segments are split in
   :func:`~treeanim.model.tree.curve_bands` bands each (four along a one-segment twig), a ring
-  of 16 vertices at each band's ends, closed by a 16-triangle fan at each end (the tip fan is
-  a low cone, so tips look rounded; the base fan closes the tube inside its parent).
+  of 16 vertices at each band's ends, closed by a 16-triangle fan at each end: the tip fan is
+  a low cone, so tips look rounded (flat where branches sit on the tip, under their collars);
+  a root's base fan is a flat disc on the ground.
+  A child branch's base is a welded collar (R the parent's radius at the joint, r the
+  child's): its base ring is a *rim* on the parent's surface, with the parent's surface
+  normals (the shading runs on across the joint), and its base fan a cone from the rim down
+  to an *apex* sunk in the parent, out of sight. Along a parent the rim is
+  ρ = clip(½(R + r), 1.15 r, 1.5 r) (at most 0.95 R) from the child's axis, each side as far
+  out along the child as it meets the parent's tube (radius R about the parent's segment
+  behind or ahead of the joint), and the apex on the parent's axis. At a fork (a child on its
+  parent's tip) the rim is the parent's end ring, widened to max(R, 1.15 r) and raised so
+  that the cone from the apex, 2 R below the end, passes through the end ring: the parent's
+  silhouette runs on into each child's; a child turned more than 70° from the parent tilts its
+  rim towards it by the excess (an elbow). The collar is skinned with the child's base frame
+  (t = 0, T₀ = R[attach], the parent's frame at the joint), so it moves with the parent.
+  Collars add no triangles, and 15 vertices a branch (a base fan's apex, one per side).
 - leaf: a ``tree.petiole_sides``-sided petiole tube with a ring at each node (no caps, no
   curve: the lamina is rigid on the petiole's tip node), plus the species' lamina
   triangulation placed on the petiole's tip node: v = direction of the
@@ -66,6 +82,17 @@ from ..model.geometry import arc_length, lamina_frames
 from ..model.geometry import perpendicular as _perpendicular
 from ..model.geometry import unit as _unit
 from ..model.tree import BRANCH_SIDES, Tree, curve_bands
+
+#: A child branch's collar rim is this many times its base radius, at least and at most...
+COLLAR_FLARE = (1.15, 1.5)
+#: ... and, along a parent, at most this fraction of the parent's radius (it fits inside).
+COLLAR_FIT = 0.95
+#: Where a child sits on its parent's tip, its collar's apex lies this many parent radii below
+#: the parent's end (at most half the parent's last segment).
+COLLAR_SINK = 2.0
+#: A child on its parent's tip forks from the parent's end ring, tilted towards the child by as
+#: much as the child turns from the parent's direction beyond this angle (degrees).
+COLLAR_FORK = 70.0
 
 MATERIAL_BARK = 0
 MATERIAL_PETIOLE = 1
@@ -234,13 +261,85 @@ class _Parts:
         self.tri_obj.append(np.broadcast_to(obj, tris.shape[:-1]).reshape(-1))
 
 
+def _outward(q: np.ndarray, axis: np.ndarray) -> np.ndarray:
+    """Unit directions of points ``q`` (C, K, 3) away from the lines through 0 along ``axis`` (C, 3)."""
+    m = axis[:, None, :]
+    return _unit(q - np.sum(q * m, axis=2, keepdims=True) * m, np.broadcast_to(m, q.shape))
+
+
+def _leave(d: np.ndarray, radial: np.ndarray, rho: np.ndarray, axis: np.ndarray, R: np.ndarray) -> np.ndarray:
+    """(C, K): the largest s at which s·d + ρ·radial meets the cylinder of radius R about
+    ``axis`` (C, 1 or K, 3) through 0 (d (C, 3), radial (C, K, 3), ρ and R (C,))."""
+    dm = d[:, None, :]
+    d_off = dm - np.sum(dm * axis, axis=2, keepdims=True) * axis
+    u_off = radial - np.sum(radial * axis, axis=2, keepdims=True) * axis
+    qa = np.sum(d_off * d_off, axis=2)
+    qb = rho[:, None] * np.sum(d_off * u_off, axis=2)
+    qc = (rho * rho)[:, None] * np.sum(u_off * u_off, axis=2) - (R * R)[:, None]
+    return (np.sqrt(np.maximum(qb * qb - qa * qc, 0.0)) - qb) / np.maximum(qa, 1e-12)
+
+
+def _collars(tree: Tree, child: np.ndarray, d: np.ndarray, radial: np.ndarray, room: np.ndarray):
+    """Rest geometry of the collars of child branches ``child`` (module notes).
+
+    Parameters
+    ----------
+    tree : Tree
+    child : (C,) int
+        Branch objects that have a parent.
+    d : (C, 3) float
+        Unit directions in which they leave their parents.
+    radial : (C, K, 3) float
+        Unit directions of the K sides of their tubes, square to ``d``.
+    room : (C,) float
+        Length of each child's first band: the rim stays within the first half of it.
+
+    Returns
+    -------
+    rim, normal : (C, K, 3) float
+        The rim's vertices, from the child's base node, and their normals (the parent's).
+    axis : (C, 3) float
+        The parent's unit direction at the joint.
+    apex : (C, 3) float
+        The apex sunk in the parent, from the child's base node.
+    """
+    P = tree.rest_positions
+    r = 0.5 * tree.node_diameter
+    att, par = tree.attach_node[child], tree.parent[child]
+    a, _, end, nxt, prv = _node_tangents(tree, att, att - tree.object_start[par], par)
+    R, rc = r[att], r[tree.object_start[child]]
+    cos = np.sum(a * d, axis=1)
+    am = a[:, None, :]
+    # Along a parent: each side of the child's tube, widened to ρ, runs out along the child to
+    # where it leaves the parent's tube (radius R about the segment behind or ahead of the
+    # joint, on whichever side of it that is), at most half the first band out.
+    rho = np.minimum(np.clip(0.5 * (R + rc), COLLAR_FLARE[0] * rc, COLLAR_FLARE[1] * rc), COLLAR_FIT * R)
+    s = _leave(d, radial, rho, am, R)
+    ahead = np.sum((s[..., None] * d[:, None, :] + rho[:, None, None] * radial) * am, axis=2) >= 0
+    segment = np.where(ahead[..., None], _unit(P[nxt] - P[att], a)[:, None], _unit(P[att] - P[prv], a)[:, None])
+    s = np.clip(_leave(d, radial, rho, segment, R), 0.0, 0.5 * room[:, None])
+    side = s[..., None] * d[:, None, :] + rho[:, None, None] * radial
+    # At a fork (on the parent's tip): the parent's end ring, widened at least to the flare
+    # and then raised as far as a cone from the apex sunk below the end rises through the end
+    # ring; turned towards a child more than COLLAR_FORK° off the parent's direction, by the excess.
+    sink = np.minimum(COLLAR_SINK * R, 0.5 * np.linalg.norm(P[att] - P[prv], axis=1))
+    top = np.maximum(R, COLLAR_FLARE[0] * rc)
+    tilt = np.maximum(np.arccos(np.clip(cos, -1.0, 1.0)) - np.radians(COLLAR_FORK), 0.0)
+    plane = np.cos(tilt)[:, None] * a + np.sin(tilt)[:, None] * _unit(d - cos[:, None] * a, _perpendicular(a))
+    end_ring = (sink * (top / R - 1.0))[:, None, None] * am + top[:, None, None] * _outward(radial, plane)
+    rim = np.where(end[:, None, None], end_ring, side)
+    apex = np.where(end[:, None], -sink[:, None] * a, 0.0)  # below a parent's end, else on its axis
+    return rim, _outward(rim, a), a, apex
+
+
 def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool, material: int,
            jitter: np.ndarray, key: np.ndarray) -> None:
     """Tapered tubes with ``sides`` sides over the segments of objects ``objs``.
 
     ``curved`` (branches): :func:`curve_bands` bands per segment on the deflection curve, the
-    base turning with the parent (the ground for a root), and a fan closing each end. Else
-    (petioles): a ring at every node, no fans.
+    base turning with the parent (the ground for a root), and a fan at each end: a flat disc
+    under a root, a low cone at the tip, and a child's collar (module notes). Else (petioles):
+    a ring at every node, no fans.
     """
     if len(objs) == 0:
         return
@@ -252,9 +351,15 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     # T₀ of the segment leaving each node (module notes).
     prev = np.where(inner, nodes - 1, nodes)
     weight = np.where(inner, 0.5, 0.0)
+    child = curved & base & (tree.parent[obj] >= 0)
     if curved:
-        prev = np.where(base, np.where(tree.parent[obj] >= 0, tree.attach_node[obj], -1), prev)
+        prev = np.where(base, np.where(child, tree.attach_node[obj], -1), prev)
         weight = np.where(base, 1.0, weight)
+    # An object with a branch on its tip node ends in that branch's base frame.
+    carries = np.zeros(tree.n_objects, bool)
+    sub = objs[tree.parent[objs] >= 0] if curved else objs[:0]
+    par = tree.parent[sub]
+    carries[par[tree.attach_node[sub] == tree.object_start[par] + tree.object_count[par] - 1]] = True
 
     # Rings: bands per segment from each non-tip node, then the object's end ring (t = 1 on
     # the last segment where curved, else the tip node's own ring).
@@ -264,6 +369,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     t = (np.arange(len(src)) - np.repeat(np.cumsum(reps) - reps, reps)) / bands[src]
     last = tip[src]  # each object's end ring
     first = base[src] & (t == 0)
+    ic = np.flatnonzero(first & child[src])  # a child's base ring: its collar's rim
     if curved:
         src = np.where(last, src - 1, src)
         t = np.where(last, 1.0, t)
@@ -288,15 +394,20 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     radial = np.cos(ang)[None, :, None] * a[:, None, :] + np.sin(ang)[None, :, None] * b[:, None, :]
     offset = t[:, None, None] * chord[:, None, :] + radius[:, None, None] * radial
     normal = _unit(radial - slope[:, None, None] * tan[:, None, :])
-
     along = arc_length(tree)[n0] + t * seg_len
-    ends_at_tip = curved & tip[np.minimum(src + 1, len(nodes) - 1)]
+    # A child's base ring is its collar's rim, on the parent's surface with its normals.
+    offset[ic], normal[ic], axis, apex = _collars(tree, ring_obj[ic], tan[ic], radial[ic],
+                                                  seg_len[ic] / bands[src[ic]])
+    along[ic] = np.mean(np.sum(offset[ic] * tan[ic, None], axis=2), axis=1)
+    ring_prev, ring_weight = prev[src], weight[src]
+
+    ends_at_tip = curved & tip[np.minimum(src + 1, len(nodes) - 1)] & ~carries[ring_obj]
     curve = np.stack([t, ends_at_tip.astype(float)], -1)
     uv = np.stack([np.broadcast_to(np.arange(sides) / sides, (len(src), sides)),
                    np.broadcast_to(along[:, None], (len(src), sides))], -1).reshape(-1, 2)
     rep = lambda x: np.repeat(x, sides, axis=0)  # noqa: E731
-    v0 = parts.add(rep(n0), rep(prev[src]), rep(ring_obj), material, offset.reshape(-1, 3),
-                   normal.reshape(-1, 3), rep(weight[src]), rep(jitter[ring_obj]), rep(key[ring_obj]),
+    v0 = parts.add(rep(n0), rep(ring_prev), rep(ring_obj), material, offset.reshape(-1, 3),
+                   normal.reshape(-1, 3), rep(ring_weight), rep(jitter[ring_obj]), rep(key[ring_obj]),
                    uv, rep(curve))
 
     ring = v0 + sides * np.arange(len(src))  # first vertex of each ring
@@ -309,19 +420,28 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     )  # (bands, sides, 2, 3)
     parts.triangles(quads, ring_obj[band, None, None])
 
-    if curved:  # a fan at each end: flat inside the parent, a low cone at the tip
-        ib, it = np.flatnonzero(first), np.flatnonzero(last)
-        ends = np.concatenate([ib, it])
-        apex = np.concatenate([np.zeros((len(ib), 3)), chord[it] + 0.5 * radius[it, None] * tan[it]])
-        c0 = parts.add(n0[ends], prev[src[ends]], ring_obj[ends], material, apex,
-                       np.concatenate([-tan[ib], tan[it]]), weight[src[ends]], jitter[ring_obj[ends]],
-                       key[ring_obj[ends]], np.stack([np.zeros(len(ends)), along[ends]], -1), curve[ends])
-        cb = c0 + np.arange(len(ib))[:, None]
-        ct = c0 + len(ib) + np.arange(len(it))[:, None]
-        parts.triangles(np.stack([np.broadcast_to(cb, (len(ib), sides)), ring[ib, None] + s1,
+    if curved:
+        # Base fans, one apex vertex per side: a flat disc facing the ground under a root; a
+        # collar's cone from its sunk apex, with the parent's surface normals.
+        ib = np.flatnonzero(first)
+        kb = np.searchsorted(ib, ic)  # the collars among the base fans
+        peak = np.zeros((len(ib), 3))
+        peak[kb] = apex
+        face = np.repeat(-tan[ib, None], sides, axis=1)
+        face[kb] = _outward(0.5 * (offset[ic][:, s0] + offset[ic][:, s1]), axis)
+        cb = parts.add(rep(n0[ib]), rep(ring_prev[ib]), rep(ring_obj[ib]), material, rep(peak),
+                       face.reshape(-1, 3), rep(ring_weight[ib]), rep(jitter[ring_obj[ib]]), rep(key[ring_obj[ib]]),
+                       np.stack([np.tile((s0 + 0.5) / sides, len(ib)), rep(along[ib])], -1), rep(curve[ib]))
+        parts.triangles(np.stack([cb + sides * np.arange(len(ib))[:, None] + s0, ring[ib, None] + s1,
                                   ring[ib, None] + s0], -1), ring_obj[ib, None])
-        parts.triangles(np.stack([np.broadcast_to(ct, (len(it), sides)), ring[it, None] + s0,
-                                  ring[it, None] + s1], -1), ring_obj[it, None])
+        # Tip fans: a low cone; flat under the collars of branches on the tip.
+        it = np.flatnonzero(last)
+        rise = np.where(carries[ring_obj[it]], 0.0, 0.5 * radius[it])
+        ct = parts.add(n0[it], ring_prev[it], ring_obj[it], material, chord[it] + rise[:, None] * tan[it],
+                       tan[it], ring_weight[it], jitter[ring_obj[it]], key[ring_obj[it]],
+                       np.stack([np.zeros(len(it)), along[it]], -1), curve[it])
+        parts.triangles(np.stack([np.broadcast_to(ct + np.arange(len(it))[:, None], (len(it), sides)),
+                                  ring[it, None] + s0, ring[it, None] + s1], -1), ring_obj[it, None])
 
 
 def _laminas(parts: _Parts, tree: Tree, leaves: np.ndarray, jitter: np.ndarray, key: np.ndarray) -> None:
