@@ -2,8 +2,11 @@
 
 A preset gives the trunk and, per hierarchy level, how many children each branch carries,
 where along it, at what branching and roll angles, with what length and radius ratios, taper,
-curvature and gravity bend. Leaves sit on the nodes of the outer levels in phyllotactic
-rosettes; grass blades are scattered roots. The same spec and seed give bit-identical arrays.
+curvature and gravity bend. Children on a parent's tip node share its cross-section (da Vinci's
+rule), so the wood tapers through a fork without a step. Leaves spiral along the outer levels'
+branches, so many per metre of twig, with a share in tufts at the free tips; grass blades are
+scattered roots in a patch that may fade out at its edge. The same spec and seed give
+bit-identical arrays.
 """
 
 from __future__ import annotations
@@ -29,7 +32,9 @@ class LevelSpec:
     length: float = 1.0  # metres for the trunk, ratio to the parent's length otherwise
     length_var: float = 0.1
     cone: float = 0.0  # 0..1: children low on the parent are longer (a conical crown)
-    diameter: float = 0.6  # metres for the trunk, ratio to the parent's diameter at the joint
+    # Metres for the trunk; for a child along its parent, the ratio to the parent's diameter at
+    # the joint. Children on the parent's tip node ignore it: they share the tip's cross-section.
+    diameter: float = 0.6
     taper: float = 0.3  # tip diameter = base diameter * (1 - taper)
     count: float = 0.0  # children per branch of the level above (mean; the total is exact)
     attach: tuple[float, float] = (1.0, 1.0)  # where along the parent children sit (fraction)
@@ -45,11 +50,19 @@ class LevelSpec:
 
 @dataclass(frozen=True)
 class LeafSpec:
-    """Leaves: petiole beams with a lamina, in rosettes on outer nodes."""
+    """Leaves: petiole beams with a lamina, spiralling along the branches of ``levels``.
+
+    Each node of those branches within ``attach`` (fraction of the branch's length) bears the
+    leaves of the segment below it, so leaves are spread evenly per metre of twig; a further
+    ``tip_share`` of all leaves sits in tufts at the free tips (tips no branch grows on from).
+    """
 
     count: int = 0
     winter_count: int = 0
     levels: tuple[int, ...] = ()
+    attach: tuple[float, float] = (0.0, 1.0)  # where along a branch leaves sit (fraction)
+    tip_share: float = 0.0  # share of the leaves in tufts at free tips
+    tip_angle: float = 30.0  # down angle of a tip tuft's most upright leaves, degrees
     petiole_length: float = 0.03
     petiole_diameter: float = 0.002
     petiole_segments: int = 3
@@ -57,6 +70,8 @@ class LeafSpec:
     lamina_length: float = 0.08
     size_var: float = 0.15
     down_angle: float = 55.0
+    down_var: float = 10.0
+    roll_var: float = 15.0  # scatter about the spiral's golden angle, degrees
     droop: float = 30.0
 
 
@@ -74,10 +89,19 @@ class LaminaSpec:
 
 @dataclass(frozen=True)
 class GrassSpec:
-    """A patch of grass blades, each a root object of ``segments`` segments."""
+    """A patch of grass blades, each a root object of ``segments`` segments.
+
+    The patch is a rectangle or an ellipse (``shape``) ``size`` metres across. Over the outer
+    ``edge`` of its radius the blades thin out to none and shorten to ``edge_height`` of their
+    height; ``wobble`` makes a round patch's outline irregular (relative radius change).
+    """
 
     count: int = 0
+    shape: str = "rect"  # rect | round
     size: tuple[float, float] = (10.0, 10.0)
+    edge: float = 0.0
+    edge_height: float = 1.0
+    wobble: float = 0.0
     height: tuple[float, float] = (0.3, 0.6)
     width: float = 0.012
     segments: int = 3
@@ -95,6 +119,24 @@ class BeamSpec:
 
 
 @dataclass(frozen=True)
+class CrownSpec:
+    """An ellipsoidal envelope the branches are pruned to (Weber & Penn's pruning).
+
+    The ellipsoid spans heights ``height`` (metres) and has the horizontal ``radius``; it is
+    centred over the trunk's top. A branch (level 2 and up) whose tip would leave it is
+    shortened until the tip lies on it, to no less than ``min_scale`` of its length; its
+    children still grow in proportion to its unpruned length, so pruning does not compound
+    from level to level. A radius of 0 leaves the branches as grown. Presets keep ``min_scale``
+    at 0.3 or more: stubs a few centimetres long, as thick as their parent's tip, make the load
+    path's oscillators diverge.
+    """
+
+    height: tuple[float, float] = (0.0, 0.0)
+    radius: float = 0.0
+    min_scale: float = 0.5
+
+
+@dataclass(frozen=True)
 class TreeSpec:
     """Everything a preset says about the shape of a tree."""
 
@@ -102,6 +144,7 @@ class TreeSpec:
     type: str = "tree"  # tree | grass | beam
     seed: int = 0
     levels: tuple[LevelSpec, ...] = ()
+    crown: CrownSpec = field(default_factory=CrownSpec)
     leaves: LeafSpec = field(default_factory=LeafSpec)
     lamina: LaminaSpec | None = None
     grass: GrassSpec = field(default_factory=GrassSpec)
@@ -155,6 +198,22 @@ def _exact_split(total: int, weights: np.ndarray, rng: np.random.Generator) -> n
 
 
 # ---------------------------------------------------------------------------- trees
+def _prune(pts: np.ndarray, centre: np.ndarray, radii: np.ndarray, min_scale: float) -> np.ndarray:
+    """Scale branches (K, n, 3) about their bases so each tip stays inside the ellipsoid.
+
+    A branch's points grow linearly with its length, so the tip at scale s is base + s·(tip −
+    base); in units of the radii, |p + s·u|² = 1 is a quadratic in s whose positive root is
+    where the tip meets the envelope.
+    """
+    base = pts[:, :1]
+    p = (base[:, 0] - centre) / radii
+    u = (pts[:, -1] - base[:, 0]) / radii
+    a, b, c = np.sum(u * u, axis=1), np.sum(p * u, axis=1), np.sum(p * p, axis=1) - 1
+    root = (-b + np.sqrt(np.maximum(b * b - a * c, 0.0))) / np.maximum(a, 1e-30)
+    scale = np.clip(np.where(c < 0, root, 0.0), min_scale, 1.0)
+    return base + scale[:, None, None] * (pts - base)
+
+
 def _branches(spec: TreeSpec, rng: np.random.Generator) -> list[ObjectSpec]:
     trunk = spec.levels[0]
     lean = np.radians(trunk.lean)
@@ -168,6 +227,11 @@ def _branches(spec: TreeSpec, rng: np.random.Generator) -> list[ObjectSpec]:
     diam = trunk.diameter * (1 - trunk.taper * np.linspace(0, 1, trunk.segments + 1))
     specs = [ObjectSpec(pts, diam, "branch", 1)]
     lengths = [trunk.length]
+    crown = spec.crown
+    if crown.radius > 0:
+        lo, hi = crown.height
+        centre = np.array([pts[-1, 0], 0.5 * (lo + hi), pts[-1, 2]])
+        radii = np.array([crown.radius, 0.5 * (hi - lo), crown.radius])
     current = [0]
     for lv, child in enumerate(spec.levels[1:], start=2):
         if not current:
@@ -202,35 +266,65 @@ def _branches(spec: TreeSpec, rng: np.random.Generator) -> list[ObjectSpec]:
                 parent.points[at], d, length, child.segments,
                 np.full(n_children, child.curvature), np.full(n_children, child.gravity), bend_axis,
             )
-            d_base = parent.diameters[at] * child.diameter
+            grown = length  # children scale with the length a branch grew to, before pruning
+            if crown.radius > 0:
+                pts = _prune(pts, centre, radii, crown.min_scale)
+                length = np.sum(np.linalg.norm(np.diff(pts, axis=1), axis=2), axis=1)
+            d_base = parent.diameters[at] * min(child.diameter, 1.0)
+            on_tip = at == n_seg
+            if on_tip.any():
+                # da Vinci's rule (the pipe model): the children on the tip share its cross-section
+                # in proportion to their length, so their areas add up to the parent's.
+                d_base[on_tip] = parent.diameters[-1] * np.sqrt(length[on_tip] / length[on_tip].sum())
             shape = 1 - child.taper * np.linspace(0, 1, child.segments + 1)
             for k in range(n_children):
                 specs.append(ObjectSpec(pts[k], d_base[k] * shape, "branch", lv, parent=p, attach=int(at[k])))
-                lengths.append(float(length[k]))
+                lengths.append(float(grown[k]))
                 nxt.append(len(specs) - 1)
         current = nxt
     return specs
+
+
+def _leaf_slots(lf: LeafSpec, branches: list[ObjectSpec]) -> tuple[np.ndarray, ...]:
+    """The nodes that bear leaves: (branch, node, length of the segment below, free tip?)."""
+    grown_on = {(s.parent, s.attach) for s in branches if s.parent >= 0}
+    rows = []
+    for b, s in enumerate(branches):
+        if s.level not in lf.levels:
+            continue
+        seg = np.linalg.norm(np.diff(s.points, axis=0), axis=1)
+        frac = np.cumsum(seg) / seg.sum()  # of nodes 1..n along the branch
+        for j in np.flatnonzero((frac >= lf.attach[0] - 1e-9) & (frac <= lf.attach[1] + 1e-9)) + 1:
+            rows.append((b, j, seg[j - 1], j == len(seg) and (b, j) not in grown_on))
+    if not rows:
+        raise ValueError(f"key 'leaves.levels': {list(lf.levels)} names no level that has branches "
+                         f"with nodes in leaves.attach {list(lf.attach)}")
+    b, j, served, free = (np.array(c) for c in zip(*rows))
+    return b.astype(np.int64), j.astype(np.int64), served.astype(float), free.astype(bool)
 
 
 def _leaves(spec: TreeSpec, branches: list[ObjectSpec], rng: np.random.Generator) -> list[ObjectSpec]:
     lf = spec.leaves
     if lf.count <= 0:
         return []
-    # Eligible nodes: every non-base node of a branch on the leaf levels.
-    slots = [(b, j) for b, s in enumerate(branches) if s.level in lf.levels for j in range(1, len(s.points))]
-    if not slots:
-        raise ValueError(f"key 'leaves.levels': {list(lf.levels)} names no level that has branches")
-    per_slot = _exact_split(lf.count, np.ones(len(slots)), rng)
-    owner = np.repeat(np.arange(len(slots)), per_slot)
-    rank_in_slot = np.concatenate([np.arange(c) for c in per_slot])
-    b_idx = np.array([slots[o][0] for o in owner])
-    j_idx = np.array([slots[o][1] for o in owner])
+    slot_b, slot_j, served, free = _leaf_slots(lf, branches)
+    # So many leaves per metre of twig, plus the tufts at the free tips.
+    n_tuft = int(round(lf.tip_share * lf.count)) if free.any() else 0
+    per_slot = _exact_split(lf.count - n_tuft, served, rng) + _exact_split(n_tuft, free.astype(float), rng)
+    owner = np.repeat(np.arange(len(slot_b)), per_slot)
+    b_idx, j_idx = slot_b[owner], slot_j[owner]
     n = len(owner)
+    # Spiral phyllotaxis along each branch: the golden angle from one leaf to the next.
+    first = np.searchsorted(b_idx, b_idx)  # slots (and so leaves) are ordered by branch, then node
+    rank = np.arange(n) - first
+    phase = rng.uniform(0, 360, len(branches))[b_idx]
+    roll = np.radians(phase + GOLDEN_ANGLE * rank + rng.normal(0, lf.roll_var, n))
     base = np.array([branches[b].points[j] for b, j in zip(b_idx, j_idx)])
     axis_dir = _unit(np.array([branches[b].points[j] - branches[b].points[j - 1] for b, j in zip(b_idx, j_idx)]))
-    roll = np.radians(rng.uniform(0, 360, len(slots))[owner] + GOLDEN_ANGLE * rank_in_slot + rng.normal(0, 15, n))
     side = rotate(perpendicular(axis_dir), axis_dir, roll)
-    down = np.radians(lf.down_angle + rng.normal(0, 10, n))
+    # Leaves along a twig stand out at down_angle; a tip's tuft opens from tip_angle to it.
+    down = np.where(free[owner], rng.uniform(lf.tip_angle, lf.down_angle, n), lf.down_angle)
+    down = np.radians(down + rng.normal(0, lf.down_var, n))
     d = rotate(axis_dir, _unit(np.cross(axis_dir, side)), down)
     scale = np.clip(1 + rng.normal(0, lf.size_var, n), 0.6, 1.4)
     bend_axis = _unit(np.cross(d, side) + 1e-9 * perpendicular(d))
@@ -255,18 +349,57 @@ def _leaves(spec: TreeSpec, branches: list[ObjectSpec], rng: np.random.Generator
     ]
 
 
+def _fade(rho: np.ndarray, edge: float) -> np.ndarray:
+    """1 inside the patch, easing (smoothstep) to 0 over the outer ``edge`` of its radius."""
+    if edge <= 0:
+        return np.ones_like(rho)
+    t = np.clip((1 - rho) / edge, 0.0, 1.0)
+    return t * t * (3 - 2 * t)
+
+
+def _sample(pdf: np.ndarray, grid: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Inverse-CDF samples of a density tabulated on ``grid``, at uniform numbers ``u``."""
+    cdf = np.concatenate([[0.0], np.cumsum(0.5 * (pdf[1:] + pdf[:-1]) * np.diff(grid))])
+    return np.interp(u, cdf / cdf[-1], grid)
+
+
+def _patch(g: GrassSpec, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Blade roots (n, 2) in the ground plane and each one's relative radius in the patch.
+
+    The relative radius rho (0 at the centre, 1 at the outline) is drawn with density
+    rho * fade(rho), which is uniform per square metre inside the patch and thins out over its
+    edge; a rectangle measures rho as the larger of |x| and |z| (relative), an ellipse as the
+    distance, its outline pushed in and out by a seeded ``wobble``.
+    """
+    grid = np.linspace(0.0, 1.0, 1025)
+    rho = _sample(grid * _fade(grid, g.edge), grid, rng.random(n))
+    half = np.array(g.size) / 2
+    if g.shape == "round":
+        k = np.arange(2, 6)
+        amp, phase = rng.uniform(0.3, 1.0, len(k)) / k, rng.uniform(0, 2 * np.pi, len(k))
+        ring = np.linspace(0.0, 2 * np.pi, 1025)
+        wave = np.cos(np.multiply.outer(ring, k) + phase) @ amp
+        outline = 1 - g.wobble * (wave.max() - wave) / np.ptp(wave)  # relative radius, in [1 - wobble, 1]
+        theta = _sample(outline**2, ring, rng.random(n))  # the area per angle grows as r²
+        xz = (rho * np.interp(theta, ring, outline))[:, None] * np.column_stack([np.cos(theta), np.sin(theta)])
+    else:  # a point on the rectangle's outline scaled by rho: uniform along it
+        t, side = rng.uniform(-1.0, 1.0, n), rng.integers(0, 4, n)
+        sign = np.where(side % 2 == 0, 1.0, -1.0)
+        xz = rho[:, None] * np.where((side < 2)[:, None], np.column_stack([sign, t]), np.column_stack([t, sign]))
+    return xz * half, rho
+
+
 def _grass(spec: TreeSpec, rng: np.random.Generator) -> list[ObjectSpec]:
     g = spec.grass
     n = g.count
-    base = np.column_stack([
-        rng.uniform(-g.size[0] / 2, g.size[0] / 2, n), np.zeros(n), rng.uniform(-g.size[1] / 2, g.size[1] / 2, n),
-    ])
+    xz, rho = _patch(g, n, rng)
+    base = np.column_stack([xz[:, 0], np.zeros(n), xz[:, 1]])
     lean = np.radians(rng.uniform(0, 15, n))
     az = rng.uniform(0, 2 * np.pi, n)
     d = np.column_stack([np.sin(lean) * np.cos(az), np.cos(lean), np.sin(lean) * np.sin(az)])
     face = np.column_stack([np.cos(az + 0.5 * np.pi), np.zeros(n), np.sin(az + 0.5 * np.pi)])
     bend_axis = _unit(np.cross(d, np.column_stack([np.cos(az), np.zeros(n), np.sin(az)])) + 1e-9 * face)
-    height = rng.uniform(*g.height, n)
+    height = rng.uniform(*g.height, n) * (g.edge_height + (1 - g.edge_height) * _fade(rho, g.edge))
     pts = bent_polyline(base, d, height, g.segments, rng.uniform(0.3, 1.0, n) * g.bend, np.zeros(n), bend_axis)
     width = g.width * np.linspace(1.0, 0.45, g.segments + 1)
     normal = _unit(np.cross(pts[:, 1] - pts[:, 0], face))

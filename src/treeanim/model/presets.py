@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .errors import PresetError
-from .generate import BeamSpec, GrassSpec, LaminaSpec, LeafSpec, LevelSpec, TreeSpec, generate
+from .generate import BeamSpec, CrownSpec, GrassSpec, LaminaSpec, LeafSpec, LevelSpec, TreeSpec, generate
 from .params import SCALAR_KEYS, ModeRange, PhysicsParams, SeasonModes
 from .tree import Tree
 
@@ -57,6 +57,13 @@ BOUNDS: dict[str, tuple[float, float]] = {
     "height": (1e-3, 100.0),
     "width": (1e-5, 1.0),
     "bend": (-180.0, 180.0),
+    "edge": (0.0, 1.0),
+    "edge_height": (0.0, 1.0),
+    "wobble": (0.0, 0.5),
+    "tip_share": (0.0, 1.0),
+    "radius": (0.0, 100.0),
+    "min_scale": (0.3, 1.0),
+    "tip_angle": (0.0, 180.0),
     "seed": (0, 2**63 - 1),
     "f": (1e-3, 100.0),
     "zeta": (0.0, 10.0),
@@ -272,7 +279,8 @@ def _physics(data) -> PhysicsParams:
 
 
 def _tree_spec(data: dict, source: str) -> TreeSpec:
-    top = ("name", "description", "type", "seed", "trunk", "levels", "leaves", "lamina", "grass", "beam", "physics")
+    top = ("name", "description", "type", "seed", "trunk", "levels", "crown", "leaves", "lamina", "grass", "beam",
+           "physics")
     for k in data:
         if k not in top:
             raise _KeyProblem(k, f"unknown key; expected one of {', '.join(top)}")
@@ -295,8 +303,10 @@ def _tree_spec(data: dict, source: str) -> TreeSpec:
         if not isinstance(raw_levels, list):
             raise _KeyProblem("levels", f"expected an array of tables [[levels]], got {_describe(raw_levels)}")
         for i, lv in enumerate(raw_levels):
-            levels.append(_dataclass_from(LevelSpec, lv, f"levels[{i}].", required=("count", "length", "diameter")))
+            levels.append(_dataclass_from(LevelSpec, lv, f"levels[{i}].", required=("count", "length")))
         kw["levels"] = tuple(levels)
+        if "crown" in data:
+            kw["crown"] = _dataclass_from(CrownSpec, data["crown"], "crown.", required=("height", "radius"))
         if "leaves" in data:
             kw["leaves"] = _dataclass_from(LeafSpec, data["leaves"], "leaves.", required=("count", "levels"))
             if kw["leaves"].count > 0:
@@ -315,6 +325,11 @@ def _tree_spec(data: dict, source: str) -> TreeSpec:
 def _check_leaves(spec: TreeSpec) -> None:
     if spec.type == "grass" and spec.grass.count < 1:
         raise _KeyProblem("grass.count", f"expected at least 1 blade, got {spec.grass.count}")
+    if spec.grass.shape not in ("rect", "round"):
+        raise _KeyProblem("grass.shape", f"expected 'rect' or 'round', got {spec.grass.shape!r}")
+    crown = spec.crown
+    if crown.radius > 0 and not crown.height[0] < crown.height[1]:
+        raise _KeyProblem("crown.height", f"expected [bottom, top] with bottom < top, got {list(crown.height)}")
     lf = spec.leaves
     if lf.winter_count > lf.count:
         raise _KeyProblem("leaves.winter_count", f"expected at most leaves.count ({lf.count}), got {lf.winter_count}")
