@@ -1,7 +1,9 @@
 """Record the paper model's poses (``load_path=False``) as the reference of test_paper_model.py.
 
 Run once, with the release whose behaviour the paper model must keep (commit 4ed910f, before the
-load path): ``python tests/data/make_paper_reference.py``. Each scenario is stepped and every
+load path): ``python tests/data/make_paper_reference.py``. When the presets change (issue #13
+reshaped the trees), record again with 4ed910f's ``physics`` package and today's presets and
+model. Each scenario is stepped and every
 fifth node's position (and, for the small cherry, rotation) is stored after the last step.
 """
 
