@@ -144,8 +144,9 @@ def test_wind_carries_falling_leaves_downwind():
     calm = drop_leaves(0.0, 8.0)[2]
     windy = drop_leaves(8.0, 8.0)[2]
     drift = lambda P: np.median(P[-1][:, 0] - P[0][:, 0])  # noqa: E731
+    fall = np.median(windy[0][:, 1])  # how far they fall: the wind carries them a good part of it
     assert abs(drift(calm)) < 0.2
-    assert drift(windy) > 1.0
+    assert drift(windy) > 0.35 * fall > 0.2, (drift(windy), fall)
 
 
 def test_leaves_back_on_the_tree_leave_the_ground_and_the_paper_drops_them_unseen():
