@@ -35,7 +35,12 @@ CASES = [
      "lamina.outline", "x >= 0"),
     ("leaf level missing", lambda s: s.replace("levels = [4, 5, 6]", "levels = [9]"), "leaves.levels", "between"),
     ("physics scalar", lambda s: s.replace("[physics.summer]", "[physics]\nei_max = -3\n[physics.summer]"),
-     "physics.ei_max", "positive"),
+     "physics.ei_max", "(0, 1e+12]"),
+    # accepted once, and the simulation went NaN (issue #14, item 5)
+    ("huge damping scale", lambda s: s.replace("[physics.summer]", "[physics]\nleaf_zeta_w_scale = 1e300\n[physics.summer]"),
+     "physics.leaf_zeta_w_scale", "(0, 100]"),
+    ("huge wind gain", lambda s: s.replace("[physics.summer]", "[physics]\nwind_gain_leaf = 1e308\n[physics.summer]"),
+     "physics.wind_gain_leaf", "(0, 1000]"),
 ]
 
 

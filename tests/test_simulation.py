@@ -341,6 +341,15 @@ def test_lengths_hold_where_forces_and_stiffness_underflow(load_path):
         assert np.max(np.abs(np.linalg.norm(np.diff(P, axis=0)[seg], axis=1) / rest - 1.0)) < 1e-9
 
 
+@pytest.mark.parametrize("name, value", [("leaf_zeta_w_scale", 1e300), ("wind_gain_leaf", 1e308), ("ei_max", 1e13),
+                                         ("drag_leaf", float("inf"))])
+def test_physics_beyond_its_bounds_is_refused_and_the_state_kept(busy, name, value):
+    before = snapshot(busy)
+    with pytest.raises(ValueError, match=f"physics.{name}"):
+        busy.physics = dataclasses.replace(busy.physics, **{name: value})
+    assert_same(before, snapshot(busy))
+
+
 def test_bad_modes_shape(busy):
     busy.modes.f = np.ones((3, 3))
     with pytest.raises(ValueError, match="modes.f"):

@@ -143,3 +143,14 @@ class PhysicsParams:
 SCALAR_KEYS = tuple(
     k for k in PhysicsParams.__dataclass_fields__ if k not in ("summer", "winter")
 )
+#: The largest value of each scalar: far beyond any plant or air, small enough that every state
+#: of the simulation stays finite (a gain of 1e308 or a damping scale of 1e300 overflowed it).
+SCALAR_MAX = {
+    "ei_max": 1e12, "stiffness_exponent": 8.0, "twist_c0": 100.0, "leaf_zeta_w_scale": 100.0,
+    "leaf_zeta_v_scale": 100.0, "wind_gain_branch": 1e3, "wind_gain_leaf": 1e3, "wind_gain_blade": 1e3,
+    "wood_density": 1e4, "leaf_density": 1e4, "lamina_thickness": 0.05, "leaf_twist_c0": 100.0,
+    "leaf_youngs_modulus": 1e12, "blade_youngs_modulus": 1e12, "air_density": 10.0, "drag_branch": 10.0,
+    "drag_leaf": 10.0, "drag_blade": 10.0, "reconfiguration": 2.0, "reconfiguration_speed": 100.0,
+    "leaf_flutter": 1.5,
+}
+assert set(SCALAR_MAX) == set(SCALAR_KEYS)

@@ -18,7 +18,7 @@ import numpy as np
 
 from .errors import PresetError
 from .generate import BeamSpec, CrownSpec, GrassSpec, LaminaSpec, LeafSpec, LevelSpec, TreeSpec, generate
-from .params import SCALAR_KEYS, ModeRange, PhysicsParams, SeasonModes
+from .params import SCALAR_KEYS, SCALAR_MAX, ModeRange, PhysicsParams, SeasonModes
 from .tree import Tree
 
 #: Allowed ranges of numeric keys (inclusive); keys not listed must be finite and >= 0.
@@ -271,8 +271,8 @@ def _physics(data) -> PhysicsParams:
     for k in SCALAR_KEYS:
         if k in data:
             v = data[k]
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v <= 0:
-                raise _KeyProblem(f"physics.{k}", f"expected a finite positive number, got {_describe(v)}")
+            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v <= SCALAR_MAX[k]:
+                raise _KeyProblem(f"physics.{k}", f"expected a number in (0, {SCALAR_MAX[k]:g}], got {_describe(v)}")
             scalars[k] = float(v)
     return PhysicsParams(summer=_modes(data["summer"], "physics.summer."),
                          winter=_modes(data["winter"], "physics.winter."), **scalars)

@@ -10,7 +10,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from ..model.geometry import arc_length, lamina_frames, object_lengths, polygon_centroid, segment_lengths
-from ..model.params import PhysicsParams
+from ..model.params import SCALAR_KEYS, SCALAR_MAX, PhysicsParams
 from ..model.tree import KINDS, Tree
 from .aero import Drag
 from .bending import BendingPlan, matrix_to_quat, rest_frames, saturating_twist
@@ -63,16 +63,11 @@ def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
         raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
     positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness",
                 "leaf_youngs_modulus", "blade_youngs_modulus", "air_density", "reconfiguration_speed")
-    for name in positive:
+    for name in SCALAR_KEYS:
         x = finite_float(f"physics.{name}", getattr(p, name))
-        if x <= 0:
-            raise ValueError(f"physics.{name} must be > 0, got {x!r}")
-    for name in ("stiffness_exponent", "twist_c0", "leaf_twist_c0", "leaf_zeta_w_scale",
-                 "leaf_zeta_v_scale", "wind_gain_branch", "wind_gain_leaf", "wind_gain_blade",
-                 "drag_branch", "drag_leaf", "drag_blade", "reconfiguration", "leaf_flutter"):
-        x = finite_float(f"physics.{name}", getattr(p, name))
-        if x < 0:
-            raise ValueError(f"physics.{name} must be >= 0, got {x!r}")
+        if not (x > 0 if name in positive else x >= 0) or x > SCALAR_MAX[name]:
+            raise ValueError(f"physics.{name} must be {'>' if name in positive else '>='} 0 and at most "
+                             f"{SCALAR_MAX[name]:g}, got {x!r}")
     for season in ("summer", "winter"):
         sm = getattr(p, season)
         for kind in kinds:
