@@ -36,6 +36,8 @@ CASES = [
     ("leaf level missing", lambda s: s.replace("levels = [4, 5, 6]", "levels = [9]"), "leaves.levels", "between"),
     ("physics scalar", lambda s: s.replace("[physics.summer]", "[physics]\nei_max = -3\n[physics.summer]"),
      "physics.ei_max", "(0, 1e+12]"),
+    ("bark colour", lambda s: s.replace("color = [0.38, 0.25, 0.22]", "color = [0.38, 0.25]"), "bark.color", "[r, g, b]"),
+    ("bark furrows", lambda s: s.replace("furrows = 8.0", "furrows = 0.0"), "bark.furrows", "[1, 64]"),
     # accepted once, and the simulation went NaN (issue #14, item 5)
     ("huge damping scale", lambda s: s.replace("[physics.summer]", "[physics]\nleaf_zeta_w_scale = 1e300\n[physics.summer]"),
      "physics.leaf_zeta_w_scale", "(0, 100]"),

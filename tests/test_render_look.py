@@ -173,3 +173,22 @@ def test_a_thin_twig_stays_continuous_from_frame_to_frame(offscreen):
     assert np.percentile(np.abs(ratio - 1.0), 90) < 0.3, ratio
     # Without the minimum width it falls apart into dots
     assert np.mean(true_width > 3.0) < 0.8, np.mean(true_width > 3.0)
+
+
+def test_the_bark_takes_its_species_colour(offscreen):
+    """The same trunk with a grey and a red-brown [bark] colour: its pixels follow it."""
+    from treeanim.model.build import ObjectSpec, assemble
+    from treeanim.model.look import Bark
+
+    pts = np.outer(np.linspace(0.0, 2.0, 3), (0.0, 1.0, 0.0))
+    cam = OrbitCamera(target=(0.0, 1.0, 0.0), distance=2.5, elevation=0.0)
+    means = []
+    for color in ((0.5, 0.5, 0.5), (0.5, 0.25, 0.15)):
+        tree = assemble([ObjectSpec(pts, np.array([0.3, 0.28, 0.26]), "branch", 1)], name="trunk",
+                        bark=Bark(color=color, lenticels=0.5))
+        img = render(offscreen, tree, cam, shadow=False).astype(float)
+        trunk = img[H // 4: 3 * H // 4, W // 2 - 8: W // 2 + 8].reshape(-1, 3)
+        means.append(trunk.mean(axis=0))
+    grey, brown = means
+    assert abs(grey[0] - grey[2]) < 12  # grey stays grey under the lights
+    assert brown[0] - brown[2] > 40 and brown[0] - brown[2] > grey[0] - grey[2] + 30

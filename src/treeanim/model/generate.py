@@ -17,6 +17,7 @@ import numpy as np
 
 from .build import ObjectSpec, assemble, perpendicular
 from .lamina import make_lamina
+from .look import Bark
 from .params import PhysicsParams
 from .tree import Tree
 
@@ -151,6 +152,7 @@ class TreeSpec:
     beam: BeamSpec = field(default_factory=BeamSpec)
     physics: PhysicsParams = field(default_factory=PhysicsParams)
     source: str = ""
+    bark: Bark = field(default_factory=Bark)
 
 
 # ---------------------------------------------------------------------------- geometry helpers
@@ -438,4 +440,5 @@ def generate(spec: TreeSpec) -> Tree:
         physics=spec.physics,
         seed=spec.seed,
         source=spec.source,
+        bark=spec.bark,
     )

@@ -18,6 +18,7 @@ import numpy as np
 
 from .errors import PresetError
 from .generate import BeamSpec, CrownSpec, GrassSpec, LaminaSpec, LeafSpec, LevelSpec, TreeSpec, generate
+from .look import Bark
 from .params import SCALAR_KEYS, SCALAR_MAX, ModeRange, PhysicsParams, SeasonModes
 from .tree import Tree
 
@@ -63,6 +64,11 @@ BOUNDS: dict[str, tuple[float, float]] = {
     "tip_share": (0.0, 1.0),
     "radius": (0.0, 100.0),
     "min_scale": (0.3, 1.0),
+    "color": (0.0, 1.0),
+    "furrows": (1.0, 64.0),
+    "depth": (0.0, 1.0),
+    "interlace": (0.0, 1.0),
+    "lenticels": (0.0, 1.0),
     "tip_angle": (0.0, 180.0),
     "seed": (0, 2**63 - 1),
     "f": (1e-3, 100.0),
@@ -207,6 +213,10 @@ def _coerce(value, default, key: str):
             ):
                 raise _KeyProblem(key, f"expected a list of at least 3 [x, y] points, got {_describe(value)}")
             return tuple(tuple(_number(c, key, False) for c in p) for p in value)
+        if name == "color":
+            if not isinstance(value, list) or len(value) != 3:
+                raise _KeyProblem(key, f"expected an sRGB colour [r, g, b] in [0, 1], got {_describe(value)}")
+            return tuple(_number(c, key, False) for c in value)
         if name == "levels":
             if not isinstance(value, list):
                 raise _KeyProblem(key, f"expected a list of level numbers, got {_describe(value)}")
@@ -279,8 +289,8 @@ def _physics(data) -> PhysicsParams:
 
 
 def _tree_spec(data: dict, source: str) -> TreeSpec:
-    top = ("name", "description", "type", "seed", "trunk", "levels", "crown", "leaves", "lamina", "grass", "beam",
-           "physics")
+    top = ("name", "description", "type", "seed", "trunk", "levels", "crown", "leaves", "lamina", "bark", "grass",
+           "beam", "physics")
     for k in data:
         if k not in top:
             raise _KeyProblem(k, f"unknown key; expected one of {', '.join(top)}")
@@ -307,6 +317,8 @@ def _tree_spec(data: dict, source: str) -> TreeSpec:
         kw["levels"] = tuple(levels)
         if "crown" in data:
             kw["crown"] = _dataclass_from(CrownSpec, data["crown"], "crown.", required=("height", "radius"))
+        if "bark" in data:
+            kw["bark"] = _dataclass_from(Bark, data["bark"], "bark.")
         if "leaves" in data:
             kw["leaves"] = _dataclass_from(LeafSpec, data["leaves"], "leaves.", required=("count", "levels"))
             if kw["leaves"].count > 0:

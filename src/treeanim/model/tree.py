@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .geometry import polygon_area
+from .look import Bark
 from .params import PhysicsParams
 
 KINDS = ("branch", "leaf", "blade")
@@ -127,6 +128,7 @@ class Tree:
     physics: PhysicsParams = field(default_factory=PhysicsParams)
     seed: int = 0
     source: str = ""
+    bark: Bark = field(default_factory=Bark)
 
     # ------------------------------------------------------------------ sizes
     @property

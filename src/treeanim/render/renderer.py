@@ -26,7 +26,6 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from ..model.look import Bark
 from ..model.tree import Tree
 from .camera import OrbitCamera
 from .mesh import VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh, build_mesh
@@ -251,7 +250,7 @@ class Renderer:
         self._uniform(g, "u_trunk_radius", float(self.trunk_radius if s.shadow else 0.0))
         self._uniform(g, "u_grid", float(s.ground_grid))
         self._uniform(self.tree_prog, "u_translucency", float(s.translucency))
-        bark = getattr(self.tree, "bark", None) or Bark()
+        bark = self.tree.bark
         self._uniform(self.tree_prog, "u_bark_color", tuple(float(c) for c in bark.color))
         self._uniform(self.tree_prog, "u_bark", (float(bark.furrows), float(bark.depth), float(bark.interlace),
                                                  float(bark.lenticels)))
