@@ -22,6 +22,10 @@ void node_transform(int j, out vec3 p, out mat3 R) {
              b.y, c.x, c.w);  // column 2
 }
 
+vec3 node_position(int j) {
+    return fetch_texel(u_nodes, 3 * j).xyz;
+}
+
 mat3 orthonormal(mat3 m) {  // Gram-Schmidt on the columns
     vec3 c0 = normalize(m[0]);
     vec3 c1 = normalize(m[1] - dot(m[1], c0) * c0);

@@ -83,11 +83,8 @@ void main() {
         float metres = length(across);
         float px = metres * u_pixels_per_metre / max((u_view_proj * vec4(centre, 1.0)).w, 1e-6);
         if (px < u_thin_pixels) {
-            vec3 p0, p1;
-            mat3 R0, R1;
-            node_transform(in_ids.x, p0, R0);
-            node_transform(in_ids.x + 1, p1, R1);   // the segment's axis
-            vec3 side = cross(p1 - p0, u_camera_pos - centre);
+            vec3 axis = node_position(in_ids.x + 1) - node_position(in_ids.x);   // the segment's
+            vec3 side = cross(axis, u_camera_pos - centre);
             float k = dot(across, side) / max(metres * length(side), 1e-30);  // -1 .. 1 across the axis
             float half_px = v_material == BARK ? px : abs(k) * px;            // a blade: as seen
             float edge = v_material == BARK ? k * (px + 1.0) : sign(k) * (half_px + 1.0);

@@ -77,7 +77,7 @@ class Scene:
     show_sky: bool = True
     show_ground: bool = True
     shadow: bool = True                 # the sun's shadows (tree on ground and on itself)
-    shadow_size: int = 2048             # shadow-map texels a side (read when the renderer is made)
+    shadow_size: int = 1024             # shadow-map texels a side (read when the renderer is made)
     translucency: float = 1.0           # sunlight through the leaves (0: opaque leaves)
     thin_pixels: float = 1.5            # twigs and blades of a half width below this (px) get soft edges (0: none)
 
