@@ -222,3 +222,47 @@ def test_cli_output_cut_short_by_its_reader_stops_quietly():
         os.close(w)
     assert p.returncode == 141, p.stderr.decode()
     assert p.stderr == b""
+
+
+# --------------------------------------------------------------------------- issue #14, items 2 and 11
+@pytest.mark.parametrize("what,mutate,key,words", [
+    ("two levels of 100,000", lambda s: s.replace("count = 3\n", "count = 100000\n", 1).replace("count = 2\n", "count = 100000\n", 1),
+     "levels[].count", "a preset may build at most"),
+    ("50,000 outline points", lambda s: s.replace("outline = [[0.0, 0.0],", "outline = [[0.0, 0.0], " + "[0.1, 0.5], " * 50_000),
+     "lamina.outline", "3 to 1000"),
+    ("a 100 KB name", lambda s: s.replace('name = "small_cherry"', 'name = "' + "x" * 100_000 + '"'), "name", "at most 1000"),
+])
+def test_presets_that_ask_for_too_much_are_refused_at_once(tmp_path, what, mutate, key, words):
+    """Each key in bounds, together billions of objects (or a huge outline): refused from the
+    counts, before anything is built, in bounded time, and in one short line."""
+    import time
+
+    path = write(tmp_path, mutate(GOOD))
+    t0 = time.perf_counter()
+    with pytest.raises(PresetError) as err:
+        ta.load_tree(path)
+    msg = str(err.value)
+    assert time.perf_counter() - t0 < 10.0
+    assert f"'{key}" in msg and words in msg and len(msg) < 300 + len(str(path)), msg[:300]
+
+
+def test_grass_of_100000_blades_of_64_segments_is_refused(tmp_path):
+    text = Path(ta.load_preset("grassland").source).read_text()
+    text = text.replace("count = 5000", "count = 100000").replace("segments = 3", "segments = 64")
+    with pytest.raises(PresetError, match="grass.count, grass.segments.*a preset may build at most"):
+        ta.load_tree(write(tmp_path, text))
+
+
+@pytest.mark.parametrize("key", ["size_var", "down_var"])
+def test_a_negative_zero_is_zero(tmp_path, key):
+    import re
+
+    text, n = re.subn(rf"^{key} = .*$", f"{key} = -0.0", GOOD, count=1, flags=re.M)
+    assert n == 1
+    ta.load_tree(write(tmp_path, text))  # once: "scale < 0" from the random generator, with no key
+
+
+def test_an_integer_of_thousands_of_digits_is_one_short_line(tmp_path):
+    with pytest.raises(PresetError, match="not valid TOML") as err:
+        ta.load_tree(write(tmp_path, GOOD.replace("length = 0.8", "length = " + "1" * 5000, 1)))
+    assert len(str(err.value)) < 300

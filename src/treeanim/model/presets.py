@@ -75,6 +75,11 @@ BOUNDS: dict[str, tuple[float, float]] = {
     "zeta": (0.0, 10.0),
 }
 
+#: Longest string value (a name, a description, a shape).
+MAX_STRING = 1000
+#: Most control points of a lamina outline (it is resampled to ``samples`` points anyway).
+MAX_OUTLINE = 1000
+
 _PRESET_PKG = "treeanim.presets"
 
 
@@ -161,13 +166,15 @@ def read_spec(path: str | Path) -> TreeSpec:
     text = _read_text(path)
     try:
         data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise PresetError(f"{path}: not valid TOML ({e})") from None
+    except ValueError as e:  # TOMLDecodeError, or an integer of thousands of digits
+        why = " ".join(str(e).split())
+        raise PresetError(f"{path}: not valid TOML ({why if len(why) <= 120 else why[:117] + '...'})") from None
     except RecursionError:  # tomllib parses nested arrays and tables recursively
         raise PresetError(f"{path}: arrays or tables nested too deeply to be a preset") from None
     try:
         spec = _tree_spec(data, str(path))
         _check_leaves(spec)
+        _check_size(spec)
     except _KeyProblem as e:
         raise PresetError(f"{path}: key '{e.key}': {e.expected}") from None
     return spec
@@ -194,7 +201,7 @@ def _number(value, key: str, integer: bool):
         raise _KeyProblem(key, f"expected {kind} in [{lo:g}, {hi:g}], got {_describe(value)}")
     if not math.isfinite(value) or not lo <= value <= hi:
         raise _KeyProblem(key, f"expected {kind} in [{lo:g}, {hi:g}], got {_describe(value)}")
-    return int(value) if integer else float(value)
+    return int(value) if integer else float(value) + 0.0  # (-0.0 is 0)
 
 
 def _coerce(value, default, key: str):
@@ -202,16 +209,18 @@ def _coerce(value, default, key: str):
     if isinstance(default, str):
         if not isinstance(value, str):
             raise _KeyProblem(key, f"expected a string, got {_describe(value)}")
+        if len(value) > MAX_STRING:
+            raise _KeyProblem(key, f"expected at most {MAX_STRING} characters, got {len(value):,}")
         return value
     if isinstance(default, (int, float)) and not isinstance(default, bool):
         return _number(value, key, integer=isinstance(default, int))
     if isinstance(default, tuple):
         name = key.rsplit(".", 1)[-1]
         if name == "outline":
-            if not isinstance(value, list) or len(value) < 3 or not all(
+            if not isinstance(value, list) or not 3 <= len(value) <= MAX_OUTLINE or not all(
                 isinstance(p, list) and len(p) == 2 for p in value
             ):
-                raise _KeyProblem(key, f"expected a list of at least 3 [x, y] points, got {_describe(value)}")
+                raise _KeyProblem(key, f"expected a list of 3 to {MAX_OUTLINE} [x, y] points, got {_describe(value)}")
             return tuple(tuple(_number(c, key, False) for c in p) for p in value)
         if name == "color":
             if not isinstance(value, list) or len(value) != 3:
@@ -332,6 +341,53 @@ def _tree_spec(data: dict, source: str) -> TreeSpec:
     else:
         kw["beam"] = _dataclass_from(BeamSpec, data.get("beam", {}), "beam.")
     return TreeSpec(**kw)
+
+
+def estimate_size(spec: TreeSpec) -> dict[str, float]:
+    """An upper bound of the objects, nodes and triangles ``spec`` builds, from its counts alone
+    (before building anything: crown pruning and rounding only remove).
+
+    Returns
+    -------
+    dict
+        ``objects``, ``nodes``, ``triangles``, and ``keys``: the keys that drive the largest.
+    """
+    if spec.type == "grass":
+        g = spec.grass
+        return {"objects": g.count, "nodes": g.count * (g.segments + 1), "triangles": g.count * (2 * g.segments + 1),
+                "keys": "grass.count, grass.segments"}
+    if spec.type == "beam":
+        n = spec.beam.segments
+        return {"objects": 1, "nodes": n + 1, "triangles": 32 * 4 * n, "keys": "beam.segments"}
+    objects = nodes = triangles = 0.0
+    per_level = 1.0
+    for lv in spec.levels:  # the trunk, then each level: so many children per branch above
+        per_level = per_level * (lv.count if lv is not spec.levels[0] else 1.0)
+        objects += per_level
+        nodes += per_level * (lv.segments + 1)
+        triangles += per_level * 32 * 4 * lv.segments  # rings of a curved tube, at least four bands
+    lf = spec.leaves
+    if lf.count:
+        la = spec.lamina
+        outline = 2 * (la.samples + la.teeth * 2) if la is not None else 0
+        objects += lf.count
+        nodes += lf.count * (lf.petiole_segments + 1)
+        triangles += lf.count * (2 * lf.petiole_sides * lf.petiole_segments + outline)
+    return {"objects": objects, "nodes": nodes, "triangles": triangles,
+            "keys": "levels[].count, levels[].segments, leaves.count, lamina.samples"}
+
+
+#: Most objects, nodes and triangles a preset may build (about 30 times the large cherry's:
+#: the mesh alone is then some hundreds of MB and building takes tens of seconds).
+SIZE_BUDGET = {"objects": 200_000, "nodes": 1_000_000, "triangles": 25_000_000}
+
+
+def _check_size(spec: TreeSpec) -> None:
+    size = estimate_size(spec)
+    for what, most in SIZE_BUDGET.items():
+        if size[what] > most:
+            raise _KeyProblem(size["keys"], f"these ask for about {size[what]:.3g} {what}; a preset may build at "
+                                            f"most {most:,}")
 
 
 def _check_leaves(spec: TreeSpec) -> None:
