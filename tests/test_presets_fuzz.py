@@ -1,0 +1,130 @@
+"""Preset mutations by hypothesis (issue #14): a mutated preset either loads and simulates to a
+finite tree, or is refused with one line naming the file — never a traceback, a hang or
+gigabytes of memory."""
+
+from __future__ import annotations
+
+import math
+import resource
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import treeanim as ta
+from treeanim import PresetError
+
+GOOD = tomllib.loads(Path(ta.load_preset("small_cherry").source).read_text())
+
+
+def _paths(node, prefix=()):
+    """Every key path of a parsed TOML document (into tables and arrays of tables)."""
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield prefix + (k,)
+            yield from _paths(v, prefix + (k,))
+    elif isinstance(node, list) and node and all(isinstance(x, dict) for x in node):
+        for i, x in enumerate(node):
+            yield from _paths(x, prefix + (i,))
+
+
+PATHS = sorted(_paths(GOOD), key=str)
+
+scalars = st.one_of(
+    st.integers(-10**12, 10**12), st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0, -0.0, 1e-300, 1e300, 100_000, 64, 65, 0.5, -1]),
+    st.text(max_size=20), st.booleans(),
+)
+values = st.one_of(scalars, st.lists(scalars, max_size=5), st.lists(st.lists(scalars, max_size=3), max_size=4),
+                   st.dictionaries(st.sampled_from(["f", "zeta", "x", "count"]), scalars, max_size=3))
+
+
+def _toml(value) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float):
+        return "nan" if math.isnan(value) else ("inf" if value > 0 else "-inf") if math.isinf(value) else repr(value)
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, str):
+        return '"' + value.encode("unicode_escape").decode("ascii").replace('"', '\\"') + '"'
+    if isinstance(value, list):
+        return "[" + ", ".join(_toml(v) for v in value) + "]"
+    return "{ " + ", ".join(f'"{k}" = {_toml(v)}' for k, v in value.items()) + " }"
+
+
+def dump(doc: dict, prefix: str = "") -> str:
+    """A TOML text of ``doc`` (tables, arrays of tables, inline values)."""
+    lines, tables = [], []
+    for k, v in doc.items():
+        if isinstance(v, dict) and prefix.count(".") < 3:
+            tables.append((k, v))
+        elif isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
+            tables.append((k, v))
+        else:
+            lines.append(f'"{k}" = {_toml(v)}')
+    for k, v in tables:
+        name = f'{prefix}"{k}"'
+        if isinstance(v, dict):
+            lines += ["", f"[{name}]", dump(v, name + ".")]
+        else:
+            for item in v:
+                lines += ["", f"[[{name}]]", dump(item, name + ".")]
+    return "\n".join(lines)
+
+
+def mutated(path, how, value) -> dict:
+    import copy
+
+    doc = copy.deepcopy(GOOD)
+    *parents, last = path
+    node = doc
+    for p in parents:
+        node = node[p]
+    if how == "delete":
+        del node[last]
+    elif how == "unknown":
+        node[f"{last}_typo"] = value
+    else:
+        node[last] = value
+    return doc
+
+
+@settings(max_examples=200, deadline=10_000, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
+@given(path=st.sampled_from(PATHS), how=st.sampled_from(["replace", "replace", "replace", "delete", "unknown"]),
+       value=values)
+def test_a_mutated_preset_loads_or_is_refused_in_one_line(tmp_path_factory, path, how, value):
+    target = tmp_path_factory.mktemp("fuzz") / "mutated.toml"
+    target.write_text(dump(mutated(path, how, value)), encoding="utf-8")
+    try:
+        tree = ta.load_tree(target)
+    except PresetError as e:
+        msg = str(e)
+        assert msg.startswith(f"{target}: ") and "\n" not in msg and len(msg) < 400 + len(str(target)), msg[:500]
+        return
+    try:
+        sim = ta.Simulation(tree, wind=ta.WindField(speed=12.0))
+    except ValueError as e:  # a tree the simulation refuses (a kind with no f/zeta range): one line
+        assert "\n" not in str(e)
+        return
+    for _ in range(3):
+        sim.step(1 / 30)
+    assert np.isfinite(sim.positions).all()
+
+
+def test_the_fuzzing_stayed_within_2_gb():
+    """(Runs after the fuzz test in this module.) The process's peak memory."""
+    peak_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    assert peak_kb < 2 * 1024 * 1024, f"peak {peak_kb / 1024:.0f} MB"
+
+
+def test_the_dumper_writes_the_good_preset_back():
+    assert tomllib.loads(dump(GOOD)) == GOOD
+
+
+@pytest.mark.parametrize("path", [("trunk", "segments"), ("levels", 0, "count"), ("physics", "summer", "leaf")])
+def test_mutations_reach_nested_keys(path):
+    assert path in PATHS
