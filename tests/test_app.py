@@ -12,6 +12,7 @@ import subprocess
 import sys
 import time
 import tomllib
+from pathlib import Path
 
 import glfw
 import numpy as np
@@ -686,11 +687,12 @@ def test_panel_load_shows_a_simulation_error_and_keeps_the_tree(viewer, monkeypa
     assert v.ctx.error == "GL_NO_ERROR"
 
 
-@pytest.mark.parametrize("what", ["fifo", "endless", "nested"])
+@pytest.mark.parametrize("what", ["fifo", "endless", "nested", "overflowing"])
 def test_panel_load_of_a_file_that_never_ends_or_nests_too_deep_keeps_the_tree(viewer, tmp_path, what):
-    """A FIFO (which would block the window forever), a link to /dev/zero (read without end)
-    and a 1,000-deep array (RecursionError in the TOML parser): one line in the panel, the
-    current tree stays, the window keeps drawing."""
+    """A FIFO (which would block the window forever), a link to /dev/zero (read without end),
+    a 1,000-deep array (RecursionError in the TOML parser) and physics that overflowed the
+    simulation (a leaf damping scale of 1e300): one line in the panel, the current tree stays,
+    the window keeps drawing."""
     import threading
 
     v = viewer
@@ -700,8 +702,11 @@ def test_panel_load_of_a_file_that_never_ends_or_nests_too_deep_keeps_the_tree(v
         os.mkfifo(path)
     elif what == "endless":
         path.symlink_to("/dev/zero")
-    else:
+    elif what == "nested":
         path.write_text("x = " + "[" * 1000 + "]" * 1000 + "\n")
+    else:
+        text = Path(v.tree.source).read_text()
+        path.write_text(text.replace("[physics.summer]", "[physics]\nleaf_zeta_w_scale = 1e300\n\n[physics.summer]"))
     done = []
     loader = threading.Thread(target=lambda: done.append(v.panel.load(str(path))), daemon=True)
     loader.start()
