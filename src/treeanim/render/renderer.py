@@ -13,8 +13,9 @@ texel i at (i mod width, i div width), read with texelFetch):
 - objects, RGBA32F, 1 texel an object: ``(visible, highlight, 0, 0)``; rewritten only when
   the visibility or highlight changes.
 
-Each frame draws the sun's shadow map first (:mod:`treeanim.render.shadow`), then the tree,
-then sky and ground behind it, then the overlays.
+Each frame draws the sun's shadow map first (:mod:`treeanim.render.shadow`), then sky and
+ground, then the tree over them (blended: twigs thinner than a pixel are soft lines of their
+true weight), then the overlays.
 """
 
 from __future__ import annotations
