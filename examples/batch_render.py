@@ -26,9 +26,8 @@ def run() -> int:
             path = out / f"{name}_season{season}.png"
             status = treeanim(["render", name, "--season", season, "--wind", args.wind, "--size", args.size,
                                "--quiet", "--out", str(path)])
-            if status:
+            if status:  # (treeanim render has printed where it wrote)
                 return status
-            print(path)
     return 0
 
 

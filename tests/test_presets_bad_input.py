@@ -99,6 +99,12 @@ def test_cli_unknown_preset(tmp_path):
     assert res.returncode == 2 and "Traceback" not in res.stderr and "small_cherry" in res.stderr
 
 
+def test_cli_info_of_a_tree_the_paper_has_not_shows_no_paper_totals():
+    res = run_cli("info", "beam")
+    total = next(line for line in res.stdout.splitlines() if line.startswith("total"))
+    assert res.returncode == 0 and total.count("—") == 2 and " 0" not in total, total
+
+
 def test_cli_info_prints_our_counts_beside_the_paper():
     res = run_cli("info", "large_cherry", "--season", "1")
     assert res.returncode == 0, res.stderr

@@ -461,9 +461,9 @@ def cmd_info(args) -> int:
             f"{kind:<12}{n:>7,} / {ref(1):>6}{stats[kind + '_nodes']:>8,} / {ref(2):>7}"
             f"{stats[kind + '_triangles']:>11,} / {ref(3):>8}   {mr}"
         )
-    total_p = sum(r[2] for r in paper.values()), sum(r[3] for r in paper.values())
-    print(f"{'total':<12}{stats['objects']:>7,}{'':>9}{stats['nodes']:>8,} / {total_p[0]:>7,}"
-          f"{stats['triangles']:>11,} / {total_p[1]:>8,}")
+    total_p = [f"{sum(r[i] for r in paper.values()):,}" if paper else "—" for i in (2, 3)]  # no paper row: —
+    print(f"{'total':<12}{stats['objects']:>7,}{'':>9}{stats['nodes']:>8,} / {total_p[0]:>7}"
+          f"{stats['triangles']:>11,} / {total_p[1]:>8}")
     if key in TABLE1_FPS:
         print(f"paper's frame rate: {TABLE1_FPS[key]} FPS (2012, Core2 Duo 2.8 GHz, GeForce 9500 GT)")
     return 0
