@@ -367,6 +367,15 @@ def test_panel_light_moves_the_sun_and_its_shadow_and_survives_a_new_tree(viewer
         _click(v, *_reveal(v, section))
 
 
+def test_the_save_name_follows_the_preset_unless_typed(viewer):
+    v = viewer
+    assert v.panel.path == "small_cherry-custom.toml"
+    assert v.panel.apply("preset", "beam") and v.panel.path == "beam-custom.toml"
+    v.panel.path = "mine.toml"
+    assert v.panel.apply("preset", "small_cherry") and v.panel.path == "mine.toml"
+    v.panel.path = "small_cherry-custom.toml"
+
+
 def test_panel_apply_sets_physics_season_and_time(viewer):
     v = viewer
     p = v.panel

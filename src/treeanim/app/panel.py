@@ -71,6 +71,7 @@ class Panel:
     def __init__(self, viewer) -> None:
         self.viewer = viewer
         self.path = ""
+        self._default_path = ""
         self.edit_season = "summer"
         self.item_rects: dict[str, tuple[float, float, float, float]] = {}
         self.rect: tuple[float, float, float, float] | None = None
@@ -111,7 +112,9 @@ class Panel:
     def tree_changed(self) -> None:
         """The viewer shows a new tree: default file name and season table."""
         v = self.viewer
-        self.path = self.path or f"{v.sim.tree.name}-custom.toml"
+        if not self.path or self.path == self._default_path:  # a name the user typed is kept
+            self.path = f"{v.sim.tree.name}-custom.toml"
+        self._default_path = f"{v.sim.tree.name}-custom.toml"
         self.edit_season = "summer" if v.sim.season < 0.5 else "winter"
         self._kinds = [k for k in KINDS if np.any(v.sim.tree.kind == k)]
         ei = float(v.sim.tree.physics.ei_max)
