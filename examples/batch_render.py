@@ -1,6 +1,6 @@
 """Render a still of every preset in summer and in winter, offscreen (no window, no GPU needed).
 
-    python examples/batch_render.py --out stills/ --size 960x540
+    .venv/bin/python examples/batch_render.py --out stills/ --size 960x540
 
 Each picture is what ``treeanim render PRESET --season S --out FILE.png`` makes; this script
 only loops over presets and seasons.

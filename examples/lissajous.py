@@ -5,16 +5,18 @@ natural frequencies and damping ratios, pulled sideways and let go, traces a har
 figure — the sway turns from a line into an ellipse and round to the opposite diagonal as the
 two modes drift out of phase, while it decays.
 
-    python examples/lissajous.py --out lissajous_out
+    .venv/bin/python examples/lissajous.py --out lissajous_out
 
 writes ``fig4a.png`` (f_u = 0.75, f_w = 0.8, ζ_u = 0.045, ζ_w = 0.04), ``fig4b.png``
 (f_u = 1.0, f_w = 1.1, ζ_u = 0.035, ζ_w = 0.03) and ``fig4.png`` (both side by side): the
-beam tip's horizontal trace after the release. Needs matplotlib (``pip install treeanim[plots]``).
+beam tip's horizontal trace after the release. Needs matplotlib:
+``.venv/bin/pip install -e '.[plots]'`` from the repository.
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -116,16 +118,22 @@ def plot(ax, times, xz, title):
     return lc
 
 
-def main(argv=None) -> None:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description="Fig. 4: Lissajous traces of a pulled and released beam")
     ap.add_argument("--out", type=Path, default=Path("lissajous_out"), help="output folder for the PNGs")
     ap.add_argument("--angle", type=float, default=35.0, help="pull direction, degrees from u towards w")
     ap.add_argument("--seconds", type=float, default=25.0, help="seconds recorded after the release")
     args = ap.parse_args(argv)
-    import matplotlib
+    try:
+        import matplotlib
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        from treeanim.offline import PLOTS_HINT
+
+        print(f"lissajous.py {PLOTS_HINT}", file=sys.stderr)
+        return 1
 
     args.out.mkdir(parents=True, exist_ok=True)
     results = {}
@@ -148,7 +156,8 @@ def main(argv=None) -> None:
     fig.savefig(args.out / "fig4.png")
     plt.close(fig)
     print(f"wrote {args.out / 'fig4.png'}")
+    return 0
 
 
 if __name__ == "__main__":
-    main()
+    raise SystemExit(main())

@@ -1,6 +1,6 @@
 """Plot the wind field's measured spectra and a vertical slice of wind speed (paper Fig. 7b).
 
-    python examples/wind_spectrum.py --out out/
+    .venv/bin/python examples/wind_spectrum.py --out out/
 
 writes two PNGs:
 
@@ -12,7 +12,8 @@ writes two PNGs:
   profile c1·ln(c2·h) of Eq. 16, averaged over 8 seeds (drawn at the nominal speed, and
   least-squares scaled: Eq. 17's turbulence factor averages a little below 1).
 
-Needs matplotlib (the optional extra ``plots``: ``pip install 'treeanim[plots]'``).
+Needs matplotlib: ``.venv/bin/pip install -e '.[plots]'`` from the repository, then
+``.venv/bin/python examples/wind_spectrum.py``.
 """
 
 from __future__ import annotations
@@ -55,11 +56,9 @@ def main(argv: list[str] | None = None) -> int:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        print(
-            "wind_spectrum.py needs matplotlib: pip install 'treeanim[plots]' "
-            "(or pip install matplotlib)",
-            file=sys.stderr,
-        )
+        from treeanim.offline import PLOTS_HINT
+
+        print(f"wind_spectrum.py {PLOTS_HINT}", file=sys.stderr)
         return 1
 
     args.out.mkdir(parents=True, exist_ok=True)

@@ -359,7 +359,7 @@ def cmd_trace(args) -> int:
         try:
             import matplotlib  # noqa: F401
         except ImportError:
-            raise UsageError("--plot needs matplotlib (pip install 'treeanim[plots]')") from None
+            raise UsageError(f"--plot {offline.PLOTS_HINT}") from None
     scene = argparse.Namespace(**vars(args))
     scene.pull = []
     tree, sim = make_simulation(scene)

@@ -681,6 +681,10 @@ def plot_trace(path: Path, trace: TraceResult, title: str = "") -> None:
         plt.close(fig)
 
 
+#: What to install for plots (``trace --plot`` and the examples), from the repository.
+PLOTS_HINT = "needs matplotlib: .venv/bin/pip install -e '.[plots]' (from the repository)"
+
+
 def zero_crossing_frequency(t: np.ndarray, x: np.ndarray) -> float:
     """Frequency (Hz) of an oscillating signal from its mean zero-crossing interval."""
     x = np.asarray(x, float)
