@@ -295,7 +295,8 @@ class Panel:
         now = time.perf_counter()
         if now - self._timing_at > 0.25:  # readable, and cheaper than formatting every frame
             fps = 1.0 / v.frame_s.value if v.frame_s.value else 0.0
-            self._timing = f"sim {v.sim_ms.value or 0:.1f} ms  render {v.render_ms.value or 0:.1f} ms  {fps:.0f} FPS"
+            rt = f"  {v.real_time.value:.2f}× real time" if v.real_time.value is not None else ""
+            self._timing = f"sim {v.sim_ms.value or 0:.1f} ms  render {v.render_ms.value or 0:.1f} ms  {fps:.0f} FPS{rt}"
             self._timing_at = now
         imgui.text(self._timing)
         gl = v.gl_renderer.split(" (")[0][:24]

@@ -39,8 +39,10 @@ from ..render.renderer import Renderer, Scene
 from .gui import Gui
 from .window import Window
 
-#: Longest real time one frame advances the simulation by (s): a stall never makes a jump.
-MAX_FRAME_DT = 1.0 / 20.0
+#: Longest real time one frame advances the simulation by (s): slow frames (a software
+#: renderer at a few frames a second) still keep real time, in sub-steps; a stall (a dragged or
+#: hidden window) never makes a jump.
+MAX_FRAME_DT = 0.5
 #: Longest simulation sub-step (s of simulated time).
 MAX_SUBSTEP = 1.0 / 60.0
 #: Time constant (s, simulated) of the low-pass on the pull force: it damps the loop between
@@ -218,6 +220,7 @@ class Viewer:
         self.messages: list[str] = []  # lines for the panel's status line (newest last)
         self.screenshots: list[Path] = []
         self.sim_ms, self.render_ms, self.frame_s = _Ema(), _Ema(), _Ema(0.05)
+        self.real_time = _Ema(0.05)  # simulated seconds per real second (the time scale, if kept up)
         self.last_sim_s = self.last_draw_s = 0.0  # the last frame's advance() and draw(), s
         self._acc = 0.0
         self._last_time: float | None = None
@@ -373,8 +376,11 @@ class Viewer:
             return False
         self.window.make_current()
         t0 = time.perf_counter()
+        before = self.sim.time
         self.advance(dt)
         t1 = time.perf_counter()
+        if dt > 0 and not self.paused:
+            self.real_time.add((self.sim.time - before) / dt)
         self.draw(dt)
         t2 = time.perf_counter()
         self.last_sim_s, self.last_draw_s = t1 - t0, t2 - t1
