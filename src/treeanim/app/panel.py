@@ -435,7 +435,9 @@ class Panel:
             for line in ("left-drag a branch or leaf: pull, let go: swing", "left-drag the sky: orbit",
                          "right/middle-drag: pan   wheel: zoom", "F frame  Space pause  R reset  H panel",
                          "S/F12 screenshot  F11 full screen  Esc/Q quit"):
-                imgui.text_disabled(line)
+                imgui.push_style_color(imgui.Col_.text, imgui.get_style_color_vec4(imgui.Col_.text_disabled))
+                imgui.text_wrapped(line)  # the panel is narrow: lines wrap rather than run off its edge
+                imgui.pop_style_color()
         imgui.pop_item_width()
         imgui.end()
         # What the next clicks belong to (io.want_capture_mouse lags a frame behind the cursor).
