@@ -1,4 +1,4 @@
-"""The load path (issue #10, DESIGN §12): whole-tree mechanics measured from the public API."""
+"""The load path (issue #10, docs/design.md §12): whole-tree mechanics measured from the public API."""
 
 from __future__ import annotations
 

@@ -174,7 +174,7 @@ def test_trace_after_release_has_the_beams_modal_frequencies(tmp_path):
     f, zeta = sim.modes.f[0], sim.modes.zeta[0]  # columns u, v, w
     d = tip - rest_tip
     assert 0.04 * length < np.hypot(d[0, 0], d[0, 2]) < 0.15 * length, "released from the pull's static deflection"
-    # Free swing: a load along u (x here) swings at f_w, one along w (z) at f_u (DESIGN §5),
+    # Free swing: a load along u (x here) swings at f_w, one along w (z) at f_u (docs/design.md §5),
     # each at the damped frequency f·sqrt(1 - ζ²).
     fx = offline.zero_crossing_frequency(t, d[:, 0])
     fz = offline.zero_crossing_frequency(t, d[:, 2])

@@ -1,6 +1,6 @@
 """Invariants of the Simulation under hypothesis: any wind, any step, any preset.
 
-Segment lengths are kept (only rotations are applied, DESIGN §5), everything stays finite,
+Segment lengths are kept (only rotations are applied, docs/design.md §5), everything stays finite,
 rotations stay rotations, and the same inputs give the same result.
 """
 

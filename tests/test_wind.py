@@ -1,4 +1,4 @@
-"""The paper's 3-D 1/f^β wind field, WindField(model="paper") (§4.3, Eqs. 13–18; DESIGN §7).
+"""The paper's 3-D 1/f^β wind field, WindField(model="paper") (§4.3, Eqs. 13–18; docs/design.md §7).
 
 Everything here is measured from what the code produces: spectra from the noise grids,
 profiles and directions from many samples, and the sampler against an independent

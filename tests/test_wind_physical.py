@@ -1,4 +1,4 @@
-"""The physical wind field, WindField(model="physical") (issue 11, DESIGN §12).
+"""The physical wind field, WindField(model="physical") (issue 11, docs/design.md §12).
 
 Everything is measured from time series the field produces at fixed points: advection lags
 by cross-correlation, spectra by Welch and a log-log fit, autocorrelations, intensities,

@@ -1,6 +1,6 @@
 """treeanim: interactive trees in wind and under the mouse (Hu, Chiba & He 2012).
 
-The public API (DESIGN §9)::
+The public API (docs/design.md §9)::
 
     import treeanim as ta
     tree = ta.load_preset("small_cherry")

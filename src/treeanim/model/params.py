@@ -1,6 +1,6 @@
 """Physical parameters a preset carries: modal ranges per kind and season, and constants.
 
-These are plain data; the physics package interprets them (DESIGN §4–§6).
+These are plain data; the physics package interprets them (docs/design.md §4–§6).
 """
 
 from __future__ import annotations
@@ -59,14 +59,14 @@ class PhysicsParams:
     wind_gain_branch, wind_gain_leaf, wind_gain_blade : float
         Drag gain per kind (N·s/m³): load = gain × exposed area × wind velocity.
     wood_density, leaf_density : float
-        kg/m³, for the base-excitation inertia (DESIGN §6 step 3) and, in the load path, the
+        kg/m³, for the base-excitation inertia (docs/design.md §6 step 3) and, in the load path, the
         modal mass that sets a branch's stiffness (K = m·ω²).
     lamina_thickness : float
         Thickness of a leaf lamina (and of a grass blade) in metres, for its mass.
     leaf_twist_c0 : float
         ``twist_c0`` for leaves (their petioles twist more readily than wood).
     leaf_youngs_modulus : float
-        Load path only (DESIGN §12): Young's modulus E (Pa) of petioles; a section of
+        Load path only (docs/design.md §12): Young's modulus E (Pa) of petioles; a section of
         diameter D has EI = E π D⁴/64 (with ``stiffness_exponent`` m:
         EI = E π D_max⁴/64 · (D/D_max)^m). Branches need no modulus: their stiffness follows
         from their modal frequency and the mass they carry.

@@ -1,4 +1,4 @@
-"""The tree as structure-of-arrays (DESIGN §3).
+"""The tree as structure-of-arrays (docs/design.md §3).
 
 A tree is a set of *objects* (curved beams: branches, leaf petioles, grass blades), each a
 run of >= 2 contiguous *nodes* ordered root to tip. Objects are sorted by hierarchy level,

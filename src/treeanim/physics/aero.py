@@ -1,4 +1,4 @@
-"""Aerodynamic loads beyond the paper (DESIGN §12): quadratic drag on the air-relative wind.
+"""Aerodynamic loads beyond the paper (docs/design.md §12): quadratic drag on the air-relative wind.
 
 The paper drives every object with a load linear in the wind (Eq. 19 × a gain). Here the load
 is the drag of real air, ½ρ C A |U_rel| U_rel, with U_rel the wind relative to the moving object.

@@ -1,4 +1,4 @@
-"""Curved-beam bending (Eqs. 7–11, DESIGN §5), vectorised across objects.
+"""Curved-beam bending (Eqs. 7–11, docs/design.md §5), vectorised across objects.
 
 Every object bends in its own rest frame (world rest coordinates), independently of its
 parent's motion; :mod:`treeanim.physics.hierarchy` then carries the result up the tree. For

@@ -1,4 +1,4 @@
-"""Carrying each object's local bend up the hierarchy (Eq. 12, DESIGN §6).
+"""Carrying each object's local bend up the hierarchy (Eq. 12, docs/design.md §6).
 
 Every object bends in its local rest frame (u, v, w), whose orientation at rest is the
 quaternion q₀. Carried by its parent, that frame has the world orientation

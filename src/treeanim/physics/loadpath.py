@@ -1,4 +1,4 @@
-"""The load path (DESIGN §12): every object carries the loads of everything that grows on it.
+"""The load path (docs/design.md §12): every object carries the loads of everything that grows on it.
 
 In the paper each object feels only the wind on its own area (Eq. 19), so the crown's drag
 never reaches the trunk. Here:

@@ -1,4 +1,4 @@
-"""Modal parameters of every object (Eqs. 20–22, DESIGN §4).
+"""Modal parameters of every object (Eqs. 20–22, docs/design.md §4).
 
 Each object gets three modes (u, v, w) with a natural frequency f (Hz) and a damping ratio ζ:
 

@@ -1,4 +1,4 @@
-"""Driven damped oscillators of the three modes (Eqs. 2–5, DESIGN §5).
+"""Driven damped oscillators of the three modes (Eqs. 2–5, docs/design.md §5).
 
 Each mode obeys q̈ + 4πζf q̇ + 4π²f² q = g (m = 1) and outputs L′ = 4π²f² q (Eq. 5), so L′
 settles at the applied load g: unit static gain. The state is kept in load units:

@@ -1,4 +1,4 @@
-"""The whole-tree simulation (DESIGN §6): wind → loads → oscillators → bending → hierarchy."""
+"""The whole-tree simulation (docs/design.md §6): wind → loads → oscillators → bending → hierarchy."""
 
 from __future__ import annotations
 
@@ -86,7 +86,7 @@ def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
 
 
 class Simulation:
-    """A tree animated by wind and by pulls (Hu, Chiba & He 2012; DESIGN §5–§8).
+    """A tree animated by wind and by pulls (Hu, Chiba & He 2012; docs/design.md §5–§8).
 
     Parameters
     ----------
@@ -107,7 +107,7 @@ class Simulation:
         independent objects. The load path always couples (its loads go down the tree, so the
         motion must come back up: one without the other feeds energy into a gusty crown).
     load_path : bool
-        True (default): the tree is one structure (DESIGN §12, :mod:`~treeanim.physics.loadpath`):
+        True (default): the tree is one structure (docs/design.md §12, :mod:`~treeanim.physics.loadpath`):
         every object carries its children's loads down to the trunk, drag is quadratic in the
         air-relative wind with foliage reconfiguration (:mod:`~treeanim.physics.aero`), joints
         are as stiff as a tapered cantilever of the preset's Young's modulus, and pulls build
@@ -146,7 +146,7 @@ class Simulation:
 
     Notes
     -----
-    One :meth:`step` (DESIGN §6):
+    One :meth:`step` (docs/design.md §6):
 
     1. wind U at each object's middle node (previous-step pose);
     2. local load L = (U·u, U·v, U·w) in the object's previous-step world frame (the rest
@@ -266,7 +266,7 @@ class Simulation:
         o = self._bplan.order
         self._neg_half_pi_over_n_ord = -0.5 * np.pi / self._nseg[o]
         self._rest_bounds = (X.min(axis=0), X.max(axis=0))
-        # The load path (DESIGN §12): its plan, the drag, and each object's true middle (half
+        # The load path (docs/design.md §12): its plan, the drag, and each object's true middle (half
         # its arc length, on segment j at fraction t) where it samples the wind.
         self._lp = LoadPath(tree, frames, self._bplan, load_point)
         self._drag = Drag(kind, np.where(leaf, lam_area, length * dmean))
@@ -496,7 +496,7 @@ class Simulation:
 
     @property
     def load_path(self) -> bool:
-        """Whether the tree is one structure (DESIGN §12) or the paper's independent objects
+        """Whether the tree is one structure (docs/design.md §12) or the paper's independent objects
         (settable; switching restarts from rest, keeping time, season and physics)."""
         return self._load_path
 
@@ -665,7 +665,7 @@ class Simulation:
 
     # ------------------------------------------------------------------ interaction
     def pull(self, i: int, force_xyz) -> None:
-        """Hold object ``i`` with a constant world force (N) at its tip (DESIGN §8).
+        """Hold object ``i`` with a constant world force (N) at its tip (docs/design.md §8).
 
         While held, the object follows the static deflection of its current load (no
         oscillation of its own modes); :meth:`release` lets it swing freely from there. Pulling
@@ -748,7 +748,7 @@ class Simulation:
         self._fn = None
 
     def step(self, dt: float) -> None:
-        """Advance the simulation by ``dt`` seconds (DESIGN §6; §12 with the load path).
+        """Advance the simulation by ``dt`` seconds (docs/design.md §6; §12 with the load path).
 
         One step is a pipeline of stages: wind → aerodynamic loads → (load path and)
         oscillators → bending → hierarchy.
@@ -814,7 +814,7 @@ class Simulation:
         return coef
 
     def _step_paper(self, U, f3: np.ndarray, z3: np.ndarray, dt: float) -> None:
-        """The paper's step (DESIGN §6): linear loads on each object's own area, Eqs. 2–12."""
+        """The paper's step (docs/design.md §6): linear loads on each object's own area, Eqs. 2–12."""
         M = self._M
         ws = self._ws
         mul = np.multiply
@@ -891,7 +891,7 @@ class Simulation:
             self._att_v = vel
 
     def _step_load_path(self, U, f3: np.ndarray, z3: np.ndarray, dt: float) -> None:
-        """The whole-tree step (DESIGN §12): aerodynamic loads → load path with the
+        """The whole-tree step (docs/design.md §12): aerodynamic loads → load path with the
         oscillators (Eqs. 2–5) → bending (Eqs. 7–11 generalised) → hierarchy (Eq. 12)."""
         held = np.fromiter(self._pulls, dtype=np.int64)  # the objects being pulled
         F_own, c_air = self._aero_loads(U)

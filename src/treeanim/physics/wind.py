@@ -1,6 +1,6 @@
 """Wind over trees: the physical field (default) and the paper's (Hu, Chiba & He 2012).
 
-``WindField(model="physical")`` (DESIGN §12, issue 11) is weather-like wind:
+``WindField(model="physical")`` (docs/design.md §12, issue 11) is weather-like wind:
 
 * **Turbulence in metres.** Three independent Gaussian fields (along-wind u, vertical v,
   lateral w) on one periodic tile of 96 × 48 × 96 cells covering 8 L × 4 L × 8 L (along,
@@ -39,7 +39,7 @@ exactly. Three independent periodic noise grids (``fbm_noise``) give the along-w
 vertical (v) and lateral (w) turbulence. ``WindField`` samples them by periodic trilinear
 interpolation, shapes them with the logarithmic mean profile (Eq. 16) and the normalisation
 of Eq. 17, and turns the result into a world velocity along the user's wind direction
-(Eq. 18). Choices made there (DESIGN §7 leaves them open):
+(Eq. 18). Choices made there (docs/design.md §7 leaves them open):
 
 * **Grid frame.** The grids are sampled in the *wind's own frame*: a point is scaled by the
   bounds to [0, 1]³, then to grid units (× (N − 1)), and its grid coordinates are its
@@ -293,7 +293,7 @@ def _cached_grid(n: int, beta: float, seed: int, component: int) -> np.ndarray:
 class WindField:
     """Wind over trees, sampled at any points and time: the physical model or the paper's.
 
-    ``model="physical"`` (the default, DESIGN §12) is turbulence in metres carried downwind
+    ``model="physical"`` (the default, docs/design.md §12) is turbulence in metres carried downwind
     at the wind speed (Taylor), evolving along its way so that it never repeats, with a
     von Kármán f^−β spectrum, a canopy profile and gusts; see the module docstring.
     ``model="paper"`` is Hu, Chiba & He (2012) Eqs. 13–18 exactly as before issue 11 (same

@@ -3,7 +3,7 @@
 A tree's mesh never changes while it animates: every vertex stores the node whose transform
 it follows and its offset from that node at rest, and the vertex shader (``shaders/skin.glsl``)
 places it each frame from the node positions and rotations the simulation produces
-(DESIGN §6, §10). :meth:`TreeMesh.skin` is the same formula on the CPU.
+(docs/design.md §6, §10). :meth:`TreeMesh.skin` is the same formula on the CPU.
 
 A vertex lies on the segment that leaves its node j, at a fraction t of its length (t = 0 at
 the node). Its segment's end frames are T₀ = orthonormalise(mix(R[j], R[prev], weight)) —
