@@ -6,9 +6,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import small_tree, twig_tree
 
 import treeanim as ta
+from conftest import small_tree, twig_tree
 from treeanim.model.build import ObjectSpec, assemble
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.mesh import MATERIAL_BARK, TreeMesh, build_mesh

@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import treeanim as ta
-from treeanim.model.generate import LeafSpec, LevelSpec, TreeSpec, generate
+from treeanim.model.generate import LevelSpec, TreeSpec, generate
 from treeanim.model.lamina import make_lamina
 from treeanim.model.presets import read_spec
 

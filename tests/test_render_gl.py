@@ -7,8 +7,8 @@ import dataclasses
 import moderngl
 import numpy as np
 import pytest
-from conftest import grass_patch, small_tree
 
+from conftest import grass_patch, small_tree
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.offscreen import OffscreenRenderer, create_egl_context
 from treeanim.render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
@@ -148,7 +148,6 @@ def test_a_hard_pulled_one_segment_twig_is_drawn_as_a_curve(offscreen):
     level and bows above its chord (a rod under a tip load, not a stick hinged at the trunk),
     where the CPU skinning puts it."""
     from conftest import twig_tree
-
     from treeanim.physics.simulation import Simulation
 
     offscreen.resize(W, H)

@@ -25,7 +25,7 @@ def luminance(img):
 
 def render(off, tree, cam, present=None, **scene):
     off.resize(W, H)
-    r = off.load(tree, scene=Scene(**scene))
+    off.load(tree, scene=Scene(**scene))
     off.update(*rest(tree), present=present)
     return off.render(cam)
 

@@ -6,8 +6,8 @@ import re
 
 import numpy as np
 import pytest
-from conftest import beam_tree, grass_patch, small_tree, twig_tree
 
+from conftest import beam_tree, grass_patch, small_tree, twig_tree
 from treeanim.model.geometry import unit as _unit
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.mesh import (

@@ -6,8 +6,8 @@ import glfw
 import moderngl
 import numpy as np
 import pytest
-from conftest import small_tree
 
+from conftest import small_tree
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.overlays import LocalFrames
 from treeanim.render.renderer import Renderer

@@ -24,6 +24,7 @@ from .files import write_bytes
 from .model.tree import Tree
 from .render.mesh import MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh, build_mesh
 
+
 @dataclass(frozen=True)
 class Skeleton:
     """Joints of a tree: one per segment-starting node, plus a root joint 0 at the origin.

@@ -11,10 +11,11 @@ from __future__ import annotations
 import ctypes
 import re
 
+import glfw
+
 # imgui_bundle ships its own libglfw; importing it first makes pyGLFW load that same library, so
 # the process holds one GLFW state (the order matters only when both are imported).
 import imgui_bundle  # noqa: F401  (side effect: PYGLFW_LIBRARY)
-import glfw
 import moderngl
 
 from .errors import HEADLESS_HINT, ViewerUnavailable, check_display

@@ -435,7 +435,6 @@ class BendingPlan:
         for i, K in enumerate(self.counts):
             a, b = self.offsets[i], self.offsets[i + 1]
             tw = slice(a, b) if per_segment else slice(0, K)
-            s = self.seg[i]
             if blocks is None:
                 fu = mul(Fu[:K], self.frac[i], out=ws.get("fu", (K,)))  # Eq. 7
                 fw = mul(Fw[:K], self.frac[i], out=ws.get("fw", (K,)))

@@ -14,8 +14,8 @@ from ..model.params import SCALAR_KEYS, SCALAR_MAX, PhysicsParams
 from ..model.tree import KINDS, Tree
 from .aero import Drag
 from .bending import BendingPlan, matrix_to_quat, rest_frames, saturating_twist
-from .falling import FallingLeaves
 from .checks import finite_float, finite_vector3
+from .falling import FallingLeaves
 from .hierarchy import CompositionPlan
 from .leaves import LeafTwist
 from .loadpath import LoadPath
@@ -726,7 +726,6 @@ class Simulation:
         self._Fw = Fw
         # The rest pose as the composition computes it (equal to the rest positions up to
         # round-off), so that a tree at rest sees exactly zero base velocity.
-        bp = self._bplan
         self._frame, self._base, self._sample_pos = np.empty((4, M)), np.empty((3, M)), np.empty((3, M))
         self._compose()
         U = len(self._att_nodes)
