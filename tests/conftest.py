@@ -8,6 +8,52 @@ import pytest
 from treeanim.model.build import ObjectSpec, assemble
 from treeanim.model.tree import Lamina
 
+# --------------------------------------------------------------------------- markers
+#: Modules that draw through OpenGL (EGL offscreen), and those that open a window (Xvfb).
+GL_MODULES = {"test_render_gl", "test_render_look", "test_junctions", "test_offline", "test_examples"}
+WINDOW_MODULES = {"test_app", "test_render_window"}
+#: Tests of a second or more on a 2-core machine (``pytest --durations``): ``-m "not slow"`` is
+#: the quick loop, under a minute; CI runs everything.
+SLOW = (
+    "test_simulation.py::test_free_decay_of_a_beam_has_the_set_f_and_zeta",
+    "test_simulation.py::test_release_in_the_u_w_plane_shows_both_frequencies",
+    "test_simulation.py::test_euler_agrees_with_exact_at_small_dt",
+    "test_simulation.py::test_modal_loads_settle_at_the_load_unit_static_gain",
+    "test_simulation.py::test_load_path_free_decay_in_calm_air_keeps_the_set_f_and_zeta",
+    "test_export.py",
+    "test_examples.py",
+    "test_install.py",
+    "test_offline.py::test_bench_json_reports_every_preset",
+    "test_offline.py::test_a_write_that_fails_part_way",
+    "test_offline.py::test_ctrl_c_keeps_a_playable_video",
+    "test_offline.py::test_trace_after_release_has_the_beams_modal_frequencies",
+    "test_offline.py::test_png_frames_and_still_match_the_simulated_times",
+    "test_offline.py::test_render_mp4_reads_back_and_moves",
+    "test_offline.py::test_sigterm_during_a_render",
+    "test_presets_fuzz.py::test_a_mutated_preset",
+    "test_leaves.py",
+    "test_grass.py",
+    "test_load_path.py",
+    "test_simulation_hypothesis.py",
+    "test_wind_physical.py",
+    "test_junctions.py::test_collars_stay_welded_in_a_gale",
+    "test_species.py::test_crown_pruning_and_leaf_placement_keep_the_invariants",
+    "test_model.py::test_generator_invariants",
+    "test_app.py",
+)
+
+
+def pytest_collection_modifyitems(items):
+    for item in items:
+        module = item.path.stem
+        if module in GL_MODULES:
+            item.add_marker(pytest.mark.gl)
+        if module in WINDOW_MODULES:
+            item.add_marker(pytest.mark.window)
+        nodeid = f"{item.path.name}::{item.name}"
+        if nodeid.startswith(SLOW):
+            item.add_marker(pytest.mark.slow)
+
 
 class Uniform:
     """A steady uniform wind U (m/s) everywhere (only ``sample`` is needed)."""

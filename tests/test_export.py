@@ -93,12 +93,12 @@ def test_export_mesh_matches_tree(tmp_path):
 def test_winter_export_drops_leaves(tmp_path):
     summer, winter = tmp_path / "s.glb", tmp_path / "w.glb"
     for path, season in ((summer, "0"), (winter, "1")):
-        assert export("large_cherry", "--seconds", "0.4", "--fps", "5", "--season", season, "--out", str(path)).returncode == 0
+        assert export("small_cherry", "--seconds", "0.4", "--fps", "5", "--season", season, "--out", str(path)).returncode == 0
     tris = []
     for path in (summer, winter):
         doc, _ = load(path)
         tris.append(doc.accessors[doc.meshes[0].primitives[0].indices].count // 3)
-    tree = ta.load_preset("large_cherry")
+    tree = ta.load_preset("small_cherry")
     assert tris == [tree.stats(0.0)["triangles"], tree.stats(1.0)["triangles"]]
     assert validate(winter)["numErrors"] == 0
 
