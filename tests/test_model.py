@@ -11,16 +11,12 @@ import treeanim as ta
 from treeanim.model.generate import LevelSpec, TreeSpec, generate
 from treeanim.model.lamina import make_lamina
 from treeanim.model.presets import read_spec
+from treeanim.table1 import PLURAL, ROWS
+from treeanim.table1 import TABLE1 as PAPER
 
 # The paper's Table 1: (preset, season) -> {kind: (objects, nodes, triangles)}.
-TABLE1 = {
-    ("small_cherry", 0.0): {"branch": (60, 123, 3936), "leaf": (816, 3264, 115056)},
-    ("large_cherry", 0.0): {"branch": (546, 1160, 37120), "leaf": (5460, 21840, 769860)},
-    ("large_cherry", 1.0): {"branch": (546, 1160, 37120), "leaf": (344, 1376, 48504)},
-    ("tulip_poplar", 0.0): {"branch": (322, 1410, 45120), "leaf": (1932, 9660, 241500)},
-    ("grassland", 0.0): {"blade": (5000, 20000, 35000)},
-}
-PLURAL = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
+TABLE1 = {ROWS[key]: {kind: counts for kind, *counts in ((r[0], r[1], r[2], r[3]) for r in rows)}
+          for key, rows in PAPER.items()}
 
 
 @pytest.fixture(scope="module")

@@ -22,6 +22,7 @@ import pytest
 
 import treeanim as ta
 from treeanim import cli, offline
+from treeanim.table1 import ROWS
 
 
 def treeanim(*args, cwd=None, timeout=300):
@@ -222,7 +223,7 @@ def test_bench_json_reports_every_preset(tmp_path):
                    cwd=tmp_path)
     assert res.returncode == 0, res.stderr
     doc = json.loads((tmp_path / "bench.json").read_text())
-    assert [r["key"] for r in doc["rows"]] == list(offline.BENCH_ROWS)
+    assert [r["key"] for r in doc["rows"]] == list(ROWS)
     assert doc["gl_renderer"] and doc["machine"]["cpu"] and doc["machine"]["cores"] >= 1
     assert doc["size"] == [64, 36]
     for r in doc["rows"]:
@@ -231,7 +232,7 @@ def test_bench_json_reports_every_preset(tmp_path):
         assert r["sim_ms_min"] <= r["sim_ms"] <= r["sim_ms_p90"], r["key"]
         assert r["render_ms_min"] <= r["render_ms"] <= r["render_ms_p90"], r["key"]
         # The counts reported are those of the tree measured: the preset's own statistics.
-        preset, season = offline.BENCH_ROWS[r["key"]]
+        preset, season = ROWS[r["key"]]
         stats = ta.load_preset(preset).stats(season)
         assert (r["objects"], r["nodes"], r["triangles"]) == (stats["objects"], stats["nodes"], stats["triangles"])
         assert abs(r["nodes"] / r["paper_nodes"] - 1) < 0.1

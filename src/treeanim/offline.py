@@ -30,6 +30,7 @@ import numpy as np
 
 from .files import atomic_path, temp_beside
 from .files import write_text as write_text  # re-exported: the command line writes its JSON through it
+from .table1 import ROWS, TABLE1, TABLE1_FPS
 
 #: Image sides above this are refused (llvmpipe allows 16384, but memory runs out first).
 MAX_SIDE = 8192
@@ -697,14 +698,6 @@ def zero_crossing_frequency(t: np.ndarray, x: np.ndarray) -> float:
 
 
 # ============================================================================ bench
-#: The benchmark's rows: (key in cli.TABLE1, preset, season).
-BENCH_ROWS = {
-    "small_cherry": ("small_cherry", 0.0),
-    "large_cherry": ("large_cherry", 0.0),
-    "large_cherry@winter": ("large_cherry", 1.0),
-    "tulip_poplar": ("tulip_poplar", 0.0),
-    "grassland": ("grassland", 0.0),
-}
 
 
 def machine_info() -> dict:
@@ -730,9 +723,7 @@ def bench_row(key: str, off, width: int, height: int, frames: int, steps: int, w
     """One row of the benchmark: our counts, the paper's, and the medians in milliseconds."""
     import treeanim as ta
 
-    from .cli import TABLE1, TABLE1_FPS
-
-    preset, season = BENCH_ROWS.get(key, (key, 0.0))
+    preset, season = ROWS.get(key, (key, 0.0))
     tree = ta.load_preset(preset)
     stats = tree.stats(season)
     try:
@@ -782,7 +773,7 @@ def bench_row(key: str, off, width: int, height: int, frames: int, steps: int, w
 
 def run_bench(keys, width: int = 1280, height: int = 720, frames: int = 20, steps: int = 200, samples: int = 4,
               wind: float = 5.0, quiet: bool = False) -> dict:
-    """The Table 1 benchmark over ``keys`` (see :data:`BENCH_ROWS`): a dict with the machine,
+    """The Table 1 benchmark over ``keys`` (see :data:`treeanim.table1.ROWS`): a dict with the machine,
     the GL renderer and one row per key.
 
     Raises

@@ -21,7 +21,10 @@ from ..physics.simulation import INTEGRATORS
 from ..physics.wind import WIND_PRESETS
 from ..render.renderer import sun_angles, sun_direction
 from .settings import save_preset
-from .viewer import PANEL_WIDTH, wind_angle
+from .winddir import wind_angle
+
+#: Width of the panel in screen units at UI scale 1.
+PANEL_WIDTH = 330
 
 #: Slider ranges: (min, max, format, logarithmic).
 RANGES = {

@@ -37,6 +37,7 @@ from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
 from ..render.picking import Picker
 from ..render.renderer import Renderer, Scene
 from .gui import Gui
+from .winddir import wind_direction
 from .window import Window
 
 #: Longest real time one frame advances the simulation by (s): slow frames (a software
@@ -57,8 +58,6 @@ PULL_MAX_LENGTHS = 2.0
 ORBIT_DEG_PER_UNIT = 0.35
 #: Zoom factor per wheel notch.
 ZOOM_PER_NOTCH = 0.88
-#: Width of the panel in screen units at UI scale 1.
-PANEL_WIDTH = 330
 
 
 @dataclass
@@ -133,18 +132,6 @@ def _clone_wind(w: WindField | None, **changes) -> WindField:
         kw["direction"] = (1.0, 0.0, 0.0)
     kw.update(changes)
     return WindField(**kw)
-
-
-def wind_direction(angle_deg: float) -> np.ndarray:
-    """The horizontal unit vector at ``angle_deg`` about +y from +x (90° is −z)."""
-    a = math.radians(angle_deg)
-    return np.array([math.cos(a), 0.0, -math.sin(a)])
-
-
-def wind_angle(direction) -> float:
-    """Inverse of :func:`wind_direction`: degrees in [0, 360)."""
-    d = np.asarray(direction, float)
-    return math.degrees(math.atan2(-d[2], d[0])) % 360.0
 
 
 class _Ema:
