@@ -1,6 +1,7 @@
 #version 330 core
 
 #include "common.glsl"
+#include "constants.glsl"
 
 in vec3 v_world;
 in vec3 v_normal;
@@ -45,22 +46,22 @@ float tent_integral(float x) {
 }
 
 void main() {
-    if (v_half >= 0.0 && v_material == 0 && !gl_FrontFacing) discard;  // a thin twig, flat: its far half
+    if (v_half >= 0.0 && v_material == BARK && !gl_FrontFacing) discard;  // a thin twig, flat: its far half
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;                 // double-sided: laminas, blades
     vec3 V = normalize(u_camera_pos - v_world);
     float ndl = dot(n, u_sun_dir);
-    bool foliage = v_material != 0;
+    bool foliage = v_material != BARK;
     vec3 albedo = v_albedo;
-    if (v_material == 0) {
+    if (v_material == BARK) {
         albedo *= bark(v_uv);
-    } else if (v_material == 2) {
+    } else if (v_material == LAMINA) {
         // Lamina: a lighter midrib and faint side veins; darker towards the base.
         float ax = abs(v_uv.x);
         float rib = (1.0 - smoothstep(0.008, 0.022, ax)) * step(0.02, v_uv.y) * (1.0 - smoothstep(0.85, 1.0, v_uv.y));
         float side = 1.0 - smoothstep(0.0, 0.07, abs(fract((v_uv.y - 0.9 * ax) * 7.0) - 0.5) - 0.43);
         albedo *= (0.88 + 0.16 * v_uv.y) * (1.0 + 0.45 * rib + 0.12 * side * (1.0 - rib));
-    } else if (v_material == 3) {
+    } else if (v_material == BLADE) {
         albedo *= 0.85 + 0.3 * (1.0 - abs(v_uv.x));
     }
     float sun = sun_visibility(v_world, n);

@@ -28,10 +28,7 @@ flat out float v_highlight;
 noperspective out float v_edge;  // thin twigs and blades: distance from the axis on screen, px
 out float v_half;                // their true half width on screen, px (< 0: not thin)
 
-const int BARK = 0;
-const int PETIOLE = 1;
-const int LAMINA = 2;
-const int BLADE = 3;
+#include "constants.glsl"
 
 vec3 lin(vec3 c) { return pow(c, vec3(2.2)); }
 

@@ -60,6 +60,18 @@ def test_shader_sources_expand_includes():
     assert "#include" not in shader_source("line.vert")
 
 
+def test_the_shaders_take_their_material_ids_from_the_mesh():
+    import re
+
+    from treeanim.render import mesh
+
+    for name in ("tree.vert", "tree.frag"):
+        src = shader_source(name)
+        for material in ("BARK", "PETIOLE", "LAMINA", "BLADE"):
+            assert f"const int {material} = {getattr(mesh, 'MATERIAL_' + material)};" in src
+        assert not re.search(r"v_material\s*[!=]=\s*\d", src), "a material id written by hand"
+
+
 def test_tree_is_drawn_where_the_camera_looks(scene):
     off, r, cam = scene
     img = off.render(cam)

@@ -1,4 +1,8 @@
-"""Loading GLSL sources shipped as package data (``treeanim.shaders``), with ``#include``."""
+"""Loading GLSL sources shipped as package data (``treeanim.shaders``), with ``#include``.
+
+``#include "constants.glsl"`` is made here from the Python constants the shaders share (the
+mesh's material ids), so the two can never drift apart.
+"""
 
 from __future__ import annotations
 
@@ -19,10 +23,20 @@ def shader_source(name: str) -> str:
     def expand(fname: str, seen: tuple[str, ...]) -> str:
         if fname in seen:
             raise ValueError(f"shader include cycle: {' -> '.join(seen + (fname,))}")
+        if fname == "constants.glsl":
+            return constants_glsl()
         text = files("treeanim.shaders").joinpath(fname).read_text(encoding="utf-8")
         return _INCLUDE.sub(lambda m: expand(m.group(1), seen + (fname,)), text)
 
     return expand(name, ())
+
+
+def constants_glsl() -> str:
+    """GLSL constants generated from Python: the materials of :mod:`treeanim.render.mesh`."""
+    from . import mesh
+
+    names = ("BARK", "PETIOLE", "LAMINA", "BLADE")
+    return "\n".join(f"const int {n} = {getattr(mesh, 'MATERIAL_' + n)};" for n in names) + "\n"
 
 
 def load_program(ctx: moderngl.Context, vertex: str, fragment: str, geometry: str | None = None) -> moderngl.Program:
