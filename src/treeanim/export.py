@@ -22,6 +22,7 @@ import pygltflib as gl
 
 from .files import write_bytes
 from .model.tree import Tree
+from .physics.rotation import matrix_to_quat
 from .render.mesh import MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh, build_mesh
 
 
@@ -72,23 +73,10 @@ def skeleton(tree: Tree) -> Skeleton:
 
 # ---------------------------------------------------------------------------- rotations
 def quaternions(R: np.ndarray) -> np.ndarray:
-    """Unit quaternions (x, y, z, w) of rotation matrices (..., 3, 3), w >= 0."""
+    """Unit quaternions in glTF's order (x, y, z, w), w >= 0, of rotation matrices (..., 3, 3)."""
     R = np.asarray(R, float)
-    m00, m11, m22 = R[..., 0, 0], R[..., 1, 1], R[..., 2, 2]
-    q = np.stack(
-        [
-            np.sqrt(np.maximum(0.0, 1 + m00 - m11 - m22)) / 2,
-            np.sqrt(np.maximum(0.0, 1 - m00 + m11 - m22)) / 2,
-            np.sqrt(np.maximum(0.0, 1 - m00 - m11 + m22)) / 2,
-            np.sqrt(np.maximum(0.0, 1 + m00 + m11 + m22)) / 2,
-        ],
-        axis=-1,
-    )
-    # Signs of x, y, z from the antisymmetric part (w taken >= 0).
-    q[..., 0] = np.copysign(q[..., 0], R[..., 2, 1] - R[..., 1, 2])
-    q[..., 1] = np.copysign(q[..., 1], R[..., 0, 2] - R[..., 2, 0])
-    q[..., 2] = np.copysign(q[..., 2], R[..., 1, 0] - R[..., 0, 1])
-    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+    wxyz = matrix_to_quat(R.reshape(-1, 3, 3))  # the project's convention, scalar first
+    return wxyz[[1, 2, 3, 0]].T.reshape(R.shape[:-2] + (4,))
 
 
 def local_rotations(skel: Skeleton, rotations: np.ndarray) -> np.ndarray:

@@ -245,25 +245,6 @@ def rest_frames(tree) -> np.ndarray:
     return np.stack([u, v, w], axis=2)
 
 
-def matrix_to_quat(R: np.ndarray) -> np.ndarray:
-    """(4, K) unit quaternions (w, x, y, z) of (K, 3, 3) rotation matrices.
-
-    Parameters
-    ----------
-    R : (K, 3, 3) float
-        Proper rotations.
-
-    Returns
-    -------
-    numpy.ndarray, (4, K) float
-        C-contiguous, scalar part first.
-    """
-    from scipy.spatial.transform import Rotation
-
-    xyzw = Rotation.from_matrix(R).as_quat()
-    return np.ascontiguousarray(np.roll(xyzw, 1, axis=1).T)
-
-
 class BendingPlan:
     """Per-segment-index index arrays of a tree, precomputed once, and the bent state.
 

@@ -1,6 +1,8 @@
 """Small vectorised rotation helpers in component-major layout.
 
-Vectors are (3, K) arrays and unit quaternions (4, K) arrays with rows (w, x, y, z); the last
+Vectors are (3, K) arrays and unit quaternions (4, K) arrays with rows (w, x, y, z) — the
+project's one quaternion convention (glTF's (x, y, z, w) is made from it in
+:mod:`treeanim.export`); the last
 axis runs over objects, segments or nodes, so every operation is a contiguous numpy loop over
 K. Quaternions keep the per-segment work small (a product is 28 passes over K numbers, a 3×3
 product 27 over 9K); they are turned into 3×3 matrices only for the output.
@@ -181,3 +183,22 @@ def qmat(q: np.ndarray, out: np.ndarray | None = None, ws: Workspace | None = No
     np.subtract(1.0, m9[8], out=m9[8])
     out.reshape(K, 9)[...] = m9.T
     return out
+
+
+def matrix_to_quat(R: np.ndarray) -> np.ndarray:
+    """(4, K) unit quaternions (w, x, y, z), w >= 0, of (K, 3, 3) rotation matrices.
+
+    Parameters
+    ----------
+    R : (K, 3, 3) float
+        Proper rotations.
+
+    Returns
+    -------
+    numpy.ndarray, (4, K) float
+        C-contiguous, scalar part first.
+    """
+    from scipy.spatial.transform import Rotation
+
+    xyzw = Rotation.from_matrix(np.asarray(R, float).reshape(-1, 3, 3)).as_quat(canonical=True)
+    return np.ascontiguousarray(np.roll(xyzw, 1, axis=1).T)

@@ -13,7 +13,7 @@ from ..model.geometry import arc_length, lamina_frames, object_lengths, polygon_
 from ..model.params import SCALAR_KEYS, SCALAR_MAX, PhysicsParams
 from ..model.tree import KINDS, Tree
 from .aero import Drag
-from .bending import BendingPlan, matrix_to_quat, rest_frames, saturating_twist
+from .bending import BendingPlan, rest_frames, saturating_twist
 from .checks import finite_float, finite_vector3
 from .falling import FallingLeaves
 from .hierarchy import CompositionPlan
@@ -21,7 +21,7 @@ from .leaves import LeafTwist
 from .loadpath import LoadPath
 from .modal import ModalDraws, ModalParameters, derive_modes, mean_diameters
 from .oscillator import euler_step, exact_coefficients, exact_step
-from .rotation import Workspace, qrot
+from .rotation import Workspace, matrix_to_quat, qrot
 from .wind import DEFAULT_BOUNDS
 
 __all__ = ["Simulation", "trace_tips", "INTEGRATORS", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA",
