@@ -111,15 +111,27 @@ def _wind_speed(text: str) -> float:
     return _number(float, 0, MAX_SPEED, lo_open=False)(text)
 
 
-def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
-    """Wind, season and seed options (the scene around the tree)."""
-    from treeanim.physics.wind import MODELS, WIND_PRESETS
+def add_season_option(p: argparse.ArgumentParser) -> None:
+    """--season, for every command that builds a tree."""
+    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
+
+
+def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
+    """--wind and --wind-preset (the viewer's and the offline commands' wind)."""
+    from treeanim.physics.wind import WIND_PRESETS
 
     names = ", ".join(f"{k} (Beaufort {v['beaufort']}, {v['speed']:g} m/s)" for k, v in WIND_PRESETS.items())
     p.add_argument("--wind", type=_wind_speed, default=None, metavar="SPEED",
                    help=f"mean wind speed at the canopy top, m/s (default {wind:g}, or the preset's; 0 = calm)")
     p.add_argument("--wind-preset", choices=list(WIND_PRESETS), default=None, metavar="NAME",
-                   help=f"a named wind: {names}; --wind and --turbulence override its values")
+                   help=f"a named wind: {names}; --wind (and --turbulence where it exists) override its values")
+
+
+def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
+    """Wind, season and seed options (the scene around the tree)."""
+    from treeanim.physics.wind import MODELS
+
+    add_wind_speed_options(p, wind)
     p.add_argument("--wind-model", choices=list(MODELS), default=None,
                    help="physical (default: turbulence in metres carried downwind, gusts, canopy profile) "
                    "or paper (Hu, Chiba & He 2012, Eqs. 13-18; the default with --paper)")
@@ -128,7 +140,7 @@ def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
     p.add_argument("--turbulence", type=_number(float, 0, 2, lo_open=False), default=None, metavar="T",
                    help="physical: turbulence intensity at the canopy top in [0, 1] (default 0.3); "
                    "paper: lambda of Eq. 17 in [1, 2] (default 1.5)")
-    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
+    add_season_option(p)
     p.add_argument("--seed", type=_number(int, 0, 2**32 - 1, lo_open=False), default=0,
                    help="seed of the wind and the modal noise (default 0)")
     p.set_defaults(wind_default=wind)
@@ -473,7 +485,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("info", help="print a preset's statistics beside the paper's Table 1",
                        description="Print a preset's objects, nodes and triangles beside the paper's Table 1 row.")
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
-    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
+    add_season_option(p)
     p.set_defaults(func=cmd_info)
 
     p = sub.add_parser("export", help="bake the animation into a glTF 2.0 file (.glb or .gltf)",
@@ -553,11 +565,8 @@ def build_parser() -> argparse.ArgumentParser:
         "swing; sliders for wind, season and physics. Needs a display and OpenGL 3.3.")
     p.add_argument("preset", nargs="?", default="small_cherry",
                    help="preset name (see 'treeanim list') or path to a preset .toml (default small_cherry)")
-    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
-    p.add_argument("--wind", type=_wind_speed, default=None, metavar="SPEED",
-                   help="mean wind speed at the canopy top, m/s (default 5, or the preset's; 0 = calm)")
-    p.add_argument("--wind-preset", choices=list(__import__("treeanim.physics.wind", fromlist=["x"]).WIND_PRESETS),
-                   default=None, metavar="NAME", help="a named wind: calm, breeze, windy, gale, storm (by Beaufort)")
+    add_season_option(p)
+    add_wind_speed_options(p)
     p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH",
                    help="window size (default 1280x720)")
     p.add_argument("--samples", type=_samples, default=None, metavar="N",
