@@ -350,6 +350,21 @@ def test_physics_beyond_its_bounds_is_refused_and_the_state_kept(busy, name, val
     assert_same(before, snapshot(busy))
 
 
+def test_the_paper_models_compliance_predicts_a_small_pull():
+    """Simulation.compliance (the viewer's pull spring) uses the stiffness the bending uses:
+    a small pull across a tapered three-segment branch moves its tip by force × compliance."""
+    from treeanim.model.build import ObjectSpec, assemble
+
+    pts = np.outer(np.linspace(0.0, 1.5, 4), (0.0, 1.0, 0.0))
+    tree = assemble([ObjectSpec(pts, np.array([0.08, 0.05, 0.03, 0.01]), "branch", 1)], name="tapered")
+    sim = Simulation(tree, load_path=False)
+    force = 1e-5 * sim.physics.ei_max / 1.5**2  # small: the tip moves about a millimetre
+    sim.pull(0, (0.0, 0.0, force))
+    sim.step(1 / 60)  # held: the static deflection at once
+    moved = sim.positions[3, 2] - tree.rest_positions[3, 2]
+    assert moved == pytest.approx(force * sim.compliance(0, 2, 1.0), rel=0.02)
+
+
 def test_bad_modes_shape(busy):
     busy.modes.f = np.ones((3, 3))
     with pytest.raises(ValueError, match="modes.f"):

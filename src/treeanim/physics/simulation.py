@@ -654,12 +654,10 @@ class Simulation:
             self._modes_arrays()  # the stiffness follows the modes
             share = np.linalg.norm(anchor - X[0]) / max(float(self._lp.lever0[i]), 1e-12)
             return float(min(share, 4.0) ** 3 / self._lp.K[i])
-        p = self._physics
-        D = tree.node_diameter[nodes]
         L = np.linalg.norm(seg, axis=1)
         n = len(L)
-        stiff = p.ei_max * (0.5 * (D[:-1] + D[1:]) / float(np.max(tree.node_diameter))) ** p.stiffness_exponent
-        phi = (n - np.arange(n)) / n * L / np.maximum(stiff, 1e-30)  # Eq. 7's fractions at Eq. 10's k
+        stiff = np.concatenate(self._k)[self._bplan.flat_of_node[nodes[:-1]]]  # Eq. 10's k, as the bending uses it
+        phi = (n - np.arange(n)) / n * L / np.maximum(stiff, 1e-30)  # Eq. 7's fractions
         lever = np.linalg.norm(anchor - X[: k + 1], axis=1)
         return float(np.sum(phi[: k + 1] * lever))
 
