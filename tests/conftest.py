@@ -22,6 +22,7 @@ SLOW = (
     "test_simulation.py::test_load_path_free_decay_in_calm_air_keeps_the_set_f_and_zeta",
     "test_export.py",
     "test_examples.py",
+    "test_readme.py::test_the_quick_readme_commands_run_as_typed",
     "test_install.py",
     "test_offline.py::test_bench_json_reports_every_preset",
     "test_offline.py::test_a_write_that_fails_part_way",
