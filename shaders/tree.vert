@@ -36,14 +36,14 @@ vec3 lin(vec3 c) { return pow(c, vec3(2.2)); }
 vec3 leaf_color(float jitter, float key) {
     // Summer: saturated cherry greens, each leaf a little different in hue and value.
     float j2 = fract(jitter * 13.37);
-    vec3 summer = mix(lin(vec3(0.13, 0.33, 0.05)), lin(vec3(0.33, 0.55, 0.10)), jitter);
-    summer = mix(summer, lin(vec3(0.24, 0.46, 0.16)), 0.35 * j2);
+    vec3 summer = mix(lin(C_LEAF_DARK), lin(C_LEAF_LIGHT), jitter);
+    summer = mix(summer, lin(C_LEAF_COOL), 0.35 * j2);
     // Autumn: leaves that fall first turn first (key = drop order, 0 first).
     float prog = smoothstep(0.05 + 0.35 * key, 0.30 + 0.45 * key, u_season);
-    vec3 yellow = lin(vec3(0.88, 0.70, 0.12));
-    vec3 orange = lin(vec3(0.92, 0.40, 0.06));
-    vec3 red = lin(vec3(0.70, 0.10, 0.06));
-    vec3 brown = lin(vec3(0.40, 0.17, 0.06));
+    vec3 yellow = lin(C_LEAF_YELLOW);
+    vec3 orange = lin(C_LEAF_ORANGE);
+    vec3 red = lin(C_LEAF_RED);
+    vec3 brown = lin(C_LEAF_BROWN);
     vec3 c = mix(summer, yellow, smoothstep(0.0, 0.35, prog));
     c = mix(c, mix(orange, red, j2), smoothstep(0.3, 0.7, prog) * (0.55 + 0.45 * jitter));
     c = mix(c, brown, 0.75 * smoothstep(0.8, 1.0, prog));
@@ -99,13 +99,13 @@ void main() {
     if (v_material == BARK) {
         v_albedo = lin(u_bark_color) * (0.92 + 0.16 * jitter);
     } else if (v_material == PETIOLE) {
-        v_albedo = mix(leaf_color(jitter, key), lin(vec3(0.55, 0.28, 0.14)), 0.4);
+        v_albedo = mix(leaf_color(jitter, key), lin(C_PETIOLE), 0.4);
     } else if (v_material == LAMINA) {
         v_albedo = leaf_color(jitter, key);
     } else {
-        vec3 base = lin(vec3(0.10, 0.24, 0.05));
-        vec3 tip = mix(lin(vec3(0.42, 0.58, 0.16)), lin(vec3(0.55, 0.60, 0.22)), jitter);
+        vec3 base = lin(C_BLADE_BASE);
+        vec3 tip = mix(lin(C_BLADE_TIP), lin(C_BLADE_TIP_DRY), jitter);
         vec3 c = mix(base, tip, key);
-        v_albedo = mix(c, lin(vec3(0.62, 0.55, 0.32)) * (0.6 + 0.4 * key), 0.6 * u_season);
+        v_albedo = mix(c, lin(C_BLADE_WINTER) * (0.6 + 0.4 * key), 0.6 * u_season);
     }
 }

@@ -168,3 +168,18 @@ def test_a_gltf_and_its_buffer_are_replaced_as_a_pair(tmp_path):
         names.append(sorted(p.name for p in tmp_path.iterdir()))
     assert names[0] != names[1] and len(names[1]) == 2, names  # the first buffer is gone
     assert validate(out)["numErrors"] == 0
+
+
+def test_exported_bark_takes_the_species_colour():
+    """The exporter's vertex colours follow the preset's [bark] as the shader does."""
+    from treeanim.export import vertex_colours
+    from treeanim.render.mesh import MATERIAL_BARK, build_mesh
+
+    for name in ("tulip_poplar", "small_cherry"):
+        tree = ta.load_preset(name)
+        mesh = build_mesh(tree)
+        bark = vertex_colours(tree, mesh, 0.0)[mesh.material == MATERIAL_BARK, :3]
+        expected = np.power(np.asarray(tree.bark.color), 2.2)
+        ratio = bark / expected
+        assert np.all(ratio > 0.91) and np.all(ratio < 1.09)
+        assert np.allclose(ratio[:, 0], ratio[:, 2])  # the species' hue, only brighter or darker

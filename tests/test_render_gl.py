@@ -60,16 +60,21 @@ def test_shader_sources_expand_includes():
     assert "#include" not in shader_source("line.vert")
 
 
-def test_the_shaders_take_their_material_ids_from_the_mesh():
+def test_the_shaders_take_their_material_ids_and_colours_from_python():
     import re
 
-    from treeanim.render import mesh
+    from treeanim.render import mesh, palette
 
     for name in ("tree.vert", "tree.frag"):
         src = shader_source(name)
         for material in ("BARK", "PETIOLE", "LAMINA", "BLADE"):
             assert f"const int {material} = {getattr(mesh, 'MATERIAL_' + material)};" in src
         assert not re.search(r"v_material\s*[!=]=\s*\d", src), "a material id written by hand"
+    vert = shader_source("tree.vert")
+    for name, (r, g, b) in palette.COLOURS.items():
+        assert f"const vec3 C_{name} = vec3({r!r}, {g!r}, {b!r});" in vert
+    body = vert.split("void main()")[0].split("const vec3 C_BLADE_WINTER")[1]
+    assert not re.search(r"lin\(vec3\(\d", body), "a colour written by hand in the shader"
 
 
 def test_tree_is_drawn_where_the_camera_looks(scene):

@@ -23,6 +23,7 @@ import pygltflib as gl
 from .files import write_bytes
 from .model.tree import Tree
 from .physics.rotation import matrix_to_quat
+from .render import palette
 from .render.mesh import MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh, build_mesh
 
 
@@ -131,19 +132,19 @@ def vertex_colours(tree: Tree, mesh: TreeMesh, season: float) -> np.ndarray:
     jitter = mesh.vertices["extra"][:, 1].astype(float)
     key = mesh.vertices["extra"][:, 3].astype(float)
     j2 = np.modf(jitter * 13.37)[0]
-    summer = _mix(_lin(0.13, 0.33, 0.05), _lin(0.33, 0.55, 0.10), jitter)
-    summer = _mix(summer, _lin(0.24, 0.46, 0.16), 0.35 * j2)
+    c = {name: _lin(*rgb) for name, rgb in palette.COLOURS.items()}
+    summer = _mix(c["LEAF_DARK"], c["LEAF_LIGHT"], jitter)
+    summer = _mix(summer, c["LEAF_COOL"], 0.35 * j2)
     prog = _smoothstep(0.05 + 0.35 * key, 0.30 + 0.45 * key, season)  # leaves that fall first turn first
-    leaf = _mix(summer, _lin(0.88, 0.70, 0.12), _smoothstep(0.0, 0.35, prog))
-    leaf = _mix(leaf, _mix(_lin(0.92, 0.40, 0.06), _lin(0.70, 0.10, 0.06), j2),
-                _smoothstep(0.3, 0.7, prog) * (0.55 + 0.45 * jitter))
-    leaf = _mix(leaf, _lin(0.40, 0.17, 0.06), 0.75 * _smoothstep(0.8, 1.0, prog))
-    blade = _mix(_lin(0.10, 0.24, 0.05), _mix(_lin(0.42, 0.58, 0.16), _lin(0.55, 0.60, 0.22), jitter), key)
-    blade = _mix(blade, _lin(0.62, 0.55, 0.32) * (0.6 + 0.4 * key)[:, None], 0.6 * season)
+    leaf = _mix(summer, c["LEAF_YELLOW"], _smoothstep(0.0, 0.35, prog))
+    leaf = _mix(leaf, _mix(c["LEAF_ORANGE"], c["LEAF_RED"], j2), _smoothstep(0.3, 0.7, prog) * (0.55 + 0.45 * jitter))
+    leaf = _mix(leaf, c["LEAF_BROWN"], 0.75 * _smoothstep(0.8, 1.0, prog))
+    blade = _mix(c["BLADE_BASE"], _mix(c["BLADE_TIP"], c["BLADE_TIP_DRY"], jitter), key)
+    blade = _mix(blade, c["BLADE_WINTER"] * (0.6 + 0.4 * key)[:, None], 0.6 * season)
     col = np.select(
         [mat[:, None] == MATERIAL_LAMINA, mat[:, None] == MATERIAL_PETIOLE, mat[:, None] == MATERIAL_BLADE],
-        [leaf, _mix(leaf, _lin(0.55, 0.28, 0.14), 0.4), blade],
-        _lin(0.34, 0.29, 0.25) * (0.8 + 0.4 * jitter)[:, None],
+        [leaf, _mix(leaf, c["PETIOLE"], 0.4), blade],
+        _lin(*tree.bark.color) * (0.92 + 0.16 * jitter)[:, None],  # the species' bark
     )
     return np.column_stack([np.clip(col, 0, 1), np.ones(len(col))])
 

@@ -1,7 +1,7 @@
 """Loading GLSL sources shipped as package data (``treeanim.shaders``), with ``#include``.
 
 ``#include "constants.glsl"`` is made here from the Python constants the shaders share (the
-mesh's material ids), so the two can never drift apart.
+mesh's material ids, the leaves' and blades' colours), so the two can never drift apart.
 """
 
 from __future__ import annotations
@@ -32,11 +32,14 @@ def shader_source(name: str) -> str:
 
 
 def constants_glsl() -> str:
-    """GLSL constants generated from Python: the materials of :mod:`treeanim.render.mesh`."""
-    from . import mesh
+    """GLSL constants generated from Python: the materials of :mod:`treeanim.render.mesh` and
+    the colours of :mod:`treeanim.render.palette` (sRGB, as ``C_`` + name)."""
+    from . import mesh, palette
 
     names = ("BARK", "PETIOLE", "LAMINA", "BLADE")
-    return "\n".join(f"const int {n} = {getattr(mesh, 'MATERIAL_' + n)};" for n in names) + "\n"
+    lines = [f"const int {n} = {getattr(mesh, 'MATERIAL_' + n)};" for n in names]
+    lines += [f"const vec3 C_{n} = vec3({r!r}, {g!r}, {b!r});" for n, (r, g, b) in palette.COLOURS.items()]
+    return "\n".join(lines) + "\n"
 
 
 def load_program(ctx: moderngl.Context, vertex: str, fragment: str, geometry: str | None = None) -> moderngl.Program:

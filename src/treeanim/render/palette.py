@@ -1,0 +1,19 @@
+"""The colours of leaves (summer through autumn), petioles and grass blades, sRGB in [0, 1]:
+written once here, injected into the vertex shader (``constants.glsl``, see
+:mod:`treeanim.render.shaders`) and used by the glTF exporter's vertex colours."""
+
+LEAF_DARK = (0.13, 0.33, 0.05)  # summer, from dark to light by the leaf's jitter ...
+LEAF_LIGHT = (0.33, 0.55, 0.10)
+LEAF_COOL = (0.24, 0.46, 0.16)  # ... and a little of this by its second jitter
+LEAF_YELLOW = (0.88, 0.70, 0.12)  # autumn, in this order
+LEAF_ORANGE = (0.92, 0.40, 0.06)
+LEAF_RED = (0.70, 0.10, 0.06)
+LEAF_BROWN = (0.40, 0.17, 0.06)
+PETIOLE = (0.55, 0.28, 0.14)  # mixed 40 % into the leaf's colour
+BLADE_BASE = (0.10, 0.24, 0.05)
+BLADE_TIP = (0.42, 0.58, 0.16)
+BLADE_TIP_DRY = (0.55, 0.60, 0.22)
+BLADE_WINTER = (0.62, 0.55, 0.32)
+
+#: Every colour above, by name (the shader's constants).
+COLOURS = {name: value for name, value in globals().items() if name.isupper() and isinstance(value, tuple)}
