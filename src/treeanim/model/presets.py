@@ -20,7 +20,7 @@ from .errors import PresetError
 from .generate import BeamSpec, CrownSpec, GrassSpec, LaminaSpec, LeafSpec, LevelSpec, TreeSpec, generate
 from .look import Bark
 from .params import SCALAR_KEYS, SCALAR_MAX, ModeRange, PhysicsParams, SeasonModes
-from .tree import Tree
+from .tree import BRANCH_SIDES, Tree, curve_bands
 
 #: Allowed ranges of numeric keys (inclusive); keys not listed must be finite and >= 0.
 BOUNDS: dict[str, tuple[float, float]] = {
@@ -343,6 +343,11 @@ def _tree_spec(data: dict, source: str) -> TreeSpec:
     return TreeSpec(**kw)
 
 
+def _tube_triangles(segments):
+    """Triangles of a branch tube of ``segments`` segments (:meth:`Tree.triangles_per_object`)."""
+    return 2 * BRANCH_SIDES * (segments * curve_bands(np.asarray(segments) + 1) + 1)
+
+
 def estimate_size(spec: TreeSpec) -> dict[str, float]:
     """An upper bound of the objects, nodes and triangles ``spec`` builds, from its counts alone
     (before building anything: crown pruning and rounding only remove).
@@ -358,14 +363,13 @@ def estimate_size(spec: TreeSpec) -> dict[str, float]:
                 "keys": "grass.count, grass.segments"}
     if spec.type == "beam":
         n = spec.beam.segments
-        return {"objects": 1, "nodes": n + 1, "triangles": 32 * 4 * n, "keys": "beam.segments"}
-    objects = nodes = triangles = 0.0
-    per_level = 1.0
-    for lv in spec.levels:  # the trunk, then each level: so many children per branch above
-        per_level = per_level * (lv.count if lv is not spec.levels[0] else 1.0)
-        objects += per_level
-        nodes += per_level * (lv.segments + 1)
-        triangles += per_level * 32 * 4 * lv.segments  # rings of a curved tube, at least four bands
+        return {"objects": 1, "nodes": n + 1, "triangles": _tube_triangles(n), "keys": "beam.segments"}
+    # The trunk, then each level: so many children per branch of the level above.
+    per_level = np.cumprod([1.0] + [lv.count for lv in spec.levels[1:]])
+    segments = np.array([lv.segments for lv in spec.levels])
+    objects = float(per_level.sum())
+    nodes = float(per_level @ (segments + 1))
+    triangles = float(per_level @ _tube_triangles(segments))
     lf = spec.leaves
     if lf.count:
         la = spec.lamina
