@@ -87,16 +87,12 @@ def _size(text: str) -> tuple[int, int]:
     return _checked(parse_size)(text)
 
 
-def _vector(what: str):
-    from treeanim.scripted import parse_vector
+def _vector(what: str, force: bool = False):
+    """An argparse type: X,Y,Z (a force: of at most the simulation's largest pull)."""
+    from treeanim.scripted import parse_force, parse_vector
 
-    return _checked(lambda text: parse_vector(text, what))
-
-
-def _force(text: str):
-    from treeanim.scripted import parse_force
-
-    return _checked(lambda t: parse_force(t, "force"))(text)
+    parse = parse_force if force else parse_vector
+    return _checked(lambda text: parse(text, what))
 
 
 def _pull(text: str):
@@ -529,7 +525,7 @@ def build_parser() -> argparse.ArgumentParser:
         "second: the Lissajous / harmonograph trace of the paper's Figs. 1 and 4.")
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
     p.add_argument("--object", type=int, default=0, metavar="I", help="object index (default 0, e.g. the beam)")
-    p.add_argument("--pull", type=_force, required=True, metavar="FX,FY,FZ",
+    p.add_argument("--pull", type=_vector("force", force=True), required=True, metavar="FX,FY,FZ",
                    help="world force on the tip in newtons, e.g. 1.5,0,1.2 for the beam")
     p.add_argument("--hold", type=_positive(float), default=2.0, metavar="SECONDS",
                    help="how long the pull is held before release (default 2)")

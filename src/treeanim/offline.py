@@ -130,9 +130,9 @@ def check_file(path: Path, text: str) -> None:
         most = os.pathconf(folder, "PC_NAME_MAX")
     except (OSError, ValueError):
         most = 255
-    if len(os.fsencode(path.name)) > most:
-        raise InputError(f"--out {text[:60]}…: the file name is {len(os.fsencode(path.name))} bytes long; "
-                         f"at most {most}")
+    size = len(os.fsencode(path.name))
+    if size > most:
+        raise InputError(f"--out {text[:60]}…: the file name is {size} bytes long; at most {most}")
     if _exists(path, folder=True):
         raise InputError(f"--out {text}: {path} is a folder; name a file")
 
@@ -149,10 +149,11 @@ def render_target(text: str) -> Target:
     if not text.strip():
         raise InputError("--out is empty")
     path = Path(text)
-    if text.endswith(("/", os.sep)) or _exists(path, folder=True) or (path.suffix == "" and not _exists(path)):
-        if _exists(path) and not _exists(path, folder=True):
+    exists, is_folder = _exists(path), _exists(path, folder=True)
+    if text.endswith(("/", os.sep)) or is_folder or (path.suffix == "" and not exists):
+        if exists and not is_folder:
             raise InputError(f"--out {text}: {path} exists and is not a folder")
-        if _exists(path, folder=True):
+        if is_folder:
             check_folder(path, text)
         else:
             check_folder(path.parent, text)
