@@ -56,6 +56,27 @@ def pytest_collection_modifyitems(items):
             item.add_marker(pytest.mark.slow)
 
 
+def rot(axis, angle):
+    """The rotation matrix of ``angle`` radians about ``axis`` (the identity for a zero axis)."""
+    axis = np.asarray(axis, float)
+    n = np.linalg.norm(axis)
+    if n == 0:
+        return np.eye(3)
+    axis = axis / n
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+def identity(tree):
+    """(N, 3, 3) identity rotations: every node of ``tree`` at rest."""
+    return np.broadcast_to(np.eye(3), (tree.n_nodes, 3, 3))
+
+
+def rest_pose(tree):
+    """``tree``'s rest pose as a renderer takes it: (positions, rotations)."""
+    return tree.rest_positions, identity(tree)
+
+
 class Uniform:
     """A steady uniform wind U (m/s) everywhere (only ``sample`` is needed)."""
 

@@ -8,20 +8,10 @@ import numpy as np
 import pytest
 
 import treeanim as ta
-from conftest import small_tree, twig_tree
+from conftest import identity, rot, small_tree, twig_tree
 from treeanim.model.build import ObjectSpec, assemble
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.mesh import MATERIAL_BARK, TreeMesh, build_mesh
-
-
-def rot(axis, angle):
-    axis = np.asarray(axis, float) / np.linalg.norm(axis)
-    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
-
-
-def identity(tree):
-    return np.broadcast_to(np.eye(3), (tree.n_nodes, 3, 3))
 
 
 def fork_tree():

@@ -5,8 +5,8 @@ import dataclasses
 import numpy as np
 import pytest
 from scipy.optimize import brentq
-from scipy.spatial.transform import Rotation
 
+from conftest import rot
 from treeanim.model.build import ObjectSpec, assemble
 from treeanim.model.params import PhysicsParams
 from treeanim.physics.bending import rest_frames, solve_bend_angle
@@ -51,12 +51,6 @@ def test_bend_angle_small_load_is_linear_and_large_load_aligns():
 
 
 # ---------------------------------------------------------------------------- one beam vs reference
-def rot(axis, angle):
-    axis = np.asarray(axis, float)
-    n = np.linalg.norm(axis)
-    if n == 0 or angle == 0:
-        return np.eye(3)
-    return Rotation.from_rotvec(axis / n * angle).as_matrix()
 
 
 def reference_beam(points, diam, F, gamma, v, ei_max, m, dmax):

@@ -8,7 +8,7 @@ import moderngl
 import numpy as np
 import pytest
 
-from conftest import grass_patch, small_tree
+from conftest import grass_patch, rest_pose, rot, small_tree
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.offscreen import OffscreenRenderer, create_egl_context
 from treeanim.render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
@@ -16,16 +16,6 @@ from treeanim.render.renderer import Renderer
 from treeanim.render.shaders import shader_source
 
 W, H = 160, 120
-
-
-def rot(axis, angle):
-    axis = np.asarray(axis, float) / np.linalg.norm(axis)
-    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
-
-
-def rest(tree):
-    return tree.rest_positions, np.broadcast_to(np.eye(3), (tree.n_nodes, 3, 3))
 
 
 def framed_camera(renderer, aspect=W / H, **kw):
@@ -47,9 +37,9 @@ def scene(offscreen, tree):
 
 
 def background(off, r, cam, season=0.0):
-    off.update(*rest(r.tree), present=np.zeros(r.tree.n_objects, bool))
+    off.update(*rest_pose(r.tree), present=np.zeros(r.tree.n_objects, bool))
     img = off.render(cam, season=season)
-    off.update(*rest(r.tree))
+    off.update(*rest_pose(r.tree))
     return img
 
 
@@ -110,7 +100,7 @@ def test_pose_moves_pixels_and_matches_a_rotated_tree(offscreen):
     rest_img = offscreen.render(cam)
     bg = background(offscreen, r, cam)
     R = rot((0, 0, 1), -0.35)  # lean towards +x (to the right on screen)
-    P, I = rest(tree)
+    P, I = rest_pose(tree)
     offscreen.update(P @ R.T, np.broadcast_to(R, I.shape))
     bent = offscreen.render(cam)
     m_rest, m_bent = changed(rest_img, bg), changed(bent, bg)
@@ -142,7 +132,7 @@ def test_inner_joint_bend_keeps_the_tube_closed(offscreen):
     tree = beam_tree()
     r = offscreen.load(tree)
     cam = framed_camera(r)
-    P, I = rest(tree)
+    P, I = rest_pose(tree)
     j = 4
     R = rot((0, 0, 1), -0.8)
     pos = P.copy()
@@ -202,9 +192,9 @@ def test_a_hard_pulled_one_segment_twig_is_drawn_as_a_curve(offscreen):
 # ------------------------------------------------------------------------------ leaves, season
 def bare(off, r, cam, season=0.0):
     """The tree with every leaf hidden."""
-    off.update(*rest(r.tree), present=r.tree.kind != "leaf")
+    off.update(*rest_pose(r.tree), present=r.tree.kind != "leaf")
     img = off.render(cam, season=season)
-    off.update(*rest(r.tree))
+    off.update(*rest_pose(r.tree))
     return img
 
 
@@ -218,17 +208,17 @@ def test_hidden_leaves_show_far_fewer_leaf_pixels(scene):
     tree = r.tree
     bg = background(off, r, cam)
     no_leaves = bare(off, r, cam)
-    off.update(*rest(tree))  # present from the season
+    off.update(*rest_pose(tree))  # present from the season
     summer = leaf_pixels(off.render(cam, season=0.0), no_leaves)
-    off.update(*rest(tree), present=tree.leaves_present(1.0))
+    off.update(*rest_pose(tree), present=tree.leaves_present(1.0))
     winter_mask = leaf_pixels(off.render(cam, season=0.0), no_leaves)
-    off.update(*rest(tree))
+    off.update(*rest_pose(tree))
     winter_season = leaf_pixels(off.render(cam, season=1.0), bare(off, r, cam, season=1.0))
     assert len(summer) > 200
     assert len(winter_mask) < 0.25 * len(summer), (len(winter_mask), len(summer))
     assert len(winter_season) < 0.25 * len(summer), (len(winter_season), len(summer))
     # Hiding everything leaves only the background.
-    off.update(*rest(tree), present=np.zeros(tree.n_objects, bool))
+    off.update(*rest_pose(tree), present=np.zeros(tree.n_objects, bool))
     assert not changed(off.render(cam), bg).any()
 
 
@@ -239,7 +229,7 @@ def test_season_turns_leaves_from_green_to_autumn_colours(scene):
     ratios = []
     for season in (0.0, 0.35, 0.7):
         no_leaves = bare(off, r, cam, season)
-        off.update(*rest(tree), present=everything)
+        off.update(*rest_pose(tree), present=everything)
         px = leaf_pixels(off.render(cam, season=season), no_leaves)
         assert len(px) > 200
         ratios.append(float(np.mean(px[:, 0] / np.maximum(px[:, 1], 1.0))))
@@ -261,9 +251,9 @@ def test_blades_render(offscreen):
 def test_highlight_tints_the_object(scene):
     off, r, cam = scene
     base = off.render(cam)
-    off.update(*rest(r.tree), highlight=0)  # the trunk
+    off.update(*rest_pose(r.tree), highlight=0)  # the trunk
     lit = off.render(cam)
-    off.update(*rest(r.tree))
+    off.update(*rest_pose(r.tree))
     diff = changed(lit, base)
     assert diff.sum() > 30
     px = lit[diff].astype(float)
@@ -302,7 +292,7 @@ def test_each_overlay_adds_pixels(scene, name):
 def test_frames_overlay_follows_the_pose(scene):
     off, r, cam = scene
     ov = LocalFrames(kinds=("branch",))
-    P, I = rest(r.tree)
+    P, I = rest_pose(r.tree)
     a = off.render(cam, overlays=[ov])
     R = rot((0, 0, 1), 0.4)
     off.update(P @ R.T, np.broadcast_to(R, I.shape))
@@ -347,7 +337,7 @@ def test_renderer_on_a_plain_context_and_release(tree):
         r = Renderer(ctx, tree)
         fbo = ctx.simple_framebuffer((W, H))
         cam = framed_camera(r)
-        r.update(*rest(tree))
+        r.update(*rest_pose(tree))
         r.draw(cam, W, H, framebuffer=fbo, overlays=[LocalFrames()])
         img = np.frombuffer(fbo.read(components=3), np.uint8).reshape(H, W, 3)
         assert img.std() > 5

@@ -9,14 +9,11 @@ import numpy as np
 import pytest
 
 import treeanim as ta
+from conftest import rest_pose
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.renderer import Scene
 
 W, H = 200, 150
-
-
-def rest(tree):
-    return tree.rest_positions, np.broadcast_to(np.eye(3), (tree.n_nodes, 3, 3))
 
 
 def luminance(img):
@@ -26,7 +23,7 @@ def luminance(img):
 def render(off, tree, cam, present=None, **scene):
     off.resize(W, H)
     off.load(tree, scene=Scene(**scene))
-    off.update(*rest(tree), present=present)
+    off.update(*rest_pose(tree), present=present)
     return off.render(cam)
 
 

@@ -7,7 +7,7 @@ import re
 import numpy as np
 import pytest
 
-from conftest import beam_tree, grass_patch, small_tree, twig_tree
+from conftest import beam_tree, grass_patch, identity, rot, small_tree, twig_tree
 from treeanim.model.geometry import unit as _unit
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.mesh import (
@@ -22,16 +22,6 @@ from treeanim.render.mesh import (
 )
 from treeanim.render.picking import Picker, pick
 from treeanim.render.shaders import shader_source
-
-
-def rot(axis, angle):
-    axis = np.asarray(axis, float) / np.linalg.norm(axis)
-    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]])
-    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
-
-
-def identity(tree):
-    return np.broadcast_to(np.eye(3), (tree.n_nodes, 3, 3))
 
 
 @pytest.fixture(scope="module", params=["tree", "grass", "beam"])
