@@ -18,6 +18,8 @@ uniform float u_pixels_per_metre;  // at one metre from the eye: a length's size
 uniform float u_thin_pixels;       // twigs and blades with a half width below this (px) get soft edges
 uniform vec3 u_camera_pos;
 
+const float THIN_DEPTH = 0.999999;  // where thin twigs are drawn in the depth range (NDC z)
+
 out vec3 v_world;
 out vec3 v_normal;
 out vec3 v_albedo;
@@ -93,6 +95,14 @@ void main() {
         }
     }
     gl_Position = u_view_proj * vec4(v_world, 1.0);
+    if (v_half >= 0.0 && v_material == BARK) {
+        // A faint twig writes depth like any surface, so a leaf drawn after it, behind it,
+        // would be kept out and the sky show through the twig (streaks across a crown in a
+        // gale). Drawn at the back of the depth range instead, it loses to every solid
+        // surface, whatever the order: over sky, ground and its own wood it shows, blended;
+        // among leaves it fades into them.
+        gl_Position.z = THIN_DEPTH * gl_Position.w;
+    }
 
     float jitter = in_extra.y;
     float key = in_extra.w;

@@ -189,3 +189,31 @@ def test_the_bark_takes_its_species_colour(offscreen):
     grey, brown = means
     assert abs(grey[0] - grey[2]) < 12  # grey stays grey under the lights
     assert brown[0] - brown[2] > 40 and brown[0] - brown[2] > grey[0] - grey[2] + 30
+
+
+def test_a_thin_twig_in_front_never_opens_a_hole_in_what_is_behind_it(offscreen):
+    """A 0.2 px twig drawn before a thick trunk behind it: its faint pixels must not keep the
+    trunk out (the sky showing through along the twig, as it did across a gale's crown)."""
+    from treeanim.model.build import ObjectSpec, assemble
+
+    d = np.array([np.cos(np.radians(40)), np.sin(np.radians(40)), 0.0])
+    twig = np.outer(np.linspace(0.0, 3.0, 4), d) + (-1.2, 0.2, 0.5)
+    trunk = np.outer(np.linspace(0.0, 3.0, 3), (0.0, 1.0, 0.0)) + (0.0, 0.0, -0.5)
+    tree = assemble([ObjectSpec(twig, np.full(4, 0.01), "branch", 1),  # drawn first
+                     ObjectSpec(trunk, np.full(3, 1.2), "branch", 1)], name="twig_before_trunk")
+    cam = OrbitCamera(target=(0.0, 1.2, 0.0), distance=10.0, elevation=0.0)
+    off = type(offscreen)(W, H, samples=0, ctx=offscreen.ctx)
+    try:
+        both = luminance(render(off, tree, cam, shadow=False))
+        twig_only = luminance(render(off, tree, cam, present=np.array([True, False]), shadow=False))
+        trunk_only = luminance(render(off, tree, cam, present=np.array([False, True]), shadow=False))
+        sky_only = luminance(render(off, tree, cam, present=np.array([False, False]), shadow=False))
+    finally:
+        off.release()
+    on_twig = np.abs(twig_only - sky_only) > 2  # where the twig is ...
+    over_trunk = np.abs(trunk_only - sky_only) > 40  # ... across the trunk
+    where = on_twig & over_trunk
+    assert where.sum() > 10
+    # There the picture stays the trunk's, far nearer it than the sky.
+    assert np.mean(np.abs(both - trunk_only)[where]) < 0.4 * np.mean(np.abs(sky_only - trunk_only)[where])
+    assert np.all(np.abs(both - twig_only)[on_twig & ~over_trunk] < 3)  # and over the sky the twig shows
