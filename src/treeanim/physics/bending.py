@@ -274,18 +274,33 @@ class BendingPlan:
         φ/θ₀, the warm start of the next solve.
     """
 
-    def __init__(self, tree, frames: np.ndarray):
+    def __init__(self, tree, frames: np.ndarray, hinge: np.ndarray | None = None):
         X = np.asarray(tree.rest_positions, float)
         start = np.asarray(tree.object_start)
         nseg = np.asarray(tree.object_count) - 1
-        self.M = len(start)
+        self.M = M = len(start)
         self.N = len(X)
-        self.order = np.argsort(-nseg, kind="stable")
-        max_n = int(nseg.max()) if self.M else 0
-        self.counts = [int(np.count_nonzero(nseg > i)) for i in range(max_n)]
+        self.hinge = hinge = np.zeros(M, bool) if hinge is None else np.asarray(hinge, bool) & (nseg > 1)
+        eff = np.where(hinge, 1, nseg)  # segments solved by Eq. 8: a hinge object's first only
+        self.order = np.lexsort((-nseg, -eff))  # stable: by decreasing eff, then decreasing nseg
+        max_n = int(nseg.max()) if M else 0
+        n_hinged = int(hinge.sum())
+        self.hinge_start = h0 = M - int(np.count_nonzero(eff == 1)) if n_hinged else M
+        # Block i: segment i of the solved objects having one (a prefix of ``order``), then of
+        # the hinge objects having one (a prefix of their run ``order[h0:h0 + n_hinged]``).
+        self.solved = [int(np.count_nonzero(eff > i)) for i in range(max_n)]
+        hinged = [0] + [int(np.count_nonzero(hinge & (nseg > i))) for i in range(1, max_n)]
+        block_objs = [np.concatenate([self.order[:ks], self.order[h0:h0 + kh]]) for ks, kh in zip(self.solved, hinged)]
+        self.counts = [len(b) for b in block_objs]
         self.offsets = [int(x) for x in np.concatenate([[0], np.cumsum(self.counts)])]
         self.n_flat = S = self.offsets[-1]
-        R0 = np.asarray(frames, float)[self.order]  # (M, 3, 3) local → world rest, in order
+        self.seg_obj = np.concatenate(block_objs) if S else np.zeros(0, np.int64)
+        self.seg_index = np.repeat(np.arange(max_n), self.counts)
+        # Where block i's hinge entries find their previous segment in block i − 1.
+        self.hinge_prev = [h0 if i == 1 else self.solved[i - 1] for i in range(max_n)]
+        self.hinge_share = np.ones(S)  # the share of its object's hinge angle turned by each segment's end
+        self.n_solved = sum(self.solved)
+        R = np.asarray(frames, float)  # (M, 3, 3) local → world rest
 
         flat_of_node = np.empty(self.N, np.int64)
         ofs_of_node = np.full(self.N, S, np.int64)
@@ -297,8 +312,9 @@ class BendingPlan:
         diam = np.asarray(tree.node_diameter, float)
         d_root = diam[start]
         d_tip = diam[start + nseg]
-        for i, K in enumerate(self.counts):
-            objs = self.order[:K]
+        self.rest_o = np.zeros((3, S + 1))  # rest offsets from the object's base, as the bent
+        for i, objs in enumerate(block_objs):
+            K = len(objs)
             nodes = start[objs] + i
             flat = self.offsets[i] + np.arange(K)
             flat_of_node[nodes] = flat
@@ -306,7 +322,7 @@ class BendingPlan:
             last = nseg[objs] == i + 1
             flat_of_node[nodes[last] + 1] = flat[last]  # tip nodes: their last segment
             sw = X[nodes + 1] - X[nodes]
-            s = np.einsum("kji,kj->ik", R0[:K], sw)  # Rᵀ s: local (u, v, w) components
+            s = np.einsum("kji,kj->ik", R[objs], sw)  # Rᵀ s: local (u, v, w) components
             if i == 0:  # the first segment lies on v by definition (Eq. 1)
                 s = np.stack([np.zeros(K), np.linalg.norm(sw, axis=1), np.zeros(K)])
             s = np.ascontiguousarray(s)
@@ -317,17 +333,18 @@ class BendingPlan:
             self.frac_len.append(self.frac[-1] * np.sqrt(self.seg_len2[-1]))  # |Fᵢ||sᵢ| / |F|
             t = i / np.maximum(n - 1, 1)
             self.taper.append(d_root[objs] - (d_root[objs] - d_tip[objs]) * t)
+            self.rest_o[:, flat] = s if i == 0 else self.rest_o[:, self._prev_flat(i)] + s
         self.max_seg = max((float(np.sqrt(x.max())) for x in self.seg_len2 if len(x)), default=0.0)
         self.flat_of_node = flat_of_node
         self.ofs_of_node = ofs_of_node
         self.ws = Workspace()
         self.d_max = float(diam.max()) if self.N else 1.0
-        # Rest offsets of every node from its object's base (local), accumulated like the bent.
-        self.rest_o = np.zeros((3, S + 1))
-        for i, s in enumerate(self.seg):
-            a, b = self.offsets[i], self.offsets[i + 1]
-            self.rest_o[:, a:b] = s if i == 0 else self.rest_o[:, self.offsets[i - 1]:self.offsets[i - 1] + (b - a)] + s
         self.reset()
+
+    def _prev_flat(self, i: int) -> np.ndarray:
+        """Flat slots of the previous segment of each entry of block i >= 1."""
+        ks, kh = self.solved[i], self.counts[i] - self.solved[i]
+        return self.offsets[i - 1] + np.concatenate([np.arange(ks), self.hinge_prev[i] + np.arange(kh)])
 
     def reset(self) -> None:
         """Back to the unbent rest state."""
@@ -412,17 +429,20 @@ class BendingPlan:
         safe = not ((fmax * self.max_seg if blocks is None else nmax) > _SQUARE_SAFE)
         prev = None
         prev_o = None
-        per_segment = len(gamma) == self.n_flat
-        for i, K in enumerate(self.counts):
+        per_segment = len(gamma) == self.n_solved
+        h0, H = self.hinge_start, self.counts[1] - self.solved[1] if len(self.counts) > 1 else 0
+        ta = 0  # start of block i among the solved segments (``gamma`` per segment)
+        for i, K in enumerate(self.solved):
             a, b = self.offsets[i], self.offsets[i + 1]
-            tw = slice(a, b) if per_segment else slice(0, K)
+            tw = slice(ta, ta + K) if per_segment else slice(0, K)
+            ta += K
             if blocks is None:
                 fu = mul(Fu[:K], self.frac[i], out=ws.get("fu", (K,)))  # Eq. 7
                 fw = mul(Fw[:K], self.frac[i], out=ws.get("fw", (K,)))
                 fv = None
                 amag = mul(Fmag[:K], self.frac_len[i], out=ws.get("amag", (K,)))  # a = |Fᵢ||sᵢ|
             else:
-                fu, fv, fw, amag, r = blocks[i]
+                fu, fv, fw, amag, r = (x[:K] for x in blocks[i])
             tmp = ws.get("tmp", (K,))
             c_, s_ = cv[tw], sv[tw]
             sp, T, n, nn, dot, theta0 = self._moment(i, K, (fu, fv, fw), prev, c_, s_, safe, tmp)
@@ -433,7 +453,7 @@ class BendingPlan:
                 # There a·sin θ₀ = |N|·ℓ/|s| (a = |F|·ℓ, sin θ₀ = |N|/(|F||s|)).
                 np.multiply(nn, r, out=amag, where=dot < 0.0)
                 np.minimum(theta0, 0.5 * np.pi, out=theta0)
-            phi, t = solve_bend_angle(nn, dot, k[i], theta0, mul(rho_start[a:b], theta0),
+            phi, t = solve_bend_angle(nn, dot, k[i][:K], theta0, mul(rho_start[a:a + K], theta0),
                                       a=amag)  # Eqs. 8–9
             # No bend where the force is zero or (anti)parallel to the segment.
             ok = nn > mul(amag, 1e-12, out=ws.get("eps", (K,)))
@@ -441,16 +461,54 @@ class BendingPlan:
             t *= ok
             inv = np.maximum(nn, 1e-300)  # 1/|N|; where no bend, t = 0 zeroes its uses
             np.divide(1.0, inv, out=inv)
-            self.phi[a:b] = phi
-            np.divide(phi, np.maximum(theta0, 1e-300), out=self.rho[a:b])
-            dst = self.q[:, a:b]
+            self.phi[a:a + K] = phi
+            np.divide(phi, np.maximum(theta0, 1e-300), out=self.rho[a:a + K])
+            if i == 0 and H:  # the hinges' first segment turns by its share of the hinge angle
+                hs = slice(h0, h0 + H)
+                self._hinge = (phi[hs].copy(), n[0][hs] * inv[hs], n[2][hs] * inv[hs], c_[hs], s_[hs])
+                t[hs] = np.tan(0.5 * self.hinge_share[hs] * phi[hs])
+            dst = self.q[:, a:a + K]
             t2, ch2 = self._rotation(i, K, n, t, inv, T, c_, s_, dst, tmp)
-            oo = self.o[:, a:b]
+            oo = self.o[:, a:a + K]
             self._bent_segment(i, sp, (fu, fv, fw), t, t2, ch2, inv, dot, oo, tmp)
             if i > 0:
                 oo += prev_o[:, :K]  # accumulate along the object
-            prev = dst
-            prev_o = oo
+                if b > a + K:
+                    self._hinged(i, a + K, b, prev_o)
+            prev = self.q[:, a:b]
+            prev_o = self.o[:, a:b]
+
+    def _hinged(self, i, lo, hi, prev_o) -> None:
+        """Segment i >= 1 of the hinge objects, in slots ``lo:hi``. Their bend (angle φ about N̂)
+        and twist γ were solved once, at the first joint; each segment turns by a fixed share
+        cᵢ of φ about the same axis, so Cᵢ = Rot(N̂, (c₀ + … + cᵢ)φ) ⊗ Rot(v, −γ) in closed
+        form, and oᵢ = oᵢ₋₁ + Cᵢsᵢ."""
+        K = hi - lo
+        p0 = self.hinge_prev[i]
+        phi, n0, n2, c, s = (x[:K] for x in self._hinge)
+        half = np.multiply(self.hinge_share[lo:hi], phi, out=self.phi[lo:hi])
+        half = 0.5 * half
+        sh = np.sin(half)
+        a0, a1, a3 = np.cos(half), sh * n0, sh * n2
+        dst = self.q[:, lo:hi]  # (a0, a1, 0, a3) ⊗ (c, 0, s, 0)
+        np.multiply(a0, c, out=dst[0])
+        np.multiply(a1, c, out=dst[1])
+        dst[1] -= a3 * s
+        np.multiply(a0, s, out=dst[2])
+        np.multiply(a3, c, out=dst[3])
+        dst[3] += a1 * s
+        oo = self.o[:, lo:hi]
+        qrot(dst, self.seg[i][:, self.solved[i]:], out=oo, ws=self.ws)
+        oo += prev_o[:, p0:p0 + K]
+
+    def _twisted(self, C, c_, s_):
+        """T = Rot(v, −γ) ⊗ C = cos(γ/2)·C + sin(γ/2)·(−C_y, C_z, C_w, −C_x) (c_, s_: the halves)."""
+        T = self.ws.get("T", C.shape)
+        np.take(C, _SWAP, axis=0, out=T)
+        T *= _SWAP_SIGN
+        T *= s_
+        T += np.multiply(C, c_, out=self.ws.get("T2", C.shape))
+        return T
 
     def _moment(self, i, K, f, prev, c_, s_, safe, tmp):
         """Segment i twisted by Rot(v, −γ) after its parent's rotation: the moment
@@ -460,7 +518,7 @@ class BendingPlan:
         (None for the first segment, whose s′ = s₀ = (0, l, 0) and n1 = None)."""
         mul, ws = np.multiply, self.ws
         fu, fv, fw = f
-        s = self.seg[i]
+        s = self.seg[i][:, :K]
         if i == 0:
             # s′ = s₀ = (0, l, 0):  N = s′ × F = (l·F_w, 0, −l·F_u), s′·F = l·F_v
             l = s[1]
@@ -477,13 +535,7 @@ class BendingPlan:
                 return s, None, (n0, None, n2), nn, np.zeros(K), np.full(K, 0.5 * np.pi)
             dot = mul(l, fv)
             return s, None, (n0, None, n2), nn, dot, np.arctan2(nn, dot)
-        # T = Rot(v, −γ) ⊗ C_{i−1}:  cv·C + sv·(−C_y, C_z, C_w, −C_x)
-        C = prev[:, :K]
-        T = ws.get("T", (4, K))
-        np.take(C, _SWAP, axis=0, out=T)
-        T *= _SWAP_SIGN
-        T *= s_
-        T += mul(C, c_, out=ws.get("T2", (4, K)))
+        T = self._twisted(prev[:, :K], c_, s_)  # Rot(v, −γ) ⊗ C_{i−1}
         sp = qrot(T, s, out=ws.get("sp", (3, K)), ws=ws)
         sx, sy, sz = sp
         n0 = mul(sy, fw)
@@ -548,13 +600,14 @@ class BendingPlan:
         s_phi = mul(t, ch2)
         s_phi *= inv
         s_phi += s_phi
-        s_phi *= self.seg_len2[i]  # sin φ · |s|² / |N|
+        l2 = self.seg_len2[i][:len(t)]
+        s_phi *= l2  # sin φ · |s|² / |N|
         mul(sp, c_phi, out=oo)
         oo[0] += mul(fu, s_phi, out=tmp)
         oo[2] += mul(fw, s_phi, out=tmp)
         if fv is not None:
             oo[1] += mul(fv, s_phi, out=tmp)
         if i > 0 or fv is not None:
-            s_phi /= self.seg_len2[i]
+            s_phi /= l2
             s_phi *= dot
             oo -= mul(sp, s_phi, out=self.ws.get("v3", sp.shape))

@@ -104,48 +104,59 @@ class LoadPath:
         self.Xb = np.ascontiguousarray(Xb.T)
         self.Xl = np.ascontiguousarray(np.asarray(load_point, float).T)
         self.x_load = local(np.arange(M), self.Xl.T)
-        # Flat segments in the bending pass's order (block i: segment i of bplan.order[:K_i]).
-        S = bplan.n_flat
-        seg_obj = np.concatenate([bplan.order[:K] for K in bplan.counts]) if S else np.zeros(0, int)
-        seg_i = np.concatenate([np.full(K, i) for i, K in enumerate(bplan.counts)]) if S else np.zeros(0, int)
+        # Flat segments in the bending pass's order (block i: segment i of the objects having one).
+        seg_obj, seg_i = bplan.seg_obj, bplan.seg_index
         node = start[seg_obj] + seg_i
-        self.seg_obj, self.seg_node = seg_obj, node
-        self.blocks = list(zip(bplan.offsets[:-1], bplan.offsets[1:]))
+        hinged = bplan.hinge[seg_obj]
+        self.hinge_first = np.flatnonzero(hinged & (seg_i == 0))
+        self.hinge_rest = np.flatnonzero(hinged & (seg_i > 0))
         xj = local(seg_obj, X[node])
         s = local(seg_obj, X[node + 1]) - xj
-        self.h = np.linalg.norm(s, axis=0)
-        s_hat = s / np.maximum(self.h, 1e-300)
-        self.seg_vec = s
-        self.lever_vec = self.x_load[:, seg_obj] - xj  # joint → load point
-        self.lever = np.maximum(np.linalg.norm(self.lever_vec, axis=0), 1e-12)
+        h = np.linalg.norm(s, axis=0)
+        lever_vec = self.x_load[:, seg_obj] - xj  # joint → load point
+        lever = np.maximum(np.linalg.norm(lever_vec, axis=0), 1e-12)
         self.lever0 = np.maximum(np.linalg.norm(self.x_load, axis=0), 1e-12)
-        self.lever_per_len = self.lever / np.maximum(self.h, 1e-300)  # a·sin θ₀ = |N|·ℓ/|s|
+        diam = np.asarray(tree.node_diameter, float)
+        # Every segment's geometry, for the stiffness (:meth:`derive`).
+        self.geo = (seg_obj, node, s, h, lever_vec, lever, diam[node], diam[node + 1])
 
         # Own load beyond joint i: a fraction W of it, with first moment A × F about the joint.
         # Branches and blades spread it over their segments by frontal area; a leaf's acts on
         # its lamina, beyond every joint of the petiole.
-        diam = np.asarray(tree.node_diameter, float)
-        self.d0, self.d1 = diam[node], diam[node + 1]
-        area = 0.5 * (self.d0 + self.d1) * self.h
+        area = 0.5 * (diam[node] + diam[node + 1]) * h
         w = area / np.maximum(np.bincount(seg_obj, area, M)[seg_obj], 1e-300)
         W = self._suffix(w[None], node, start, count)[0]
         A = self._suffix(w * (xj + 0.5 * s), node, start, count) - W * xj
         leafseg = tree.kind[seg_obj] == "leaf"
         W[leafseg] = 1.0
-        A[:, leafseg] = self.lever_vec[:, leafseg]
+        A[:, leafseg] = lever_vec[:, leafseg]
         A0 = np.empty((3, M))
         A0[:, bplan.order] = A[:, :M]  # block 0 holds segment 0 of every object
         self.Xo = self.Xb + self._to_world(A0)  # where the own load's moment acts
+
+        # Per step only the joints Eq. 8 solves: a hinge object's later joints follow its first.
+        keep = np.flatnonzero(~hinged | (seg_i == 0))
+        self.keep = None if len(keep) == len(seg_obj) else keep
+        if self.keep is not None:
+            seg_obj, node, s, h, lever_vec, lever, W, A, leafseg = (
+                x[..., keep] for x in (seg_obj, node, s, h, lever_vec, lever, W, A, leafseg))
+        S = len(seg_obj)
+        ends = np.cumsum([0] + bplan.solved)
+        self.blocks = list(zip(ends[:-1], ends[1:]))
+        self.seg_obj = seg_obj
+        s_hat = s / np.maximum(h, 1e-300)
+        self.lever = lever
+        self.lever_per_len = lever / np.maximum(h, 1e-300)  # a·sin θ₀ = |N|·ℓ/|s|
         # The equivalent force of Eq. 8 at the lever ℓ for the own load Fo (share W, first
         # moment A × Fo) and the load-point load Ft (lever vector B):
         # (F·ŝ)ŝ + (M × ŝ)/ℓ = Fo·α + (Fo·ŝ)·dA + Ft·β + (Ft·ŝ)·dB.
         # A leaf's own load acts where the load-point load does (W = 1, A = B): the own load's
         # terms are kept as differences from the load point's, on the other segments only.
-        lev = self.lever
+        lev = lever
         self.s_hat = s_hat
-        self.beta = _dot(self.lever_vec, s_hat) / lev
-        self.dB = s_hat - self.lever_vec / lev
-        self.twist_tip = _cross(s_hat, self.lever_vec)  # torsion per unit load: (B × F)·ŝ = F·(ŝ × B)
+        self.beta = _dot(lever_vec, s_hat) / lev
+        self.dB = s_hat - lever_vec / lev
+        self.twist_tip = _cross(s_hat, lever_vec)  # torsion per unit load: (B × F)·ŝ = F·(ŝ × B)
         self.leaf_seg = np.flatnonzero(leafseg)
         spread = np.flatnonzero(~leafseg)
         self.spread = slice(None) if len(spread) == S else spread
@@ -272,36 +283,37 @@ class LoadPath:
         modal : (M,) bool
             Objects whose stiffness :meth:`tune` sets from their modal frequency and mass.
         """
-        so = self.seg_obj
+        so, node, seg_vec, h, lever_vec, lever, d0, d1 = self.geo
         Es = E[so]
         ei0 = np.pi / 64.0 * self.diam_max**4
 
         def EI(t):
-            d = self.d0 + t * (self.d1 - self.d0)
+            d = d0 + t * (d1 - d0)
             return Es * ei0 * np.maximum(d / self.diam_max, 1e-12) ** exponent
 
-        integral = np.zeros_like(self.h)
+        integral = np.zeros_like(h)
         for t, wt in zip(_T, _W):  # ∫_seg ℓ(x)² / EI(x) dx, Simpson
-            r = self.lever_vec - t * self.seg_vec
+            r = lever_vec - t * seg_vec
             integral += wt * np.einsum("ij,ij->j", r, r) / EI(t)
-        integral *= self.h
-        self.k_E = self.lever**2 / np.maximum(integral, 1e-300)
+        integral *= h
+        k_E = lever**2 / np.maximum(integral, 1e-300)
         self.K_E = 1.0 / np.maximum(np.bincount(so, integral, self.M), 1e-300)  # at the load point
         # Each joint twists under the torsion it carries, by c = ∫dx/GJ over its segment
         # (GJ = EI/TWIST_RATIO); Eq. 11's law saturates it at a quarter turn, rate (2/π)c.
-        self.twist_rate = (2.0 / np.pi) * self.h * TWIST_RATIO / EI(0.5)
+        twist_rate = (2.0 / np.pi) * h * TWIST_RATIO / EI(0.5)
+        self._hinges(so, node, integral, lever, k_E, twist_rate)
         self.modal = np.asarray(modal, bool)
         # Where a child's base sits on its parent's deflection: translation ψ and rotation χ per
         # unit deflection of the parent's load point (φᵢ = ℓᵢ/kᵢ per newton there).
-        phi = self.lever / self.k_E
+        phi = integral / lever
         N = self.N
         c1 = np.zeros(N + 1)
         c2 = np.zeros(N + 1)
         arc = np.zeros(N + 1)
-        arc[self.seg_node + 1] = self.h
+        arc[node + 1] = h
         arc = np.cumsum(arc)  # arc length, with jumps between objects that cancel below
-        c1[self.seg_node + 1] = phi
-        c2[self.seg_node + 1] = phi * arc[self.seg_node]
+        c1[node + 1] = phi
+        c2[node + 1] = phi * arc[node]
         c1, c2 = np.cumsum(c1), np.cumsum(c2)
         a = self.att_nodes
         s0 = self.start[self.slot_owner]
@@ -332,6 +344,30 @@ class LoadPath:
         self.m_modal = m_modal
         self.tune(None)
         self._base_map()
+
+    def _hinges(self, so, node, integral, lever, k_E, twist_rate) -> None:
+        """The solved joints' stiffness ``k_E`` and twist rate, and ``hinge_share``.
+
+        A hinge object (a leaf's petiole) bends and twists at its first joint only, which
+        carries the whole object's compliance: k = ℓ₀²·K, and the sum of its joints' twist
+        rates. Joint i of the chain of hinges it stands for would turn by ℓᵢ/kᵢ per newton at the
+        load point, the share cᵢ = (ℓᵢ/kᵢ)·K·ℓ₀ of the hinge's angle: so the load point moves
+        as the chain moves it (Σ cᵢℓᵢ = ℓ₀) and its tip turns as the chain's does.
+        ``hinge_share`` (every flat segment) is the share turned by the end of each segment,
+        c₀ + … + cᵢ (1 elsewhere)."""
+        first, rest = self.hinge_first, self.hinge_rest
+        hinged = np.concatenate([first, rest])
+        ho = so[hinged]
+        share = np.zeros(self.N + 1)
+        share[node[hinged] + 1] = self.lever0[ho] * self.K_E[ho] * integral[hinged] / lever[hinged]
+        share = np.cumsum(share)  # along the nodes: what precedes an object cancels
+        self.hinge_share = np.ones(len(so))
+        self.hinge_share[hinged] = share[node[hinged] + 1] - share[self.start[ho]]
+        k_E, twist_rate = k_E.copy(), twist_rate.copy()
+        k_E[first] = self.lever0[so[first]] ** 2 * self.K_E[so[first]]
+        twist_rate[first] = np.bincount(so[hinged], twist_rate[hinged], self.M)[so[first]]
+        keep = slice(None) if self.keep is None else self.keep
+        self.k_E, self.twist_rate = k_E[keep], twist_rate[keep]
 
     def _base_map(self) -> None:
         """``B`` (2M, 2M): the local (u, w) acceleration of each object's load point per unit

@@ -219,11 +219,11 @@ class Simulation:
         frames = rest_frames(tree)  # (M, 3, 3): columns u, v, w
         u, v, w = frames[:, :, 0], frames[:, :, 1], frames[:, :, 2]
         self._u, self._v, self._w = u.T.copy(), v.T.copy(), w.T.copy()
-        self._bplan = BendingPlan(tree, frames)
-        self._cplan = CompositionPlan(tree, self._bplan, matrix_to_quat(frames))
-
         kind = tree.kind
         leaf = kind == "leaf"
+        # The load path bends a leaf's petiole at one hinge (docs/design.md §12).
+        self._bplan = BendingPlan(tree, frames, hinge=leaf if self._load_path else None)
+        self._cplan = CompositionPlan(tree, self._bplan, matrix_to_quat(frames))
         length = object_lengths(tree)
         dmean = mean_diameters(tree)
         p0pn = X[tip] - X[start]
@@ -316,6 +316,7 @@ class Simulation:
                       p.blade_youngs_modulus)
         self._lp.derive(E, p.stiffness_exponent, self._drag.half_rho_cda, self._drag.foliage,
                         self._mass * self._present, branch)
+        self._bplan.hinge_share = self._lp.hinge_share
         self._mode_snap = None  # the branches' stiffness follows the modes: re-tune on the next step
 
     def _derive_modes(self) -> None:
@@ -506,8 +507,8 @@ class Simulation:
         if on == self._load_path:
             return
         self._load_path = on
-        if on:
-            self._derive_load_path()
+        self._geometry()  # the bending plan differs (hinged petioles)
+        self._derive_physics()
         self._derive_modes()
         time = self._time
         self.reset()
