@@ -298,7 +298,6 @@ class BendingPlan:
         self.seg_index = np.repeat(np.arange(max_n), self.counts)
         # Where block i's hinge entries find their previous segment in block i − 1.
         self.hinge_prev = [h0 if i == 1 else self.solved[i - 1] for i in range(max_n)]
-        self.hinge_share = np.ones(S)  # the share of its object's hinge angle turned by each segment's end
         self.n_solved = sum(self.solved)
         R = np.asarray(frames, float)  # (M, 3, 3) local → world rest
 
@@ -337,9 +336,12 @@ class BendingPlan:
         self.max_seg = max((float(np.sqrt(x.max())) for x in self.seg_len2 if len(x)), default=0.0)
         self.flat_of_node = flat_of_node
         self.ofs_of_node = ofs_of_node
+        self.tip_node = start + nseg
         self.ws = Workspace()
         self.d_max = float(diam.max()) if self.N else 1.0
+        self.n_hinges = n_hinged
         self.reset()
+        self.set_hinge_share(np.ones(S))
 
     def _prev_flat(self, i: int) -> np.ndarray:
         """Flat slots of the previous segment of each entry of block i >= 1."""
@@ -356,6 +358,9 @@ class BendingPlan:
         self.rho = np.zeros(S)
         self.rho_old = np.zeros(S)
         self.rho_start = np.zeros(S)
+        self.hinge_tip_q = np.zeros((4, self.n_hinges))  # each hinge object's last segment (run order)
+        self.hinge_tip_q[0] = 1.0
+        self._hinge = None  # the hinges' last solve, until :meth:`finish` lays out their segments
 
     def stiffness(self, ei_max: float, exponent: float) -> list[np.ndarray]:
         """kᵢ = EI_max (Dᵢ/D_max)^m per block (Eq. 10).
@@ -430,7 +435,7 @@ class BendingPlan:
         prev = None
         prev_o = None
         per_segment = len(gamma) == self.n_solved
-        h0, H = self.hinge_start, self.counts[1] - self.solved[1] if len(self.counts) > 1 else 0
+        h0, H = self.hinge_start, self.n_hinges
         ta = 0  # start of block i among the solved segments (``gamma`` per segment)
         for i, K in enumerate(self.solved):
             a, b = self.offsets[i], self.offsets[i + 1]
@@ -465,7 +470,9 @@ class BendingPlan:
             np.divide(phi, np.maximum(theta0, 1e-300), out=self.rho[a:a + K])
             if i == 0 and H:  # the hinges' first segment turns by its share of the hinge angle
                 hs = slice(h0, h0 + H)
-                self._hinge = (phi[hs].copy(), n[0][hs] * inv[hs], n[2][hs] * inv[hs], c_[hs], s_[hs])
+                self._hinge = (phi[hs].copy(), n[0][hs] * inv[hs], n[2][hs] * inv[hs], c_[hs], s_[hs], theta0[hs])
+                self._hinge_turn(self.hinge_tip_share, self.hinge_tip_q)
+                self.q[:, self.hinge_tip] = self.hinge_tip_q  # the tips now, the rest in :meth:`finish`
                 t[hs] = np.tan(0.5 * self.hinge_share[hs] * phi[hs])
             dst = self.q[:, a:a + K]
             t2, ch2 = self._rotation(i, K, n, t, inv, T, c_, s_, dst, tmp)
@@ -473,33 +480,57 @@ class BendingPlan:
             self._bent_segment(i, sp, (fu, fv, fw), t, t2, ch2, inv, dot, oo, tmp)
             if i > 0:
                 oo += prev_o[:, :K]  # accumulate along the object
-                if b > a + K:
-                    self._hinged(i, a + K, b, prev_o)
             prev = self.q[:, a:b]
             prev_o = self.o[:, a:b]
+
+    def set_hinge_share(self, share: np.ndarray) -> None:
+        """Set ``hinge_share`` (every flat segment): the share of its object's hinge angle
+        turned by the end of each segment (1 where not hinged)."""
+        self.hinge_share = np.asarray(share, float)
+        self.hinge_tip = self.flat_of_node[self.tip_node[self.order[self.hinge_start:self.hinge_start + self.n_hinges]]]
+        self.hinge_tip_share = self.hinge_share[self.hinge_tip]
+
+    def finish(self) -> None:
+        """Lay out the hinge objects' later segments (``q`` and ``o``) from their last solve;
+        :meth:`bend` leaves them, since a step needs only their tips (``hinge_tip_q``)."""
+        if self._hinge is None:
+            return
+        for i in range(1, len(self.counts)):
+            a, b = self.offsets[i] + self.solved[i], self.offsets[i + 1]
+            if b > a:
+                self._hinged(i, a, b, self.o[:, self.offsets[i - 1]:self.offsets[i]])
+        self._hinge = None
+
+    def _hinge_turn(self, share: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """Into ``out`` (4, K), the first K hinges' rotation Rot(N̂, min(share·φ, θ₀)) ⊗ Rot(v, −γ)
+        (the turn stops at the force's direction, θ₀, as a chain of hinges turns each joint
+        towards the force, never past it); returns the turn's angles."""
+        K = out.shape[1]
+        phi, n0, n2, c, s, theta0 = (x[:K] for x in self._hinge)
+        angle = np.multiply(share, phi)
+        np.minimum(angle, theta0, out=angle)
+        half = 0.5 * angle
+        sh = np.sin(half)
+        a0, a1, a3 = np.cos(half), sh * n0, sh * n2
+        np.multiply(a0, c, out=out[0])  # (a0, a1, 0, a3) ⊗ (c, 0, s, 0)
+        np.multiply(a1, c, out=out[1])
+        out[1] -= a3 * s
+        np.multiply(a0, s, out=out[2])
+        np.multiply(a3, c, out=out[3])
+        out[3] += a1 * s
+        return angle
 
     def _hinged(self, i, lo, hi, prev_o) -> None:
         """Segment i >= 1 of the hinge objects, in slots ``lo:hi``. Their bend (angle φ about N̂)
         and twist γ were solved once, at the first joint; each segment turns by a fixed share
         cᵢ of φ about the same axis, so Cᵢ = Rot(N̂, (c₀ + … + cᵢ)φ) ⊗ Rot(v, −γ) in closed
-        form, and oᵢ = oᵢ₋₁ + Cᵢsᵢ."""
-        K = hi - lo
+        form (:meth:`_hinge_turn`), and oᵢ = oᵢ₋₁ + Cᵢsᵢ."""
         p0 = self.hinge_prev[i]
-        phi, n0, n2, c, s = (x[:K] for x in self._hinge)
-        half = np.multiply(self.hinge_share[lo:hi], phi, out=self.phi[lo:hi])
-        half = 0.5 * half
-        sh = np.sin(half)
-        a0, a1, a3 = np.cos(half), sh * n0, sh * n2
-        dst = self.q[:, lo:hi]  # (a0, a1, 0, a3) ⊗ (c, 0, s, 0)
-        np.multiply(a0, c, out=dst[0])
-        np.multiply(a1, c, out=dst[1])
-        dst[1] -= a3 * s
-        np.multiply(a0, s, out=dst[2])
-        np.multiply(a3, c, out=dst[3])
-        dst[3] += a1 * s
+        dst = self.q[:, lo:hi]
+        self.phi[lo:hi] = self._hinge_turn(self.hinge_share[lo:hi], dst)
         oo = self.o[:, lo:hi]
         qrot(dst, self.seg[i][:, self.solved[i]:], out=oo, ws=self.ws)
-        oo += prev_o[:, p0:p0 + K]
+        oo += prev_o[:, p0:p0 + hi - lo]
 
     def _twisted(self, C, c_, s_):
         """T = Rot(v, −γ) ⊗ C = cos(γ/2)·C + sin(γ/2)·(−C_y, C_z, C_w, −C_x) (c_, s_: the halves)."""

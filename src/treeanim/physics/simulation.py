@@ -275,6 +275,8 @@ class Simulation:
         below = np.add.reduceat((arc <= np.repeat(half, count)).astype(np.int64), start)
         j = np.clip(below - 1, 0, count - 2)
         t = np.clip((half - arc[start + j]) / np.maximum(seg[start + j], 1e-300), 0.0, 1.0)
+        hinge = self._bplan.hinge  # a hinged petiole: the end of its first segment (bent each step)
+        j[hinge], t[hinge] = 0, 1.0
         self._mid_a = self._bplan.ofs_of_node[start + j]
         self._mid_b = self._bplan.ofs_of_node[start + j + 1]
         self._mid_t = t
@@ -316,7 +318,7 @@ class Simulation:
                       p.blade_youngs_modulus)
         self._lp.derive(E, p.stiffness_exponent, self._drag.half_rho_cda, self._drag.foliage,
                         self._mass * self._present, branch)
-        self._bplan.hinge_share = self._lp.hinge_share
+        self._bplan.set_hinge_share(self._lp.hinge_share)
         self._mode_snap = None  # the branches' stiffness follows the modes: re-tune on the next step
 
     def _derive_modes(self) -> None:
@@ -575,6 +577,7 @@ class Simulation:
         """
         if self._pos_out is None:
             buf = self._recycled("_pos_buf", (self._N, 3))
+            self._bplan.finish()
             pos = self._cplan.positions(self._bplan.o, self._node_frames(), self._base, out=buf)
             self._fallen.pose(pos)
             pos.setflags(write=False)
@@ -590,6 +593,7 @@ class Simulation:
         """
         if self._rot_out is None:
             buf = self._recycled("_rot_buf", (self._N, 3, 3))
+            self._bplan.finish()
             rot = self._cplan.rotations(self._bplan.q, self._node_frames(), out=buf)
             self._fallen.pose(None, rot)
             rot.setflags(write=False)
@@ -633,6 +637,7 @@ class Simulation:
 
     def _tip_positions(self, objs: np.ndarray) -> np.ndarray:
         """(K, 3) deformed tip positions of objects ``objs`` (no validation)."""
+        self._bplan.finish()
         o = self._bplan.o[:, self._bplan.ofs_of_node[self._tip_node[objs]]]
         return (self._base[:, objs] + qrot(self._frame[:, objs], o)).T
 
