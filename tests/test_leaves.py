@@ -28,14 +28,17 @@ def lamina_normals(name, speed, dt, seconds, warmup=2.0, every=1, **kw):
 
 
 def rotation_per_frame(name, speed, dt, seconds=5.0):
-    """Degrees each leaf's lamina turns from one frame to the next (all leaves, all frames)."""
+    """Degrees each leaf's lamina turns on its twig from one frame to the next (all leaves, all
+    frames): its rotation relative to the twig's segment at its attach node, so the petiole's
+    own bend and twist — not a twig's swing — is measured."""
     tree = ta.load_preset(name)
     sim = ta.Simulation(tree, wind=ta.WindField(speed=speed, direction=(1.0, 0.0, 0.0)))
     tips = leaf_tips(tree)
+    attach = tree.attach_node[tree.kind == "leaf"]
     prev, angles = None, []
     for k in range(int(round(seconds / dt))):
         sim.step(dt)
-        R = sim.rotations[tips]
+        R = np.einsum("kji,kjl->kil", sim.rotations[attach], sim.rotations[tips])
         if prev is not None and k * dt >= 1.0:
             rel = np.einsum("kij,kil->kjl", prev, R)
             c = np.clip((np.trace(rel, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)

@@ -139,3 +139,53 @@ def test_switching_the_model_restarts_from_rest_and_both_run(cherry):
     for _ in range(10):
         sim.step(1 / 30)
     assert np.isfinite(sim.positions).all() and sim.load_path
+
+
+def _leaf_pose(tree, wind_speed, seconds, pulls=(), dt=1 / 60):
+    """Each leaf's petiole on its twig after ``seconds`` in a wind along +x (0: calm) with the
+    given (leaf, force) pulls held: how far its tip has moved from rest (K,) and the rotation
+    of its lamina (K, 3, 3), both relative to the twig's segment at the leaf's attach node."""
+    wind = ta.WindField(speed=wind_speed, direction=(1.0, 0.0, 0.0)) if wind_speed else None
+    sim = ta.Simulation(tree, wind=wind)
+    for i, f in pulls:
+        sim.pull(i, f)
+    for _ in range(int(round(seconds / dt))):
+        sim.step(dt)
+    leaves = np.flatnonzero(tree.kind == "leaf")
+    tips, att = tree.object_start[leaves] + tree.object_count[leaves] - 1, tree.attach_node[leaves]
+    Ra, P, X = sim.rotations[att], sim.positions, tree.rest_positions
+    moved = np.einsum("kji,kj->ki", Ra, P[tips] - P[att]) - (X[tips] - X[att])
+    return np.linalg.norm(moved, axis=1), np.einsum("kji,kjl->kil", Ra, sim.rotations[tips])
+
+
+def _turn(R):
+    return np.degrees(np.arccos(np.clip((np.trace(R, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)))
+
+
+def test_a_hinged_petiole_bends_as_its_chain_of_joints(cherry, monkeypatch):
+    """The load path solves a petiole (and a grass blade) at its first joint only and turns the
+    later joints by fixed multiples of that angle (docs/design.md §12): the leaves move on
+    their twigs as when every joint is solved (Eq. 8 at each), under a pull and in a gale."""
+    leaves = np.flatnonzero(cherry.kind == "leaf")
+    pulled = leaves[::97][:8]
+    pulls = [(int(i), np.array([0.0, -0.02, 0.015])) for i in pulled]  # 2.5 grams-force, held
+
+    def run():
+        return _leaf_pose(cherry, 0.0, 2.0, pulls) + _leaf_pose(cherry, 25.0, 2.0)
+
+    hinged = run()
+    from treeanim.physics import bending, simulation
+
+    monkeypatch.setattr(simulation, "BendingPlan", lambda tree, frames, hinge=None: bending.BendingPlan(tree, frames))
+    chain = run()
+    k = np.searchsorted(leaves, pulled)
+    (d_h, r_h, g_d_h, g_h), (d_c, r_c, g_d_c, g_c) = hinged, chain
+    assert np.all(d_c[k] > 4e-4) and np.all(_turn(r_c[k]) > 3.0), "the pull bends the petioles"
+    for h, c in ((d_h[k], d_c[k]), (_turn(r_h[k]), _turn(r_c[k]))):  # the pulled tips, their laminas' tilt
+        err = np.abs(h / c - 1.0)
+        assert np.median(err) < 0.1 and err.max() < 0.35, err
+    # In a gale every leaf bends and twists on its twig about as far with one hinge.
+    q_h, q_c = (np.percentile(_turn(g), [25, 50, 90]) for g in (g_h, g_c))
+    assert q_c[1] > 5.0, q_c
+    np.testing.assert_allclose(q_h, q_c, rtol=0.2)
+    np.testing.assert_allclose(np.median(g_d_h), np.median(g_d_c), rtol=0.2)

@@ -41,7 +41,6 @@ class Drag:
 
     def __init__(self, kind: np.ndarray, frontal_area: np.ndarray):
         self.leaf = np.flatnonzero(kind == "leaf")
-        self.cross = np.flatnonzero(kind != "leaf")
         self.kind = kind
         self.area = np.asarray(frontal_area, float)
         self.ws = Workspace()
@@ -62,6 +61,9 @@ class Drag:
         cd = np.select([kind == "branch", kind == "leaf"], [p.drag_branch, p.drag_leaf], p.drag_blade)
         self.half_rho_cda = 0.5 * p.air_density * cd * self.area * present
         self.foliage = kind != "branch"
+        self.foliage_share = self.foliage.astype(float)
+        self.c_cross = np.where(kind == "leaf", 0.0, self.half_rho_cda)
+        self.c_leaf = np.where(kind == "leaf", self.half_rho_cda, 0.0)
         self.r = float(p.reconfiguration)
         self.u0 = float(p.reconfiguration_speed)
 
@@ -75,7 +77,7 @@ class Drag:
             f[~foliage] = 1.0
         return f
 
-    def loads(self, wind: np.ndarray, frame: np.ndarray, lamina_q: np.ndarray) -> np.ndarray:
+    def loads(self, wind: np.ndarray, frame: np.ndarray, tip_q: np.ndarray) -> np.ndarray:
         """Drag of the wind on every object, in its carried frame.
 
         Parameters
@@ -84,9 +86,9 @@ class Drag:
             The wind each object feels, world (m/s): U, or U minus the object's velocity.
         frame : (4, M) float
             The objects' carried frames (quaternions).
-        lamina_q : (4, L) float
-            Each leaf's own bend and twist at the petiole's tip (local quaternions), for its
-            lamina normal.
+        tip_q : (4, M) float
+            Each object's own bend and twist at its last segment (local quaternions): a leaf's
+            at the petiole's tip, for its lamina normal.
 
         Returns
         -------
@@ -94,28 +96,35 @@ class Drag:
             (F_u, F_v, F_w) in newtons, in the carried frame.
 
         The leaves' wind speed and the cosine of its angle to each lamina's normal are kept
-        as ``leaf_speed`` and ``leaf_incidence`` (L,) for their flutter.
+        as ``leaf_speed`` and ``leaf_incidence`` (L,) for their flutter. Every term is computed
+        for all objects, with zero constants where it does not apply (whole arrays are cheaper
+        than gathering the leaves and the rest apart).
         """
         M = wind.shape[1]
         ws = self.ws
         U = qrot(frame, wind, conj=True, out=ws.get("U", (3, M)), ws=ws)
-        F = np.zeros((3, M))
-        c = self.cross  # cross-flow: only the wind normal to the axis v pushes
-        un = np.hypot(U[0, c], U[2, c])
-        k = self.half_rho_cda[c] * un * self.reconfigured(un, self.foliage[c])
-        F[0, c] = k * U[0, c]
-        F[2, c] = k * U[2, c]
-        lf = self.leaf
-        if len(lf):  # the normal force ½ρC A |U| (U·n) n on the lamina
-            w, x, y, z = lamina_q  # n = the leaf's bend and twist applied to its rest normal w
+        # cross-flow (branches, blades): only the wind normal to the axis v pushes
+        un = np.hypot(U[0], U[2])
+        k = self.reconfigured(un)
+        k -= 1.0
+        k *= self.foliage_share  # wood does not reconfigure
+        k += 1.0
+        k *= un
+        k *= self.c_cross
+        F = np.empty((3, M))
+        np.multiply(k, U[0], out=F[0])
+        F[1] = 0.0
+        np.multiply(k, U[2], out=F[2])
+        if len(self.leaf):  # the normal force ½ρC A |U| (U·n) n on the lamina
+            w, x, y, z = tip_q  # n = the leaf's bend and twist applied to its rest normal w
             n = np.stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
-            Ul = U[:, lf]
-            speed = np.sqrt(np.einsum("ij,ij->j", Ul, Ul))
-            un = np.einsum("ij,ij->j", Ul, n)
-            self.leaf_speed = speed
-            self.leaf_incidence = un / np.maximum(speed, 1e-300)
+            speed = np.sqrt(np.einsum("ij,ij->j", U, U))
+            un = np.einsum("ij,ij->j", U, n)
+            self.leaf_speed = speed[self.leaf]
+            self.leaf_incidence = un[self.leaf] / np.maximum(self.leaf_speed, 1e-300)
             un *= self.reconfigured(speed)
             un *= speed
-            un *= self.half_rho_cda[lf]
-            F[:, lf] = n * un
+            un *= self.c_leaf
+            n *= un
+            F += n
         return F

@@ -336,12 +336,12 @@ class BendingPlan:
         self.max_seg = max((float(np.sqrt(x.max())) for x in self.seg_len2 if len(x)), default=0.0)
         self.flat_of_node = flat_of_node
         self.ofs_of_node = ofs_of_node
-        self.tip_node = start + nseg
         self.ws = Workspace()
         self.d_max = float(diam.max()) if self.N else 1.0
         self.n_hinges = n_hinged
+        self.hinge_tip = flat_of_node[(start + nseg)[self.order[h0:h0 + n_hinged]]]  # their last segments
+        self.hinge_gain = np.ones(S)  # cᵢ of every hinged segment (see :meth:`bend`)
         self.reset()
-        self.set_hinge_share(np.ones(S))
 
     def _prev_flat(self, i: int) -> np.ndarray:
         """Flat slots of the previous segment of each entry of block i >= 1."""
@@ -358,8 +358,7 @@ class BendingPlan:
         self.rho = np.zeros(S)
         self.rho_old = np.zeros(S)
         self.rho_start = np.zeros(S)
-        self.hinge_tip_q = np.zeros((4, self.n_hinges))  # each hinge object's last segment (run order)
-        self.hinge_tip_q[0] = 1.0
+        self.turn = np.zeros(S)  # a hinged segment's turn from its rest direction, c₀φ + … + cᵢφ
         self._hinge = None  # the hinges' last solve, until :meth:`finish` lays out their segments
 
     def stiffness(self, ei_max: float, exponent: float) -> list[np.ndarray]:
@@ -468,12 +467,10 @@ class BendingPlan:
             np.divide(1.0, inv, out=inv)
             self.phi[a:a + K] = phi
             np.divide(phi, np.maximum(theta0, 1e-300), out=self.rho[a:a + K])
-            if i == 0 and H:  # the hinges' first segment turns by its share of the hinge angle
+            if i == 0 and H:
                 hs = slice(h0, h0 + H)
-                self._hinge = (phi[hs].copy(), n[0][hs] * inv[hs], n[2][hs] * inv[hs], c_[hs], s_[hs], theta0[hs])
-                self._hinge_turn(self.hinge_tip_share, self.hinge_tip_q)
-                self.q[:, self.hinge_tip] = self.hinge_tip_q  # the tips now, the rest in :meth:`finish`
-                t[hs] = np.tan(0.5 * self.hinge_share[hs] * phi[hs])
+                self._hinge = (n[0][hs] * inv[hs], n[2][hs] * inv[hs], c_[hs], s_[hs])
+                self._hinge_turns(phi[hs], theta0[hs])
             dst = self.q[:, a:a + K]
             t2, ch2 = self._rotation(i, K, n, t, inv, T, c_, s_, dst, tmp)
             oo = self.o[:, a:a + K]
@@ -483,33 +480,53 @@ class BendingPlan:
             prev = self.q[:, a:b]
             prev_o = self.o[:, a:b]
 
-    def set_hinge_share(self, share: np.ndarray) -> None:
-        """Set ``hinge_share`` (every flat segment): the share of its object's hinge angle
-        turned by the end of each segment (1 where not hinged)."""
-        self.hinge_share = np.asarray(share, float)
-        self.hinge_tip = self.flat_of_node[self.tip_node[self.order[self.hinge_start:self.hinge_start + self.n_hinges]]]
-        self.hinge_tip_share = self.hinge_share[self.hinge_tip]
+    def _hinge_turns(self, phi: np.ndarray, theta0: np.ndarray) -> None:
+        """The hinge objects' later segments turn with their first (hinged objects, docs/design.md §12).
+
+        Their first joint was solved by Eq. 8 with angle φ about N̂ (and twisted by γ, the
+        whole object's twist). Joint i turns by cᵢ·φ (``hinge_gain``: as much as joint i of a
+        chain of hinges turns for joint 0's angle in small bends) times the share of its moment
+        arm left, sin(θ₀ − βᵢ₋₁)/sin θ₀, after the joints before it turned the object by βᵢ₋₁
+        towards the force: so the object curls as the chain does and never turns past the
+        force. The tips' rotations are set now (a step needs them, for the laminas' normal
+        force); :meth:`finish` lays out the rest."""
+        beta = phi.copy()
+        tip = beta.copy()
+        arm = 1.0 / np.maximum(np.sin(theta0), 1e-12)
+        for i in range(1, len(self.counts)):
+            a, b = self.offsets[i] + self.solved[i], self.offsets[i + 1]
+            K = b - a
+            left = np.sin(theta0[:K] - beta[:K])
+            np.maximum(left, 0.0, out=left)
+            left *= arm[:K]
+            left *= self.hinge_gain[a:b]
+            left *= phi[:K]
+            beta = beta[:K] + left
+            self.turn[a:b] = beta
+            tip[:K] = beta
+        self.turn[self.offsets[0] + self.hinge_start:self.offsets[0] + self.hinge_start + self.n_hinges] = phi
+        self.q[:, self.hinge_tip] = self._hinge_rotation(tip, np.empty((4, self.n_hinges)))
 
     def finish(self) -> None:
         """Lay out the hinge objects' later segments (``q`` and ``o``) from their last solve;
-        :meth:`bend` leaves them, since a step needs only their tips (``hinge_tip_q``)."""
+        :meth:`bend` sets only their tips' rotations, all a step needs."""
         if self._hinge is None:
             return
         for i in range(1, len(self.counts)):
-            a, b = self.offsets[i] + self.solved[i], self.offsets[i + 1]
-            if b > a:
-                self._hinged(i, a, b, self.o[:, self.offsets[i - 1]:self.offsets[i]])
+            lo, hi = self.offsets[i] + self.solved[i], self.offsets[i + 1]
+            if hi > lo:  # Cᵢ = Rot(N̂, βᵢ) ⊗ Rot(v, −γ), oᵢ = oᵢ₋₁ + Cᵢsᵢ
+                p0 = self.offsets[i - 1] + self.hinge_prev[i]
+                dst = self.q[:, lo:hi]
+                self._hinge_rotation(self.turn[lo:hi], dst)
+                oo = self.o[:, lo:hi]
+                qrot(dst, self.seg[i][:, self.solved[i]:], out=oo, ws=self.ws)
+                oo += self.o[:, p0:p0 + hi - lo]
         self._hinge = None
 
-    def _hinge_turn(self, share: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """Into ``out`` (4, K), the first K hinges' rotation Rot(N̂, min(share·φ, θ₀)) ⊗ Rot(v, −γ)
-        (the turn stops at the force's direction, θ₀, as a chain of hinges turns each joint
-        towards the force, never past it); returns the turn's angles."""
-        K = out.shape[1]
-        phi, n0, n2, c, s, theta0 = (x[:K] for x in self._hinge)
-        angle = np.multiply(share, phi)
-        np.minimum(angle, theta0, out=angle)
-        half = 0.5 * angle
+    def _hinge_rotation(self, beta: np.ndarray, out: np.ndarray) -> np.ndarray:
+        """Rot(N̂, β) ⊗ Rot(v, −γ) of the first K = len(β) hinge objects, into ``out`` (4, K)."""
+        n0, n2, c, s = (x[:len(beta)] for x in self._hinge)
+        half = 0.5 * beta
         sh = np.sin(half)
         a0, a1, a3 = np.cos(half), sh * n0, sh * n2
         np.multiply(a0, c, out=out[0])  # (a0, a1, 0, a3) ⊗ (c, 0, s, 0)
@@ -518,19 +535,7 @@ class BendingPlan:
         np.multiply(a0, s, out=out[2])
         np.multiply(a3, c, out=out[3])
         out[3] += a1 * s
-        return angle
-
-    def _hinged(self, i, lo, hi, prev_o) -> None:
-        """Segment i >= 1 of the hinge objects, in slots ``lo:hi``. Their bend (angle φ about N̂)
-        and twist γ were solved once, at the first joint; each segment turns by a fixed share
-        cᵢ of φ about the same axis, so Cᵢ = Rot(N̂, (c₀ + … + cᵢ)φ) ⊗ Rot(v, −γ) in closed
-        form (:meth:`_hinge_turn`), and oᵢ = oᵢ₋₁ + Cᵢsᵢ."""
-        p0 = self.hinge_prev[i]
-        dst = self.q[:, lo:hi]
-        self.phi[lo:hi] = self._hinge_turn(self.hinge_share[lo:hi], dst)
-        oo = self.o[:, lo:hi]
-        qrot(dst, self.seg[i][:, self.solved[i]:], out=oo, ws=self.ws)
-        oo += prev_o[:, p0:p0 + hi - lo]
+        return out
 
     def _twisted(self, C, c_, s_):
         """T = Rot(v, −γ) ⊗ C = cos(γ/2)·C + sin(γ/2)·(−C_y, C_z, C_w, −C_x) (c_, s_: the halves)."""

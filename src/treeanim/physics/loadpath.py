@@ -133,6 +133,7 @@ class LoadPath:
         A0 = np.empty((3, M))
         A0[:, bplan.order] = A[:, :M]  # block 0 holds segment 0 of every object
         self.Xo = self.Xb + self._to_world(A0)  # where the own load's moment acts
+        self.own_arm = np.linalg.norm(A, axis=0)  # the own load's lever about each joint
 
         # Per step only the joints Eq. 8 solves: a hinge object's later joints follow its first.
         keep = np.flatnonzero(~hinged | (seg_i == 0))
@@ -301,7 +302,7 @@ class LoadPath:
         # Each joint twists under the torsion it carries, by c = ∫dx/GJ over its segment
         # (GJ = EI/TWIST_RATIO); Eq. 11's law saturates it at a quarter turn, rate (2/π)c.
         twist_rate = (2.0 / np.pi) * h * TWIST_RATIO / EI(0.5)
-        self._hinges(so, node, integral, lever, k_E, twist_rate)
+        self._hinges(so, k_E, twist_rate)
         self.modal = np.asarray(modal, bool)
         # Where a child's base sits on its parent's deflection: translation ψ and rotation χ per
         # unit deflection of the parent's load point (φᵢ = ℓᵢ/kᵢ per newton there).
@@ -345,26 +346,23 @@ class LoadPath:
         self.tune(None)
         self._base_map()
 
-    def _hinges(self, so, node, integral, lever, k_E, twist_rate) -> None:
-        """The solved joints' stiffness ``k_E`` and twist rate, and ``hinge_share``.
+    def _hinges(self, so, k_E, twist_rate) -> None:
+        """The solved joints' stiffness ``k_E`` and twist rate, and ``hinge_gain``.
 
-        A hinge object (a leaf's petiole) bends and twists at its first joint only, which
-        carries the whole object's compliance: k = ℓ₀²·K, and the sum of its joints' twist
-        rates. Joint i of the chain of hinges it stands for would turn by ℓᵢ/kᵢ per newton at the
-        load point, the share cᵢ = (ℓᵢ/kᵢ)·K·ℓ₀ of the hinge's angle: so the load point moves
-        as the chain moves it (Σ cᵢℓᵢ = ℓ₀) and its tip turns as the chain's does.
-        ``hinge_share`` (every flat segment) is the share turned by the end of each segment,
-        c₀ + … + cᵢ (1 elsewhere)."""
+        A hinge object (a leaf's petiole, a grass blade) is solved at its first joint only, as
+        in the chain of hinges (Eq. 8 with that joint's k₀), and twists there by the sum of its
+        joints' twist rates. Joint i of the chain turns by Mᵢ/kᵢ under the object's own load,
+        whose moment about it is Mᵢ ∝ aᵢ (``own_arm``: the lamina's lever for a leaf, the first
+        moment of the drag along a blade): the later joints turn by the fixed multiples
+        cᵢ = (aᵢ/a₀)·(k₀/kᵢ) of the first joint's angle, as in the chain in small bends.
+        ``hinge_gain`` holds cᵢ for every flat segment (1 where not hinged)."""
         first, rest = self.hinge_first, self.hinge_rest
         hinged = np.concatenate([first, rest])
-        ho = so[hinged]
-        share = np.zeros(self.N + 1)
-        share[node[hinged] + 1] = self.lever0[ho] * self.K_E[ho] * integral[hinged] / lever[hinged]
-        share = np.cumsum(share)  # along the nodes: what precedes an object cancels
-        self.hinge_share = np.ones(len(so))
-        self.hinge_share[hinged] = share[node[hinged] + 1] - share[self.start[ho]]
-        k_E, twist_rate = k_E.copy(), twist_rate.copy()
-        k_E[first] = self.lever0[so[first]] ** 2 * self.K_E[so[first]]
+        a0k0 = np.ones(self.M)  # a₀/k₀ of every hinge object
+        a0k0[so[first]] = self.own_arm[first] / np.maximum(k_E[first], 1e-300)
+        self.hinge_gain = np.ones(len(so))
+        self.hinge_gain[rest] = self.own_arm[rest] / np.maximum(k_E[rest], 1e-300) / np.maximum(a0k0[so[rest]], 1e-300)
+        twist_rate = twist_rate.copy()
         twist_rate[first] = np.bincount(so[hinged], twist_rate[hinged], self.M)[so[first]]
         keep = slice(None) if self.keep is None else self.keep
         self.k_E, self.twist_rate = k_E[keep], twist_rate[keep]

@@ -221,8 +221,8 @@ class Simulation:
         self._u, self._v, self._w = u.T.copy(), v.T.copy(), w.T.copy()
         kind = tree.kind
         leaf = kind == "leaf"
-        # The load path bends a leaf's petiole at one hinge (docs/design.md §12).
-        self._bplan = BendingPlan(tree, frames, hinge=leaf if self._load_path else None)
+        # The load path bends a petiole or a grass blade at one hinge (docs/design.md §12).
+        self._bplan = BendingPlan(tree, frames, hinge=(kind != "branch") if self._load_path else None)
         self._cplan = CompositionPlan(tree, self._bplan, matrix_to_quat(frames))
         length = object_lengths(tree)
         dmean = mean_diameters(tree)
@@ -275,13 +275,13 @@ class Simulation:
         below = np.add.reduceat((arc <= np.repeat(half, count)).astype(np.int64), start)
         j = np.clip(below - 1, 0, count - 2)
         t = np.clip((half - arc[start + j]) / np.maximum(seg[start + j], 1e-300), 0.0, 1.0)
-        hinge = self._bplan.hinge  # a hinged petiole: the end of its first segment (bent each step)
-        j[hinge], t[hinge] = 0, 1.0
+        hinge = self._bplan.hinge  # hinged: on its first segment (bent each step), extended to half the arc
+        j[hinge], t[hinge] = 0, half[hinge] / np.maximum(seg[start[hinge]], 1e-300)
         self._mid_a = self._bplan.ofs_of_node[start + j]
         self._mid_b = self._bplan.ofs_of_node[start + j + 1]
         self._mid_t = t
         self._leaves = np.flatnonzero(leaf)
-        self._leaf_tip_flat = self._bplan.flat_of_node[tip[leaf]]
+        self._tip_flat = self._bplan.flat_of_node[tip]
         lp = self._lp
         self._leaf_twist = LeafTwist(np.searchsorted(self._leaves, lp.seg_obj[lp.leaf_seg]),
                                      np.asarray(tree.lamina_length, float)[self._leaves], self._seed)
@@ -318,7 +318,7 @@ class Simulation:
                       p.blade_youngs_modulus)
         self._lp.derive(E, p.stiffness_exponent, self._drag.half_rho_cda, self._drag.foliage,
                         self._mass * self._present, branch)
-        self._bplan.set_hinge_share(self._lp.hinge_share)
+        self._bplan.hinge_gain = self._lp.hinge_gain
         self._mode_snap = None  # the branches' stiffness follows the modes: re-tune on the next step
 
     def _derive_modes(self) -> None:
@@ -953,11 +953,11 @@ class Simulation:
         object's mode and, through Q, on what it carries), which the oscillators take
         implicitly (:meth:`_advance`) — stable however light a twig and strong the wind.
         """
-        lam_q = np.take(self._bplan.q, self._leaf_tip_flat, axis=1)
+        tip_q = np.take(self._bplan.q, self._tip_flat, axis=1)
         if U is None:
             F, rel = np.zeros((3, self._M)), -self._sample_vel
         else:
-            F = self._drag.loads(U.T, self._frame, lam_q)
+            F = self._drag.loads(U.T, self._frame, tip_q)
             rel = U.T - self._sample_vel
         speed = np.sqrt(np.einsum("ij,ij->j", rel, rel))
         lp = self._lp
