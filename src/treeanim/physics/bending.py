@@ -28,6 +28,10 @@ segments are a prefix of that order and the i-th pass works on contiguous slices
 unit quaternions; block i of the flat (4, S) array ``q`` holds segment i of every object that
 has one, and block i of the flat (3, S) array ``o`` the bent offset of node i + 1 from the
 object's base, Σ_{j<=i} Cⱼ sⱼ (accumulated per object, so no round-off crosses objects).
+
+**Hinged objects** (the load path's petioles and blades, docs/design.md §12) are solved at
+their first segment only: they sort after the solved objects with more segments, and each
+block ends with their segment i, which follows the first in closed form.
 """
 
 from __future__ import annotations
@@ -251,9 +255,15 @@ class BendingPlan:
     Attributes
     ----------
     order : (M,) int
-        Objects by decreasing segment count (stable); ``order[:counts[i]]`` have a segment i.
-    counts : list of int
-        Objects having a segment i, for i = 0 … max segments − 1.
+        Objects by decreasing solved segment count, then segment count (stable);
+        ``order[:solved[i]]`` have a solved segment i.
+    counts, solved : list of int
+        Objects having a segment i, and a solved one (block i: the solved first), for
+        i = 0 … max segments − 1.
+    hinge : (M,) bool
+        The hinged objects (``hinge`` given, more than one segment).
+    seg_obj, seg_index : (S,) int
+        Object and segment index of every flat slot.
     offsets : list of int
         Start of block i in the flat segment arrays.
     n_flat : int
@@ -269,7 +279,9 @@ class BendingPlan:
     o : (3, S + 1) float
         Bent offsets from the object's base, in world rest coordinates; column S is zero.
     phi : (S,) float
-        Bend angles.
+        Bend angles (of the solved segments).
+    turn : (S,) float
+        A hinged segment's turn from its rest direction.
     rho : (S,) float
         φ/θ₀, the warm start of the next solve.
     """
