@@ -1,0 +1,66 @@
+"""Wind over trees: the physical field (default) and the paper's (Hu, Chiba & He 2012).
+
+``WindField(model="physical")`` (docs/design.md §12, issue 11) is weather-like wind:
+
+* **Turbulence in metres.** Three independent Gaussian fields (along-wind u, vertical v,
+  lateral w) on one periodic tile of 96 × 48 × 96 cells covering 8 L × 4 L × 8 L (along,
+  up, across the wind), L the along-wind integral length scale (``length_scale``, by
+  default the canopy height). The tile is independent of any tree's box, so several trees
+  share one field. The 3-D spectrum is (k² + k0²)^−(β+2)/2 with k0 = 1/(1.339 L_c), so the
+  spectrum along any line is the von Kármán form (k1² + k0²)^−β/2: f^−β in the inertial
+  range, flat below the energy-containing eddies (L_u = L, L_v = L_w = L/3, as in canopy
+  flows). Its Fourier amplitudes are pre-compensated for trilinear interpolation (exactly
+  along the wind, on average across it), so the spectrum at a fixed point keeps its slope
+  up to about half the grid's Nyquist frequency U·12/(2L).
+* **Taylor's frozen turbulence.** The tile is carried downwind at the mean speed at the
+  canopy top, so a gust reaches a point d metres downwind d/U seconds later and gusts come
+  faster in stronger wind.
+* **Evolution, no loop.** Two layers of the tile, weighted sin(πs) and |cos(πs)| (their
+  squares sum to one, so the variance is steady), evolve with the travelled distance:
+  s grows by one every 4 L of travel, and each layer jumps to a new random place in the
+  tile (a hash of the seed and the cycle) when its weight is zero. Eddies so live for
+  about 4 L / U seconds and nothing repeats: the point's autocorrelation is ~0 beyond a few
+  L / U.
+* **Canopy profile.** Mean speed ``speed``·ln((y − d)/z0)/ln((h − d)/z0) above the canopy
+  height h (d = 0.7 h, z0 = 0.1 h) and ``speed``·exp(a(y/h − 1)) inside it (a ≈ 3.03, so
+  the two meet smoothly). Standard deviations σ_u : σ_w(lateral) : σ_v(vertical) =
+  1 : 0.75 : 0.5 with σ_u = ``turbulence``·``speed`` at and above h, decaying as
+  exp(y/h − 1) inside the canopy (the intensity rises towards the ground).
+* **Gusts.** ``gust_rate`` gusts a minute, each a plane front across the wind with a sharp
+  rise (0.5 L) and a slower decay (1.5 L) of peak ``gust_strength``·U·A (A uniform in
+  [0.5, 1.5]), carried at the wind speed; their mean is subtracted, so they are gusts and
+  lulls about the set mean.
+* **Mean direction.** Every fluctuation across the wind has zero mean by construction
+  (symmetric Gaussian noise, no rescaling), so the long-run mean wind points along
+  ``direction``.
+
+``WindField(model="paper")`` keeps the three-dimensional 1/f^β field of §4.3 (Eqs. 13–18)
+exactly. Three independent periodic noise grids (``fbm_noise``) give the along-wind (u),
+vertical (v) and lateral (w) turbulence. ``WindField`` samples them by periodic trilinear
+interpolation, shapes them with the logarithmic mean profile (Eq. 16) and the normalisation
+of Eq. 17, and turns the result into a world velocity along the user's wind direction
+(Eq. 18). Choices made there (docs/design.md §7 leaves them open):
+
+* **Grid frame.** The grids are sampled in the *wind's own frame*: a point is scaled by the
+  bounds to [0, 1]³, then to grid units (× (N − 1)), and its grid coordinates are its
+  components along (û, v̂, ŵ) = (along wind, vertical, lateral). For a wind along +x this is
+  exactly Eq. 17; for any other direction the frozen turbulence still travels downwind (at
+  c5 cells/s) and drifts laterally (c6 cells/s). Changing the direction rotates the sampling
+  frame, so the turbulence seen by a fixed point jumps when the direction changes.
+* **Height.** The mean profile uses the world height h = y in metres (ground at y = 0), not
+  the scaled coordinate: W(h) = c1·ln(c2·h) for h > 1/c2, else 0.
+* **Defaults.** ``c2 = 50 / H`` (the profile starts at 2 % of the tree top H, the top of
+  the bounds) and ``c1 = 1 / ln(c2·H)`` so W(H) = 1 and ``speed`` is the mean-profile speed at
+  the tree top. ``c3 = 0.5``, ``c4 = 1.0``, ``c5 = 4`` cells/s, ``c6 = 0.5`` cells/s.
+
+Named winds by Beaufort number (:data:`WIND_PRESETS`, :func:`wind_preset`,
+``WindField.from_preset``): calm, breeze, windy, gale, storm.
+"""
+
+from .field import WindField
+from .paper import fbm_noise
+from .physical import SIGMA_RATIOS
+from .settings import DEFAULT_BOUNDS, MAX_SPEED, MODELS, WIND_PRESETS, wind_preset
+
+__all__ = ["fbm_noise", "WindField", "WIND_PRESETS", "wind_preset", "MODELS", "DEFAULT_BOUNDS", "MAX_SPEED",
+           "SIGMA_RATIOS"]

@@ -1,0 +1,208 @@
+"""The paper's wind field (Hu, Chiba & He 2012, Eqs. 13–18): 1/f^β noise grids and their sampling."""
+
+from __future__ import annotations
+
+import math
+from functools import lru_cache
+
+import numpy as np
+import scipy.fft
+
+from .settings import _COORD_CLIP, _GRID_CLIP, MAX_BETA, MAX_GRID, _in_range, _integer
+
+
+def fbm_noise(n: int, beta: float, seed=0) -> np.ndarray:
+    """One periodic 3-D 1/f^β noise grid (Eqs. 14–15).
+
+    The Fourier amplitudes are |k|^−(β+2)/2 (the k = 0 term zero), with uniform random
+    phases, so the 3-D power falls off as |k|^−(β+2) and the 1-D power spectrum along any
+    axis, which sums the 3-D power over the two other wavenumbers, falls off as k^−β. The
+    real field comes from an inverse real FFT; it has zero mean and is then mapped linearly
+    onto exactly [−0.5, 0.5] (minimum → −0.5, maximum → +0.5), which leaves a small
+    residual mean (typically |mean| ≈ 0.02–0.03).
+
+    On a finite grid the transverse sum stops at the Nyquist wavenumber, so the measured
+    1-D slope steepens towards k = n/2 (at n = 64, fitted over k = 2…16, by up to 0.23
+    for β = 1); over k ≤ n/8 it is within 0.15 of −β.
+
+    Parameters
+    ----------
+    n : int
+        Grid edge; the result is (n, n, n). In [2, 256].
+    beta : float
+        Spectral exponent β (1.67 for the along-wind component, 1.33 across, Eq. 15), in
+        [−10, 10].
+    seed : int, sequence of int or numpy.random.SeedSequence
+        Seed for ``numpy.random.default_rng``; the same seed gives the same grid, to the bit.
+
+    Returns
+    -------
+    numpy.ndarray
+        float64 array of shape (n, n, n) with min −0.5 and max +0.5, periodic in each axis.
+
+    Raises
+    ------
+    ValueError
+        If ``n`` is not an integer in [2, 256], ``beta`` is not finite or outside [−10, 10],
+        or ``seed`` is not a seed.
+    """
+    n = _integer("n", n, 2, MAX_GRID)
+    beta = _in_range("beta", beta, -MAX_BETA, MAX_BETA)
+    try:
+        rng = np.random.default_rng(seed)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(
+            f"seed must be a non-negative integer (or a numpy SeedSequence), got {seed!r} ({exc})"
+        ) from None
+    return _fbm(n, beta, rng)
+
+
+def _fbm(n: int, beta: float, rng: np.random.Generator) -> np.ndarray:
+    # Uniform random phases with Hermitian symmetry built in: the phases of the real FFT of
+    # Gaussian white noise are uniform and independent (real on the self-conjugate
+    # wavenumbers), so the field is real and every |k| gets exactly its amplitude.
+    white = scipy.fft.rfftn(rng.standard_normal((n, n, n)), axes=(0, 1, 2))
+    mag = np.abs(white)
+    mag[mag == 0.0] = 1.0
+    phase = white / mag
+
+    k = np.fft.fftfreq(n, 1.0 / n)
+    kr = np.fft.rfftfreq(n, 1.0 / n)
+    k2 = k[:, None, None] ** 2 + k[None, :, None] ** 2 + kr[None, None, :] ** 2
+    k2[0, 0, 0] = 1.0
+    # Eq. 14: S = |k|^−(β+2)/2, in log space and normalised so no finite β overflows.
+    log_amp = -0.25 * (beta + 2.0) * np.log(k2)
+    log_amp[0, 0, 0] = -np.inf  # zero-mean field
+    log_amp -= log_amp[np.isfinite(log_amp)].max()
+    spectrum = np.exp(log_amp) * phase
+
+    # Eq. 15: inverse FFT, then standardise to [−0.5, 0.5].
+    field = scipy.fft.irfftn(spectrum, s=(n, n, n), axes=(0, 1, 2))
+    lo, hi = field.min(), field.max()
+    if not hi > lo:  # pragma: no cover - only for a degenerate all-zero spectrum
+        return np.zeros((n, n, n))
+    out = (field - lo) * (1.0 / (hi - lo)) - 0.5
+    np.clip(out, -0.5, 0.5, out=out)
+    out.flat[np.argmin(field)] = -0.5
+    out.flat[np.argmax(field)] = 0.5
+    return out
+
+
+@lru_cache(maxsize=24)
+def _cached_grid(n: int, beta: float, seed: int, component: int) -> np.ndarray:
+    g = fbm_noise(n, beta, (seed, component))
+    g.setflags(write=False)
+    return g
+
+
+
+
+class _Workspace:
+    """Scratch buffers reused between sample() calls (no page faults on every call)."""
+
+    _SPEC = {
+        "pc": (3, np.float64), "q": (3, np.float64), "fl": (3, np.float64),
+        "i": (3, np.intp), "fr": (3, np.float32), "b": (1, np.intp), "c": (8, np.intp),
+        "va": (8, np.complex64), "vb": (8, np.float32), "da": (4, np.complex64),
+        "db": (4, np.float32), "up": (3, np.float64), "s": (2, np.float64),
+    }
+
+    def __init__(self, capacity: int):
+        self.capacity = capacity
+        self.buf = {k: np.empty(r * capacity, dtype=d) for k, (r, d) in self._SPEC.items()}
+
+    def get(self, name: str, shape: tuple[int, ...]) -> np.ndarray:
+        return self.buf[name][: math.prod(shape)].reshape(shape)
+
+
+def _sample_chunk(p, out, ws, consts) -> None:
+    (m, offset, n, (tab_uv, tab_w), c1, log_h0, c3, c4, inv_s1, lam, speed, frame) = consts
+    k = p.shape[0]
+    # Grid coordinates, component-major (3, k). Clipping keeps every product finite and
+    # the modulo below exact.
+    pc = ws.get("pc", (k, 3))
+    np.clip(p, -_COORD_CLIP, _COORD_CLIP, out=pc)
+    q = ws.get("q", (3, k))
+    np.matmul(m, pc.T, out=q)
+    q += offset[:, None]
+    np.clip(q, -_GRID_CLIP, _GRID_CLIP, out=q)
+    # Periodic: q mod N in [0, N], then cell index (np.floor) and fraction.
+    fl = ws.get("fl", (3, k))
+    np.multiply(q, 1.0 / n, out=fl)
+    np.floor(fl, out=fl)
+    fl *= n
+    q -= fl
+    i = ws.get("i", (3, k))
+    np.copyto(i, q, casting="unsafe")  # q >= 0 (up to rounding): truncation is floor
+    np.clip(i, 0, n - 1, out=i)
+    fr = ws.get("fr", (3, k))
+    np.subtract(q, i, out=fr, casting="same_kind")
+    # Flattened index of each cell's lower corner in the padded (N+1)³ grid, then 8 corners.
+    mp = n + 1
+    b = ws.get("b", (k,))
+    np.multiply(i[0], mp, out=b)
+    b += i[1]
+    b *= mp
+    b += i[2]
+    c = ws.get("c", (8, k))
+    np.add(_corner_offsets(mp)[:, None], b, out=c)
+    va = ws.get("va", (8, k))
+    vb = ws.get("vb", (8, k))
+    tab_uv.take(c, out=va, mode="clip")
+    tab_w.take(c, out=vb, mode="clip")
+    # Trilinear interpolation: lerp along, then vertical, then lateral.
+    fa, fb, fc = fr
+    res = []
+    for vals, d in ((va, ws.get("da", (4, k))), (vb, ws.get("db", (4, k)))):
+        np.subtract(vals[4:8], vals[0:4], out=d)
+        d *= fa
+        d += vals[0:4]
+        e = vals[0:2]
+        np.subtract(d[2:4], d[0:2], out=e)
+        e *= fb
+        e += d[0:2]
+        r = e[1]
+        r -= e[0]
+        r *= fc
+        r += e[0]
+        res.append(r)
+    # Eq. 17: U' = (FBM_u + 0.5, c3 FBM_v, c4 FBM_w).
+    up = ws.get("up", (3, k))
+    np.add(res[0].real, 0.5, out=up[0])
+    np.multiply(res[0].imag, c3, out=up[1])
+    np.multiply(res[1], c4, out=up[2])
+    s2, mag = ws.get("s", (2, k))
+    np.einsum("ij,ij->j", up, up, out=s2)
+    np.sqrt(s2, out=s2)
+    # Eq. 16: W(h) = c1 ln(c2 h) = c1 (ln h − ln(1/c2)), zero below h = 1/c2.
+    np.maximum(p[:, 1], math.exp(log_h0), out=mag)
+    np.log(mag, out=mag)
+    mag -= log_h0
+    mag *= c1 * speed
+    # Eq. 17: s = W (1 + λ(s2/s1 − 0.5)) / s2, with no wind where s2 = 0.
+    scale = ws.get("fl", (k,))
+    np.multiply(s2, lam * inv_s1, out=scale)
+    scale += 1.0 - 0.5 * lam
+    mag *= scale
+    np.divide(mag, s2, out=mag, where=s2 > 1e-12)
+    mag[s2 <= 1e-12] = 0.0
+    # Eq. 18: U = speed (U_u û + U_v v̂ + U_w ŵ).
+    np.matmul(up.T, frame, out=out)
+    out *= mag[:, None]
+
+
+def _wrap_shift(rate: float, t: float, n: int) -> float:
+    """rate·t modulo n, computed without overflow for any finite rate and t."""
+    if rate == 0.0:
+        return 0.0
+    period = n / abs(rate)
+    if math.isfinite(period):
+        t = math.fmod(t, period)
+    return math.fmod(rate * t, n)
+
+
+@lru_cache(maxsize=8)
+def _corner_offsets(mp: int) -> np.ndarray:
+    d = np.arange(2)
+    off = (d[:, None, None] * mp + d[None, :, None]) * mp + d[None, None, :]
+    return off.reshape(8)
