@@ -174,9 +174,9 @@ def test_a_hinged_petiole_bends_as_its_chain_of_joints(cherry, monkeypatch):
         return _leaf_pose(cherry, 0.0, 2.0, pulls) + _leaf_pose(cherry, 25.0, 2.0)
 
     hinged = run()
-    from treeanim.physics import bending, simulation
+    from treeanim.physics import bending, derived
 
-    monkeypatch.setattr(simulation, "BendingPlan", lambda tree, frames, hinge=None: bending.BendingPlan(tree, frames))
+    monkeypatch.setattr(derived, "BendingPlan", lambda tree, frames, hinge=None: bending.BendingPlan(tree, frames))
     chain = run()
     k = np.searchsorted(leaves, pulled)
     (d_h, r_h, g_d_h, g_h), (d_c, r_c, g_d_c, g_c) = hinged, chain

@@ -12,7 +12,8 @@ from treeanim.model.build import ObjectSpec, assemble
 from treeanim.model.geometry import lamina_frames, polygon_centroid
 from treeanim.model.params import PhysicsParams
 from treeanim.physics.bending import rest_frames
-from treeanim.physics.simulation import MAX_PULL, Simulation, trace_tips
+from treeanim.physics.simulation import MAX_PULL, Simulation
+from treeanim.physics.trace import trace_tips
 
 
 def straight_beam(n=8, length=2.0):

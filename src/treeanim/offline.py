@@ -606,7 +606,7 @@ def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float) ->
         ``seconds`` or ``rate`` not finite and positive, or so small that fewer than 2 samples
         would follow the release (checked before anything is simulated).
     """
-    from .physics.simulation import trace_tips
+    from .physics.trace import trace_tips
 
     for name, value in (("--seconds", seconds), ("--rate", rate)):
         if not (math.isfinite(value) and value > 0):

@@ -1,0 +1,161 @@
+"""What a :class:`~treeanim.physics.simulation.Simulation` derives from its tree and physics
+(docs/design.md §5–§8, §12): rest geometry and the bending, composition and load path plans,
+stiffness, masses, drag, and the modes (Eqs. 20–22).
+
+:class:`Derived` is mixed into the Simulation; it computes once per tree what the step's
+stages (:mod:`~treeanim.physics.stages`) read, and again when the physics, the season or the
+model change.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.geometry import arc_length, lamina_frames, object_lengths, polygon_centroid, segment_lengths
+from .aero import Drag
+from .bending import BendingPlan, rest_frames
+from .falling import FallingLeaves
+from .hierarchy import CompositionPlan
+from .leaves import LeafTwist
+from .loadpath import LoadPath
+from .modal import derive_modes, mean_diameters
+from .rotation import Workspace, matrix_to_quat
+
+#: E (Pa) that shapes a branch's stiffness along its length before :meth:`LoadPath.tune` sets
+#: its magnitude from the branch's frequency and mass (any value gives the same tree).
+NOMINAL_WOOD_MODULUS = 6e9
+
+
+class Derived:
+    """Set-up of a Simulation: everything computed from the tree, its physics and the season."""
+
+    def _geometry(self) -> None:
+        """Per-object rest frames, lever arms, areas and volumes (fixed for the tree)."""
+        tree = self._tree
+        X = np.asarray(tree.rest_positions, float)
+        start = np.asarray(tree.object_start)
+        count = np.asarray(tree.object_count)
+        tip = start + count - 1
+        M = self._M
+        frames = rest_frames(tree)  # (M, 3, 3): columns u, v, w
+        u, v, w = frames[:, :, 0], frames[:, :, 1], frames[:, :, 2]
+        self._u, self._v, self._w = u.T.copy(), v.T.copy(), w.T.copy()
+        kind = tree.kind
+        leaf = kind == "leaf"
+        # The load path bends a petiole or a grass blade at one hinge (docs/design.md §12).
+        self._bplan = BendingPlan(tree, frames, hinge=(kind != "branch") if self._load_path else None)
+        self._cplan = CompositionPlan(tree, self._bplan, matrix_to_quat(frames))
+        length = object_lengths(tree)
+        dmean = mean_diameters(tree)
+        p0pn = X[tip] - X[start]
+        r = np.einsum("ij,ij->i", u, p0pn)  # Eq. 3: r = u · P0Pn
+        lam_area = np.zeros(M)
+        load_point = X[tip].copy()  # where each object's own load acts (load path)
+        if tree.lamina is not None and np.any(leaf):
+            leaves = np.flatnonzero(leaf)
+            unit_area = float(tree.lamina.area)
+            cx, cy = polygon_centroid(tree.lamina.outline)
+            L = np.asarray(tree.lamina_length, float)[leaves, None]
+            lam_area[leaves] = unit_area * L[:, 0] ** 2
+            # The lamina sits on the petiole's tip, in the frame the mesh and picking use.
+            tipn, lu, lv, _ = lamina_frames(tree, leaves)
+            centroid = X[tipn] + L * (cx * lu + cy * lv)
+            r[leaves] = np.linalg.norm(centroid - X[start[leaves]], axis=1)
+            load_point[leaves] = centroid
+        self._lever = r
+        self._area = length * dmean + lam_area
+        # Volumes: tapered segments (frusta ≈ cylinders of the mean diameter).
+        seg = segment_lengths(tree)
+        dseg = 0.5 * (tree.node_diameter[1:] + tree.node_diameter[:-1])
+        dseg = np.append(dseg, 0.0)
+        self._round_volume = np.add.reduceat(0.25 * np.pi * dseg**2 * seg, start)
+        self._flat_area = np.add.reduceat(dseg * seg, start)  # blades: width × length
+        self._lam_area = lam_area
+        self._nseg = (count - 1).astype(float)
+        self._sample_node = start + count // 2  # the middle node
+        self._sample_ofs = self._bplan.ofs_of_node[self._sample_node]
+        self._tip_node = tip
+        self._rest_P = X.T.copy()
+        # Base excitation: unique attach nodes of the non-root objects.
+        self._nonroot = np.flatnonzero(tree.parent >= 0)
+        att = np.asarray(tree.attach_node)[self._nonroot]
+        self._att_nodes, att_inv = np.unique(att, return_inverse=True)
+        # Per object, its base's column in the acceleration array (roots: the zero column).
+        self._att_col = np.full(M, len(self._att_nodes), np.int64)
+        self._att_col[self._nonroot] = att_inv
+        self._ws = Workspace()
+        o = self._bplan.order
+        self._neg_half_pi_over_n_ord = -0.5 * np.pi / self._nseg[o]
+        self._rest_bounds = (X.min(axis=0), X.max(axis=0))
+        # The load path (docs/design.md §12): its plan, the drag, and each object's true middle (half
+        # its arc length, on segment j at fraction t) where it samples the wind.
+        self._lp = LoadPath(tree, frames, self._bplan, load_point)
+        self._drag = Drag(kind, np.where(leaf, lam_area, length * dmean))
+        arc = arc_length(tree)
+        half = 0.5 * length
+        below = np.add.reduceat((arc <= np.repeat(half, count)).astype(np.int64), start)
+        j = np.clip(below - 1, 0, count - 2)
+        t = np.clip((half - arc[start + j]) / np.maximum(seg[start + j], 1e-300), 0.0, 1.0)
+        hinge = self._bplan.hinge  # hinged: on its first segment (bent each step), extended to half the arc
+        j[hinge], t[hinge] = 0, half[hinge] / np.maximum(seg[start[hinge]], 1e-300)
+        self._mid_a = self._bplan.ofs_of_node[start + j]
+        self._mid_b = self._bplan.ofs_of_node[start + j + 1]
+        self._mid_t = t
+        self._leaves = np.flatnonzero(leaf)
+        self._tip_flat = self._bplan.flat_of_node[tip]
+        lp = self._lp
+        self._leaf_twist = LeafTwist(np.searchsorted(self._leaves, lp.seg_obj[lp.leaf_seg]),
+                                     np.asarray(tree.lamina_length, float)[self._leaves], self._seed)
+        self._fallen = FallingLeaves(tree.object_start, tree.object_count, tree.rest_w, self._seed)
+
+    def _derive_physics(self) -> None:
+        """Stiffness, gains, masses and twist constants from ``self._physics``."""
+        p = self._physics
+        kind = self._tree.kind
+        gain = np.select([kind == "branch", kind == "leaf"], [p.wind_gain_branch, p.wind_gain_leaf],
+                         p.wind_gain_blade)
+        self._gain_area = gain * self._area
+        mass = np.where(kind == "branch", p.wood_density * self._round_volume, 0.0)
+        mass = np.where(kind == "leaf", p.leaf_density * (self._round_volume + self._lam_area * p.lamina_thickness),
+                        mass)
+        mass = np.where(kind == "blade", p.leaf_density * self._flat_area * p.lamina_thickness, mass)
+        self._mass = mass
+        self._k = self._bplan.stiffness(p.ei_max, p.stiffness_exponent)
+        # Eq. 11's c0, per unit of the object's root stiffness k₀ (see the class notes).
+        c0 = np.where(kind == "leaf", p.leaf_twist_c0, p.twist_c0)
+        k_root = np.empty(self._M)
+        k_root[self._bplan.order] = self._k[0]
+        self._c0k = c0 / np.maximum(k_root, 1e-300)
+        self._c0k_ord = self._c0k[self._bplan.order]
+        if self._load_path:
+            self._derive_load_path()
+
+    def _derive_load_path(self) -> None:
+        """The load path's drag, stiffness shapes and masses (physics and present leaves)."""
+        p = self._physics
+        self._drag.derive(p, self._present)
+        branch = self._tree.kind == "branch"
+        E = np.select([branch, self._tree.kind == "leaf"], [NOMINAL_WOOD_MODULUS, p.leaf_youngs_modulus],
+                      p.blade_youngs_modulus)
+        self._lp.derive(E, p.stiffness_exponent, self._drag.half_rho_cda, self._drag.foliage,
+                        self._mass * self._present, branch)
+        self._bplan.hinge_gain = self._lp.hinge_gain
+        self._mode_snap = None  # the branches' stiffness follows the modes: re-tune on the next step
+
+    def _derive_modes(self) -> None:
+        present = self._present if self._load_path else None  # Eq. 21 with the leaves still on
+        m = derive_modes(self._tree, self._physics, self._season, self._draws, present)
+        if hasattr(self, "_modes"):
+            # Keep the user's references valid: overwrite in place when possible.
+            cur = self._modes
+            if isinstance(cur.f, np.ndarray) and cur.f.shape == m.f.shape and cur.f.flags.writeable:
+                cur.f[...] = m.f
+            else:
+                cur.f = m.f
+            if isinstance(cur.zeta, np.ndarray) and cur.zeta.shape == m.zeta.shape and cur.zeta.flags.writeable:
+                cur.zeta[...] = m.zeta
+            else:
+                cur.zeta = m.zeta
+        else:
+            self._modes = m
+        self._mode_snap = None  # force re-validation and new coefficients
