@@ -22,6 +22,7 @@ import pytest
 
 import treeanim as ta
 from treeanim import cli, offline
+from treeanim.errors import InputError
 from treeanim.table1 import ROWS
 
 
@@ -200,7 +201,7 @@ def test_trace_with_fewer_than_two_samples_is_refused():
 
     sim = Simulation(ta.load_preset("beam"))
     for seconds, rate in ((5.0, 0.01), (1e-9, 240.0)):
-        with pytest.raises(offline.InputError, match="needs at least 2 samples"):
+        with pytest.raises(InputError, match="needs at least 2 samples"):
             offline.run_trace(sim, 0, (1.0, 0.0, 0.0), 0.5, seconds, rate)
     assert sim.time == 0.0 and not sim.pulls, "refused before anything was simulated"
     tr = offline.run_trace(sim, 0, (1.0, 0.0, 0.0), 0.05, 1.0 / 240, 240.0)  # the shortest trace: 2 samples
@@ -216,7 +217,7 @@ def test_bench_wind_beyond_the_fields_limit_is_input_error(monkeypatch):
 
     monkeypatch.setattr(offline, "offscreen", no_context)
     for wind in (2 * MAX_SPEED, -1.0, float("nan")):
-        with pytest.raises(offline.InputError, match="--wind"):
+        with pytest.raises(InputError, match="--wind"):
             offline.run_bench(["beam"], 16, 16, frames=1, steps=1, samples=0, wind=wind, quiet=True)
 def test_bench_json_reports_every_preset(tmp_path):
     res = treeanim("bench", "--size", "64x36", "--frames", 2, "--steps", 5, "--json", "bench.json", "--quiet",

@@ -11,14 +11,11 @@ import signal
 import sys
 import threading
 
+from .errors import GLUnavailable, InputError
 from .table1 import PLURAL, ROWS, TABLE1, TABLE1_FPS
 
 #: What plain ``treeanim`` runs.
 DEFAULT_COMMAND = ["view"]
-
-
-class UsageError(Exception):
-    """Bad command-line input: printed as one line, exit status 2."""
 
 
 def _season(text: str) -> float:
@@ -150,7 +147,7 @@ def wind_settings(args) -> dict:
     kw = dict(model=model or ("paper" if getattr(args, "paper", False) else "physical"))
     if getattr(args, "wind_preset", None):
         if kw["model"] == "paper":
-            raise UsageError("--wind-preset: the named winds are for --wind-model physical")
+            raise InputError("--wind-preset: the named winds are for --wind-model physical")
         kw.update(wind_preset(args.wind_preset))
     kw.setdefault("speed", args.wind_default)
     if args.wind is not None:
@@ -177,15 +174,15 @@ def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, f
 
 
 def check_frames(seconds: float, fps: float, step_rate: float = 60.0) -> int:
-    """The number of frames ``seconds`` at ``fps`` give; UsageError beyond :data:`MAX_FRAMES`,
+    """The number of frames ``seconds`` at ``fps`` give; InputError beyond :data:`MAX_FRAMES`,
     or beyond :data:`MAX_STEPS` simulation steps (one a frame, and at least ``step_rate`` a
     second: scripted frames step at most 1/60 s at a time)."""
     n = seconds * fps
     if n > MAX_FRAMES:
-        raise UsageError(f"--seconds {seconds:g} at --fps {fps:g} is {n:.3g} frames; at most {MAX_FRAMES:,}")
+        raise InputError(f"--seconds {seconds:g} at --fps {fps:g} is {n:.3g} frames; at most {MAX_FRAMES:,}")
     steps = seconds * max(fps, step_rate)
     if steps > MAX_STEPS:
-        raise UsageError(f"--seconds {seconds:g} takes {steps:.3g} simulation steps; at most {MAX_STEPS:,} "
+        raise InputError(f"--seconds {seconds:g} takes {steps:.3g} simulation steps; at most {MAX_STEPS:,} "
                          f"(about {MAX_STEPS / 3600 / 60:.0f} hours of simulated time at 60 steps a second)")
     return int(round(n))
 
@@ -205,7 +202,7 @@ def make_simulation(args):
         sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed,
                             load_path=not getattr(args, "paper", False))
     except ValueError as e:
-        raise UsageError(str(e)) from None
+        raise InputError(str(e)) from None
     return tree, sim
 
 
@@ -217,11 +214,11 @@ def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
 
     path = Path(text)
     if path.suffix.lower() not in suffixes:
-        raise UsageError(f"{option} {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
+        raise InputError(f"{option} {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
     try:
         offline.check_file(path, text)
-    except offline.InputError as e:
-        raise UsageError(str(e).replace("--out ", f"{option} ", 1)) from None
+    except InputError as e:
+        raise InputError(str(e).replace("--out ", f"{option} ", 1)) from None
     return path
 
 
@@ -238,12 +235,12 @@ def cmd_export(args) -> int:
     n = check_frames(args.seconds, args.fps)
     fade = check_frames(args.loop, args.fps)
     if n < 2:
-        raise UsageError(f"--seconds {args.seconds:g} at --fps {args.fps:g} gives fewer than 2 frames")
+        raise InputError(f"--seconds {args.seconds:g} at --fps {args.fps:g} gives fewer than 2 frames")
     if fade >= n:
-        raise UsageError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
+        raise InputError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
     size = (n + fade) * skel.count * 16
     if size > 8e9:
-        raise UsageError(f"{n + fade:,} frames of {skel.count:,} joints would need {size / 1e9:.0f} GB of keys; "
+        raise InputError(f"{n + fade:,} frames of {skel.count:,} joints would need {size / 1e9:.0f} GB of keys; "
                          "export fewer seconds or frames per second")
     keys = np.empty((n + fade, skel.count, 4), np.float32)
     bar = tqdm(total=n + fade, desc=f"baking {tree.name}", unit="frame", disable=args.quiet, leave=False)
@@ -304,10 +301,7 @@ def cmd_render(args) -> int:
     """Render an MP4 / GIF, a folder of PNG frames, or one PNG still, offscreen."""
     from treeanim import offline
 
-    try:
-        target = offline.render_target(args.out)
-    except offline.InputError as e:
-        raise UsageError(str(e)) from None
+    target = offline.render_target(args.out)
     seconds = args.seconds if args.seconds is not None else (
         offline.STILL_SECONDS if target.kind == "still" else 5.0)
     w, h = args.size
@@ -316,11 +310,11 @@ def cmd_render(args) -> int:
                             samples=args.samples, quiet=args.quiet)
     check_frames(args.start + seconds, args.fps)
     if target.kind != "still" and job.frame_range()[1] < 1:
-        raise UsageError(f"--seconds {seconds:g} at --fps {args.fps:g} gives no frame")
+        raise InputError(f"--seconds {seconds:g} at --fps {args.fps:g} gives no frame")
     tree, sim = make_simulation(args)
     try:
         res = offline.run_render(job, tree, sim, log=lambda m: print(m, file=sys.stderr))
-    except offline.GLUnavailable as e:
+    except GLUnavailable as e:
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 1
     if target.kind == "still":
@@ -356,17 +350,14 @@ def cmd_trace(args) -> int:
         try:
             import matplotlib  # noqa: F401
         except ImportError:
-            raise UsageError(f"--plot {offline.PLOTS_HINT}") from None
+            raise InputError(f"--plot {offline.PLOTS_HINT}") from None
     scene = argparse.Namespace(**vars(args))
     scene.pull = []
     tree, sim = make_simulation(scene)
     if not 0 <= args.object < tree.n_objects:
-        raise UsageError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
+        raise InputError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
     check_frames(args.hold + args.seconds, args.rate, step_rate=0.0)  # a trace steps once a sample
-    try:
-        tr = offline.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
-    except offline.InputError as e:
-        raise UsageError(str(e)) from None
+    tr = offline.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
     offline.write_trace_csv(out, tr)
     if plot is not None:
         offline.plot_trace(plot, tr, title=f"{tree.name}: pull {','.join(f'{v:g}' for v in args.pull)} N, "
@@ -396,13 +387,13 @@ def cmd_bench(args) -> int:
     known = list(ROWS) + [p for p in ta.list_presets() if p not in ROWS]
     for k in keys:
         if k not in known:
-            raise UsageError(f"--presets {k}: unknown; expected some of {', '.join(known)}")
+            raise InputError(f"--presets {k}: unknown; expected some of {', '.join(known)}")
     out = output_path(args.json, (".json",), "--json") if args.json else None
     w, h = args.size
     try:
         res = offline.run_bench(keys, w, h, frames=args.frames, steps=args.steps, samples=args.samples,
                                 wind=args.wind, quiet=args.quiet)
-    except offline.GLUnavailable as e:
+    except GLUnavailable as e:
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 1
     print(offline.format_bench(res))
@@ -423,7 +414,7 @@ def cmd_view(args) -> int:
              frames=args.frames,
              samples=args.samples)
     except (ViewerUnavailable, ValueError) as e:
-        raise UsageError(str(e)) from None
+        raise InputError(str(e)) from None
     return 0
 
 
@@ -581,8 +572,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``treeanim`` console script."""
-    from treeanim.model.errors import PresetError
-
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminated)  # `kill`: unwind, so temporary files are removed
     try:  # building the parser imports the wind's presets: Ctrl-C may come that early
@@ -596,7 +585,7 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # the reader went away (`treeanim info | head`): stop quietly
         _stdout_to_devnull()
         return 141
-    except (PresetError, UsageError) as e:
+    except InputError as e:  # a PresetError too
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 2
     except OSError as e:  # a write that failed (disk full, name too long ...): the old file is kept

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .errors import GLUnavailable, InputError
 from .files import atomic_path, temp_beside
 from .files import write_text as write_text  # re-exported: the command line writes its JSON through it
 from .table1 import ROWS, TABLE1, TABLE1_FPS
@@ -43,14 +44,6 @@ STILL_SUFFIX = ".png"
 FRAME_NAME = "frame_{:05d}.png"
 
 _SIZE = re.compile(r"^\s*(\d+)\s*[xX×]\s*(\d+)\s*$")
-
-
-class InputError(ValueError):
-    """Bad user input found by this module (the command line turns it into exit status 2)."""
-
-
-class GLUnavailable(RuntimeError):
-    """No OpenGL context to render with (the message says what to install)."""
 
 
 @contextlib.contextmanager

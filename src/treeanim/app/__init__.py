@@ -5,5 +5,5 @@ Modules: :mod:`~treeanim.app.window` (the window and its GL context), :mod:`~tre
 (:class:`~treeanim.app.viewer.Viewer`: simulation, renderer, camera, input handlers, the main
 loop), :mod:`~treeanim.app.gui` (imgui input and drawing), :mod:`~treeanim.app.panel` (the
 settings panel), :mod:`~treeanim.app.settings` (save a preset TOML), :mod:`~treeanim.app.main`
-(what the command line calls), :mod:`~treeanim.app.errors`.
+(what the command line calls), :mod:`~treeanim.app.display` (whether a window can open here).
 """

@@ -17,8 +17,8 @@ import tomllib
 from importlib import resources
 from pathlib import Path
 
+from ..errors import PresetError
 from ..files import atomic_path
-from ..model.errors import PresetError
 from ..model.params import SCALAR_KEYS, PhysicsParams
 from ..model.tree import KINDS, Tree
 

@@ -18,7 +18,8 @@ import glfw
 import imgui_bundle  # noqa: F401  (side effect: PYGLFW_LIBRARY)
 import moderngl
 
-from .errors import HEADLESS_HINT, ViewerUnavailable, check_display
+from ..errors import ViewerUnavailable
+from .display import HEADLESS_HINT, check_display
 
 __all__ = ["Window", "ViewerUnavailable", "HEADLESS_HINT", "SOFTWARE_RENDERER"]
 
