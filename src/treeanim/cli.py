@@ -79,7 +79,7 @@ def _checked(parse):
 
 
 def _size(text: str) -> tuple[int, int]:
-    from treeanim.offline import parse_size
+    from treeanim.offline.target import parse_size
 
     return _checked(parse_size)(text)
 
@@ -210,13 +210,13 @@ def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
     """Check an output path: a known extension and a folder where files can really be created."""
     from pathlib import Path
 
-    from treeanim import offline
+    from treeanim.offline.target import check_file
 
     path = Path(text)
     if path.suffix.lower() not in suffixes:
         raise InputError(f"{option} {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
     try:
-        offline.check_file(path, text)
+        check_file(path, text)
     except InputError as e:
         raise InputError(str(e).replace("--out ", f"{option} ", 1)) from None
     return path
@@ -299,21 +299,23 @@ def _mb(n: int) -> str:
 
 def cmd_render(args) -> int:
     """Render an MP4 / GIF, a folder of PNG frames, or one PNG still, offscreen."""
-    from treeanim import offline
+    from treeanim.offline import render
+    from treeanim.offline.sinks import FRAME_NAME
+    from treeanim.offline.target import render_target
 
-    target = offline.render_target(args.out)
+    target = render_target(args.out)
     seconds = args.seconds if args.seconds is not None else (
-        offline.STILL_SECONDS if target.kind == "still" else 5.0)
+        render.STILL_SECONDS if target.kind == "still" else 5.0)
     w, h = args.size
-    job = offline.RenderJob(target, w, h, args.fps, seconds, start=args.start, season=args.season, pulls=args.pull,
-                            azimuth=args.azimuth, elevation=args.elevation, distance=args.distance,
-                            samples=args.samples, quiet=args.quiet)
+    job = render.RenderJob(target, w, h, args.fps, seconds, start=args.start, season=args.season, pulls=args.pull,
+                           azimuth=args.azimuth, elevation=args.elevation, distance=args.distance,
+                           samples=args.samples, quiet=args.quiet)
     check_frames(args.start + seconds, args.fps)
     if target.kind != "still" and job.frame_range()[1] < 1:
         raise InputError(f"--seconds {seconds:g} at --fps {args.fps:g} gives no frame")
     tree, sim = make_simulation(args)
     try:
-        res = offline.run_render(job, tree, sim, log=lambda m: print(m, file=sys.stderr))
+        res = render.run_render(job, tree, sim, log=lambda m: print(m, file=sys.stderr))
     except GLUnavailable as e:
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 1
@@ -326,8 +328,8 @@ def cmd_render(args) -> int:
         pad = f", padded to {res.size[0]}×{res.size[1]}" if res.size != (w, h) else ""
         where = f"{res.path} ({w}×{h}{pad}, {dur}, {_mb(res.bytes)})"
     else:
-        last = offline.FRAME_NAME.format(max(res.frames - 1, 0))
-        where = f"{res.path}/: {offline.FRAME_NAME.format(0)} … {last} ({w}×{h}, {dur}, {_mb(res.bytes)})"
+        last = FRAME_NAME.format(max(res.frames - 1, 0))
+        where = f"{res.path}/: {FRAME_NAME.format(0)} … {last} ({w}×{h}, {dur}, {_mb(res.bytes)})"
     if res.interrupted:
         if res.kept:
             print(f"interrupted: kept {what} of {res.total} in {where}", file=sys.stderr)
@@ -342,7 +344,7 @@ def cmd_trace(args) -> int:
     """Pull one object's tip, let go, and record the tip's free swing as CSV (and a plot)."""
     import numpy as np
 
-    from treeanim import offline
+    from treeanim.offline import trace
 
     out = output_path(args.out, (".csv",))
     plot = output_path(args.plot, (".png", ".svg", ".pdf"), "--plot") if args.plot else None
@@ -350,22 +352,22 @@ def cmd_trace(args) -> int:
         try:
             import matplotlib  # noqa: F401
         except ImportError:
-            raise InputError(f"--plot {offline.PLOTS_HINT}") from None
+            raise InputError(f"--plot {trace.PLOTS_HINT}") from None
     scene = argparse.Namespace(**vars(args))
     scene.pull = []
     tree, sim = make_simulation(scene)
     if not 0 <= args.object < tree.n_objects:
         raise InputError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
     check_frames(args.hold + args.seconds, args.rate, step_rate=0.0)  # a trace steps once a sample
-    tr = offline.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
-    offline.write_trace_csv(out, tr)
+    tr = trace.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
+    trace.write_trace_csv(out, tr)
     if plot is not None:
-        offline.plot_trace(plot, tr, title=f"{tree.name}: pull {','.join(f'{v:g}' for v in args.pull)} N, "
-                                           f"released after {args.hold:g} s")
+        trace.plot_trace(plot, tr, title=f"{tree.name}: pull {','.join(f'{v:g}' for v in args.pull)} N, "
+                                         f"released after {args.hold:g} s")
     d = tr.tips - tr.rest
     f, z = tr.f, tr.zeta
-    fx = offline.zero_crossing_frequency(tr.times, d[:, 0] - d[-len(d) // 4:, 0].mean())
-    fz = offline.zero_crossing_frequency(tr.times, d[:, 2] - d[-len(d) // 4:, 2].mean())
+    fx = trace.zero_crossing_frequency(tr.times, d[:, 0] - d[-len(d) // 4:, 0].mean())
+    fz = trace.zero_crossing_frequency(tr.times, d[:, 2] - d[-len(d) // 4:, 2].mean())
     print(f"wrote {out}: {len(tr.times)} samples of object {args.object} ({tr.kind})'s tip over {args.seconds:g} s "
           f"after release at {args.rate:g} Hz" + (f"; plot {plot}" if plot else ""))
     crossing = ", ".join(f"{axis} {hz:.3f} Hz" if np.isfinite(hz) else f"{axis} too few to tell"
@@ -381,7 +383,8 @@ def cmd_bench(args) -> int:
     import json
 
     import treeanim as ta
-    from treeanim import offline
+    from treeanim.files import write_text
+    from treeanim.offline import bench
 
     keys = args.presets or list(ROWS)
     known = list(ROWS) + [p for p in ta.list_presets() if p not in ROWS]
@@ -391,14 +394,14 @@ def cmd_bench(args) -> int:
     out = output_path(args.json, (".json",), "--json") if args.json else None
     w, h = args.size
     try:
-        res = offline.run_bench(keys, w, h, frames=args.frames, steps=args.steps, samples=args.samples,
-                                wind=args.wind, quiet=args.quiet)
+        res = bench.run_bench(keys, w, h, frames=args.frames, steps=args.steps, samples=args.samples,
+                              wind=args.wind, quiet=args.quiet)
     except GLUnavailable as e:
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 1
-    print(offline.format_bench(res))
+    print(bench.format_bench(res))
     if out is not None:
-        offline.write_text(out, json.dumps(res, indent=2) + "\n")
+        write_text(out, json.dumps(res, indent=2) + "\n")
         print(f"wrote {out}")
     return 0
 
