@@ -505,7 +505,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="camera direction about the vertical; 0 looks along -z, the default wind blows left "
                    "to right (default 0)")
     p.add_argument("--elevation", type=_finite, default=None, metavar="DEG",
-                   help="camera height angle above the horizon (default 2, or 25 for flat scenes like grass)")
+                   help="camera height angle above the horizon (default 8, or 25 for flat scenes like grass)")
     p.add_argument("--distance", type=_positive(float), default=None, metavar="METRES",
                    help="camera distance to the tree's centre (default: framed on the tree)")
     p.add_argument("--samples", type=_samples, default=4, help="MSAA samples (default 4; 0 = none)")

@@ -25,6 +25,8 @@ from .winddir import wind_angle
 
 #: Width of the panel in screen units at UI scale 1.
 PANEL_WIDTH = 330
+#: Gap between the panel and the window's top and left edges (and the scene), at UI scale 1.
+PANEL_GAP = 8
 
 #: Slider ranges: (min, max, format, logarithmic).
 RANGES = {
@@ -94,6 +96,11 @@ class Panel:
     def width(self) -> float:
         """Width in screen units."""
         return PANEL_WIDTH * self.viewer.gui.scale
+
+    @property
+    def right(self) -> float:
+        """Screen units from the window's left edge to the scene beside the panel."""
+        return (PANEL_WIDTH + 2 * PANEL_GAP) * self.viewer.gui.scale
 
     def contains(self, x: float, y: float) -> bool:
         """Whether screen point (x, y) lies on the panel as last drawn."""
@@ -272,7 +279,7 @@ class Panel:
         s = v.gui.scale
         ww, wh = v._win
         self.item_rects = {}
-        imgui.set_next_window_pos(imgui.ImVec2(8 * s, 8 * s), imgui.Cond_.always)
+        imgui.set_next_window_pos(imgui.ImVec2(PANEL_GAP * s, PANEL_GAP * s), imgui.Cond_.always)
         imgui.set_next_window_size_constraints(imgui.ImVec2(self.width, 0),
                                                imgui.ImVec2(self.width, max(wh - 16 * s, 60)))
         imgui.set_next_window_size(imgui.ImVec2(self.width, 0), imgui.Cond_.always)

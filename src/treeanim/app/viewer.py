@@ -32,7 +32,7 @@ from ..model.tree import Tree
 from ..physics.simulation import MAX_PULL, Simulation
 from ..physics.wind import WindField
 from ..physics.wind import wind_preset as wind_preset_kwargs
-from ..render.camera import OrbitCamera
+from ..render.camera import OrbitCamera, frame_tree
 from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
 from ..render.picking import Picker
 from ..render.renderer import Renderer, Scene
@@ -115,8 +115,8 @@ class ViewCamera(OrbitCamera):
     _vp = None
 
     def view_projection(self, width: int, height: int) -> np.ndarray:
-        key = (self.target.tobytes(), self.distance, self.azimuth, self.elevation, self.fov_y, self.near, self.far,
-               width, height)
+        key = (self.target.tobytes(), self.shift.tobytes(), self.distance, self.azimuth, self.elevation, self.fov_y,
+               self.near, self.far, width, height)
         if key != self._vp_key:
             vp = super().view_projection(width, height)
             vp.setflags(write=False)
@@ -302,22 +302,14 @@ class Viewer:
                 setattr(w, k, v)
 
     # ------------------------------------------------------------------ camera
-    @property
-    def panel_width(self) -> float:
-        """Screen units the panel covers at the left (0 when hidden)."""
-        return self.panel.width if self.show_panel else 0.0
-
     def frame_camera(self) -> None:
-        """Aim at the tree so it fills the view beside the panel."""
+        """Frame the tree beside the panel (:func:`~treeanim.render.camera.frame_tree`, the
+        offline commands' framing): the orbit then pivots on the tree's centre."""
         w, h = self._win
         if w <= 0 or h <= 0:
             w, h = 16, 9
-        free = max(w - self.panel_width, 0.4 * w)
-        lo, hi = self.renderer.bounds()
-        flat = (hi[1] - lo[1]) < 0.5 * max(hi[0] - lo[0], hi[2] - lo[2])
-        self.camera.elevation = 25.0 if flat else 8.0  # look down on a meadow, along a tree
-        self.camera.frame((lo, hi), aspect=free / h)
-        self.camera.pan((w - free) / 2.0, 0.0, h)  # the tree moves right, beside the panel
+        left = self.panel.right if self.show_panel else 0.0
+        frame_tree(self.camera, self.tree, w, h, present=self.sim.shown, left=min(left, 0.6 * w))
 
     # ------------------------------------------------------------------ time
     @property

@@ -13,8 +13,8 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..render.camera import framed_camera
 from ..table1 import ROWS, TABLE1, TABLE1_FPS
-from .framing import framed_camera
 from .render import offscreen
 
 

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GLUnavailable
-from .framing import framed_camera
+from ..render.camera import framed_camera
 from .sinks import FRAME_NAME, SINKS, write_png
 from .target import Target
 
