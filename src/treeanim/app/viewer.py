@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
@@ -29,7 +28,8 @@ import glfw
 import numpy as np
 
 from ..model.tree import Tree
-from ..physics.simulation import MAX_PULL, Simulation
+from ..physics.pull import SpringPull
+from ..physics.simulation import Simulation
 from ..physics.wind import WindField
 from ..physics.wind import wind_preset as wind_preset_kwargs
 from ..render.camera import OrbitCamera, frame_tree
@@ -46,65 +46,10 @@ from .window import Window
 MAX_FRAME_DT = 0.5
 #: Longest simulation sub-step (s of simulated time).
 MAX_SUBSTEP = 1.0 / 60.0
-#: Time constant (s, simulated) of the low-pass on the pull force: it damps the loop between
-#: the spring and the beam's static deflection, so the grabbed point settles without ringing.
-PULL_TAU = 0.04
-#: The spring's loop gain: at equilibrium the grabbed point covers GAIN / (1 + GAIN) of the
-#: distance to the cursor (60 % for a small drag; a stiff beam bends less than that).
-PULL_GAIN = 1.5
-#: The pull force saturates at the spring force of a drag this many object lengths long.
-PULL_MAX_LENGTHS = 2.0
 #: Orbit speed, degrees per screen unit of drag.
 ORBIT_DEG_PER_UNIT = 0.35
 #: Zoom factor per wheel notch.
 ZOOM_PER_NOTCH = 0.88
-
-
-@dataclass
-class Grab:
-    """A pull in progress.
-
-    Attributes
-    ----------
-    object : int
-        The grabbed object.
-    node : int
-        Global index of the first node of the segment holding the anchor.
-    s : float
-        Where the anchor lies along that segment, 0 … 1.
-    offset : (3,) float
-        Picked point minus anchor at grab time (the picked point may lie on a leaf's lamina).
-    plane_point, plane_normal : (3,) float
-        The plane facing the camera through the picked point; the cursor is projected on it.
-    target : (3,) float
-        The cursor's point on that plane.
-    k : float
-        Spring constant, N/m.
-    f_max : float
-        Largest force, N.
-    force : (3,) float
-        The current (low-passed) pull force, N.
-    ratio : float
-        Metres the grabbed point moves per metre the object's tip moves while bent by a tip
-        force (the ratio of their compliances): between a frame's sub-steps the grabbed point
-        is followed through :meth:`Simulation.tip_position` instead of the whole pose.
-    frame_anchor, frame_tip : (3,) float or None
-        The grabbed point and the tip at the frame's first sub-step (exact, from the pose).
-    """
-
-    object: int
-    node: int
-    s: float
-    offset: np.ndarray
-    plane_point: np.ndarray
-    plane_normal: np.ndarray
-    target: np.ndarray
-    k: float
-    f_max: float
-    force: np.ndarray
-    ratio: float = 1.0
-    frame_anchor: np.ndarray | None = None
-    frame_tip: np.ndarray | None = None
 
 
 class ViewCamera(OrbitCamera):
@@ -179,8 +124,8 @@ class Viewer:
         The OpenGL renderer's name.
     show_trace, show_frames, show_wind : bool
         Overlays: the pulled tip's trace, the local frames, the wind slices and arrow.
-    grab : Grab or None
-        The pull in progress.
+    grab : SpringPull or None
+        The pull in progress (:mod:`treeanim.physics.pull`).
     last_sim_s, last_draw_s : float
         Wall time of the last frame's simulation sub-steps and of its drawing (pose upload,
         draw calls, panel), seconds; ``sim_ms`` and ``render_ms`` are their moving averages.
@@ -200,7 +145,7 @@ class Viewer:
         self.show_trace = True
         self.show_frames = False
         self.show_wind = False
-        self.grab: Grab | None = None
+        self.grab: SpringPull | None = None
         self.traced: int | None = None  # object whose tip the trace follows
         self.trace = PullTrace(capacity=2400)
         self.camera = ViewCamera(azimuth=20.0, elevation=8.0)
@@ -334,7 +279,7 @@ class Viewer:
         sim = self.sim
         for j in range(n):
             if self.grab is not None:
-                self._update_pull(h, exact=j == 0)
+                self.grab.step(sim, h, exact=j == 0)
             sim.step(h)
             if self.traced is not None:
                 self.trace.push(sim.tip_position(self.traced))
@@ -491,77 +436,31 @@ class Viewer:
         return self.picker.pick(self.sim.positions, self.sim.rotations, o, d, present=self.sim.present,
                                 pixel_angle=self.camera.pixel_angle(max(self._win[1], 1)), min_pixels=4.0)
 
-    def _cursor_target(self, x: float, y: float, g: Grab) -> np.ndarray:
-        o, d = self._ray(x, y)
-        denom = float(d @ g.plane_normal)
-        if abs(denom) < 1e-9:
-            return g.target
-        t = float((g.plane_point - o) @ g.plane_normal) / denom
-        return o + max(t, 0.0) * d
-
     def start_pull(self, x: float, y: float) -> bool:
         """Grab the object under (x, y), if any. Returns whether something was grabbed."""
         hit = self.pick(x, y)
         if hit is None:
             return False
-        tree, sim = self.sim.tree, self.sim
-        obj = hit.object
-        nodes = tree.object_nodes(obj)
-        P = sim.positions
-        a, b = P[nodes[:-1]], P[nodes[1:]]
-        e = b - a
-        s = np.clip(np.einsum("ij,ij->i", hit.point - a, e) / np.maximum(np.einsum("ij,ij->i", e, e), 1e-30), 0, 1)
-        dist = np.linalg.norm(a + s[:, None] * e - hit.point, axis=1)
-        k = int(np.argmin(dist))
-        anchor = a[k] + s[k] * e[k]
-        point = np.asarray(hit.point, float)
-        G = max(sim.compliance(obj, k, float(s[k]), point - anchor), 1e-12)
-        G_tip = max(sim.compliance(obj, len(nodes) - 2, 1.0), 1e-12)
-        spring = PULL_GAIN / G
-        length = float(np.sum(np.linalg.norm(np.diff(tree.rest_positions[nodes], axis=0), axis=1)))
-        length += float(tree.lamina_length[obj])
-        self.grab = Grab(object=obj, node=int(nodes[k]), s=float(s[k]), offset=point - anchor,
-                         plane_point=point.copy(), plane_normal=self.camera.forward.copy(), target=point.copy(),
-                         k=spring, f_max=spring * PULL_MAX_LENGTHS * length, force=np.zeros(3),
-                         ratio=G / G_tip)
+        self.grab = SpringPull.grab(self.sim, hit.object, hit.point, self.camera.forward)
         self.trace.clear()
-        self.traced = obj
-        self.trace.push(sim.tip_position(obj))
+        self.traced = hit.object
+        self.trace.push(self.sim.tip_position(hit.object))
         return True
 
     def anchor_point(self) -> np.ndarray | None:
         """Where the grabbed point is now (world), or None."""
-        g = self.grab
-        if g is None:
-            return None
-        P = self.sim.positions
-        return P[g.node] + g.s * (P[g.node + 1] - P[g.node]) + g.offset
+        return None if self.grab is None else self.grab.anchor(self.sim)
 
     def _grabbed_point(self, exact: bool) -> np.ndarray:
-        """Where the grabbed point is: exact from the pose when ``exact`` (a frame's first
-        sub-step, whose pose the last frame drew, so it is built already), else followed from
-        the frame's exact point by the tip's motion since (one tip, not N nodes, a sub-step)."""
-        g = self.grab
-        tip = self.sim.tip_position(g.object)
-        if exact or g.frame_anchor is None:
-            g.frame_anchor, g.frame_tip = self.anchor_point(), tip
-            return g.frame_anchor
-        return g.frame_anchor + g.ratio * (tip - g.frame_tip)
-
-    def _update_pull(self, h: float, exact: bool = True) -> None:
-        g = self.grab
-        raw = g.k * (g.target - self._grabbed_point(exact))
-        mag = float(np.linalg.norm(raw))
-        f_max = min(g.f_max, MAX_PULL)  # what Simulation.pull accepts, whatever the spring says
-        if mag > f_max:
-            raw *= f_max / mag
-        g.force += (h / (PULL_TAU + h)) * (raw - g.force)
-        self.sim.pull(g.object, g.force)
+        """The grabbed point, exact on a frame's first sub-step (whose pose the last frame
+        drew, so it is built already), else followed through the tip
+        (:meth:`SpringPull.grabbed_point`)."""
+        return self.grab.grabbed_point(self.sim, exact)
 
     def end_pull(self) -> None:
         """Let go of the grabbed object (it swings freely; the trace goes on)."""
         if self.grab is not None:
-            self.sim.release(self.grab.object)
+            self.grab.release(self.sim)
             self.grab = None
 
     def _end_drag(self) -> None:
@@ -585,7 +484,7 @@ class Viewer:
         elif self._mode == "pan":
             self.camera.pan(dx, dy, max(self._win[1], 1))
         elif self._mode == "pull" and self.grab is not None:
-            self.grab.target = self._cursor_target(x, y, self.grab)
+            self.grab.aim(*self._ray(x, y))
 
     def on_mouse_button(self, button: int, action: int, mods: int = 0) -> None:
         """A mouse button went down (``glfw.PRESS``) or up (``glfw.RELEASE``)."""
