@@ -20,6 +20,7 @@ from ..model.tree import KINDS
 from ..physics.simulation import INTEGRATORS
 from ..physics.wind import WIND_PRESETS
 from ..render.renderer import sun_angles, sun_direction
+from .keys import help_lines
 from .settings import save_preset
 from .winddir import wind_angle
 
@@ -442,9 +443,7 @@ class Panel:
             else:
                 imgui.text_wrapped(line)
         if self._header("Controls"):
-            for line in ("left-drag a branch or leaf: pull, let go: swing", "left-drag the sky: orbit",
-                         "right/middle-drag: pan   wheel: zoom", "F frame  Space pause  R reset  H panel",
-                         "S/F12 screenshot  F11 full screen  Esc/Q quit"):
+            for line in help_lines():
                 imgui.push_style_color(imgui.Col_.text, imgui.get_style_color_vec4(imgui.Col_.text_disabled))
                 imgui.text_wrapped(line)  # the panel is narrow: lines wrap rather than run off its edge
                 imgui.pop_style_color()

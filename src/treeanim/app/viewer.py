@@ -5,16 +5,7 @@ imgui panel.
 window's GLFW callbacks call its input handlers (``on_mouse_button``, ``on_cursor_pos``,
 ``on_scroll``, ``on_key``, ``on_char``, ``on_resize``, ``on_focus``); tests call the same
 handlers. :meth:`Viewer.frame` advances the simulation by the elapsed time and draws one frame;
-:func:`run` is the main loop.
-
-Controls
---------
-left-drag on a branch, leaf or blade   pull it (a spring to the cursor); let go to release
-left-drag elsewhere                    orbit
-right- or middle-drag                  pan
-wheel                                  zoom
-F frame the tree · Space pause · R reset · S or F12 screenshot · H hide the panel
-F11 full screen · Ctrl+S save the preset · Ctrl+O load it · Esc or Q quit
+:func:`run` is the main loop. The controls are the table in :mod:`treeanim.app.keys`.
 """
 
 from __future__ import annotations
@@ -37,6 +28,7 @@ from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
 from ..render.picking import Picker
 from ..render.renderer import Renderer, Scene
 from .gui import Gui
+from .keys import binding_for
 from .winddir import wind_direction
 from .window import Window
 
@@ -526,29 +518,9 @@ class Viewer:
             self.gui.key(key, action, mods)
         if action != glfw.PRESS or (self.show_panel and self.gui.wants_keyboard):
             return
-        ctrl = bool(mods & glfw.MOD_CONTROL)
-        if ctrl and key == glfw.KEY_S:
-            self.panel.save()
-        elif ctrl and key == glfw.KEY_O:
-            self.panel.load()
-        elif ctrl:
-            return
-        elif key in (glfw.KEY_ESCAPE, glfw.KEY_Q):
-            self.window.request_close()
-        elif key == glfw.KEY_SPACE:
-            self.paused = not self.paused
-        elif key == glfw.KEY_R:
-            self.reset()
-        elif key == glfw.KEY_F:
-            self.frame_camera()
-        elif key in (glfw.KEY_S, glfw.KEY_F12):
-            self.request_screenshot()
-        elif key == glfw.KEY_F11:
-            self.window.toggle_fullscreen()
-        elif key == glfw.KEY_H:
-            self.show_panel = not self.show_panel
-            if self.show_panel:
-                self.gui.mouse_pos(*self._cursor)
+        binding = binding_for(key, mods)
+        if binding is not None:
+            getattr(self, binding.action)()
 
     def on_resize(self, width: int, height: int) -> None:
         """The framebuffer is now ``width`` × ``height`` pixels (0 × 0: minimised). Beyond the
@@ -580,7 +552,33 @@ class Viewer:
     def on_refresh(self) -> None:
         """The window needs redrawing (nothing to do: the loop draws continuously)."""
 
-    # ------------------------------------------------------------------ actions
+    # ------------------------------------------------------------------ actions (keys.BINDINGS)
+    def toggle_pause(self) -> None:
+        """Pause or resume the simulation."""
+        self.paused = not self.paused
+
+    def toggle_panel(self) -> None:
+        """Hide or show the panel."""
+        self.show_panel = not self.show_panel
+        if self.show_panel:
+            self.gui.mouse_pos(*self._cursor)
+
+    def toggle_fullscreen(self) -> None:
+        """Full screen on the window's monitor, or back."""
+        self.window.toggle_fullscreen()
+
+    def save_preset(self) -> None:
+        """Save the settings as a preset at the panel's file name (:meth:`Panel.save`)."""
+        self.panel.save()
+
+    def load_preset(self) -> None:
+        """Load the preset at the panel's file name (:meth:`Panel.load`)."""
+        self.panel.load()
+
+    def quit(self) -> None:
+        """Close the window (the main loop ends)."""
+        self.window.request_close()
+
     def reset(self) -> None:
         """Back to rest: the simulation at time 0, no pull, no trace."""
         self._end_drag()
