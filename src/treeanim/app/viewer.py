@@ -15,7 +15,6 @@ import time
 from datetime import datetime
 from pathlib import Path
 
-import glfw
 import numpy as np
 
 from ..model.tree import Tree
@@ -23,12 +22,12 @@ from ..physics.pull import SpringPull
 from ..physics.simulation import Simulation
 from ..physics.wind import WindField
 from ..physics.wind import wind_preset as wind_preset_kwargs
-from ..render.camera import OrbitCamera, frame_tree
+from ..render.camera import TREE_ELEVATION, OrbitCamera, frame_tree
 from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
 from ..render.picking import Picker
 from ..render.renderer import Renderer, Scene
 from .gui import Gui
-from .keys import binding_for
+from .input import ViewerInput
 from .winddir import wind_direction
 from .window import Window
 
@@ -38,27 +37,6 @@ from .window import Window
 MAX_FRAME_DT = 0.5
 #: Longest simulation sub-step (s of simulated time).
 MAX_SUBSTEP = 1.0 / 60.0
-#: Orbit speed, degrees per screen unit of drag.
-ORBIT_DEG_PER_UNIT = 0.35
-#: Zoom factor per wheel notch.
-ZOOM_PER_NOTCH = 0.88
-
-
-class ViewCamera(OrbitCamera):
-    """An :class:`OrbitCamera` whose view·projection matrix is kept until the camera or the
-    viewport changes (building it through pyrr costs ~0.2 ms, and most frames reuse it)."""
-
-    _vp_key = None
-    _vp = None
-
-    def view_projection(self, width: int, height: int) -> np.ndarray:
-        key = (self.target.tobytes(), self.shift.tobytes(), self.distance, self.azimuth, self.elevation, self.fov_y,
-               self.near, self.far, width, height)
-        if key != self._vp_key:
-            vp = super().view_projection(width, height)
-            vp.setflags(write=False)
-            self._vp, self._vp_key = vp, key
-        return self._vp
 
 
 def _clone_wind(w: WindField | None, **changes) -> WindField:
@@ -82,7 +60,7 @@ class _Ema:
         self.value = x if self.value is None else self.value + self.w * (x - self.value)
 
 
-class Viewer:
+class Viewer(ViewerInput):
     """A tree in wind in a window: simulation, renderer, camera, mouse and keys, panel.
 
     Parameters
@@ -107,8 +85,7 @@ class Viewer:
     ----------
     sim : Simulation
     renderer : Renderer
-    camera : ViewCamera
-        An OrbitCamera (with its matrix cached).
+    camera : OrbitCamera
     paused : bool
     time_scale : float
         Simulated seconds per real second (0.05 … 2).
@@ -140,7 +117,7 @@ class Viewer:
         self.grab: SpringPull | None = None
         self.traced: int | None = None  # object whose tip the trace follows
         self.trace = PullTrace(capacity=2400)
-        self.camera = ViewCamera(azimuth=20.0, elevation=8.0)
+        self.camera = OrbitCamera(azimuth=20.0, elevation=TREE_ELEVATION)
         self.messages: list[str] = []  # lines for the panel's status line (newest last)
         self.screenshots: list[Path] = []
         self.sim_ms, self.render_ms, self.frame_s = _Ema(), _Ema(), _Ema(0.05)
@@ -148,11 +125,7 @@ class Viewer:
         self.last_sim_s = self.last_draw_s = 0.0  # the last frame's advance() and draw(), s
         self._acc = 0.0
         self._last_time: float | None = None
-        self._mode: str | None = None  # 'orbit', 'pan', 'pull' while a button is held
-        self._mode_button: int | None = None
-        self._cursor = (0.0, 0.0)
         self._screenshot_pending: list[Path | None] = []
-        self._readback = None
         self._uploaded = None
         self._stats_key = None
         self._stats: dict = {}
@@ -357,31 +330,8 @@ class Viewer:
     # ------------------------------------------------------------------ pixels
     def read_pixels(self) -> np.ndarray:
         """The back buffer as drawn so far, (height, width, 3) uint8, row 0 at the top
-        (a multisampled buffer is resolved first)."""
-        fw, fh = self._fb
-        if fw <= 0 or fh <= 0:
-            return np.zeros((max(fh, 0), max(fw, 0), 3), np.uint8)
-        from OpenGL import GL
-
-        self.window.make_current()
-        ctx = self.ctx
-        if self._readback is None or self._readback[0] != (fw, fh):
-            if self._readback is not None:
-                ctx.screen.use()
-                for o in self._readback[1:]:
-                    o.release()
-            rb = ctx.renderbuffer((fw, fh), 4)
-            fbo = ctx.framebuffer([rb])
-            self._readback = ((fw, fh), fbo, rb)
-        fbo = self._readback[1]
-        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, 0)
-        GL.glReadBuffer(GL.GL_BACK)
-        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, fbo.glo)
-        GL.glBlitFramebuffer(0, 0, fw, fh, 0, 0, fw, fh, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
-        data = fbo.read(components=3, alignment=1)
-        ctx.screen.use()
-        img = np.frombuffer(data, np.uint8).reshape(fh, fw, 3)
-        return np.ascontiguousarray(img[::-1])
+        (:meth:`Window.read_pixels`)."""
+        return self.window.read_pixels(*self._fb)
 
     def request_screenshot(self, path=None) -> None:
         """Write a screenshot after the next frame is drawn (see :meth:`screenshot`)."""
@@ -455,103 +405,6 @@ class Viewer:
             self.grab.release(self.sim)
             self.grab = None
 
-    def _end_drag(self) -> None:
-        self.end_pull()
-        self._mode = None
-        self._mode_button = None
-
-    # ------------------------------------------------------------------ input handlers
-    def _over_panel(self, x: float, y: float) -> bool:
-        return self.show_panel and self.panel.owns_mouse(x, y)
-
-    def on_cursor_pos(self, x: float, y: float) -> None:
-        """Cursor moved to (x, y) screen units, origin top-left."""
-        px, py = self._cursor
-        self._cursor = (float(x), float(y))
-        if self.show_panel:
-            self.gui.mouse_pos(x, y)
-        dx, dy = x - px, y - py
-        if self._mode == "orbit":
-            self.camera.orbit(-ORBIT_DEG_PER_UNIT * dx, ORBIT_DEG_PER_UNIT * dy)
-        elif self._mode == "pan":
-            self.camera.pan(dx, dy, max(self._win[1], 1))
-        elif self._mode == "pull" and self.grab is not None:
-            self.grab.aim(*self._ray(x, y))
-
-    def on_mouse_button(self, button: int, action: int, mods: int = 0) -> None:
-        """A mouse button went down (``glfw.PRESS``) or up (``glfw.RELEASE``)."""
-        x, y = self._cursor
-        if action == glfw.PRESS:
-            over = self._over_panel(x, y)
-            if self.show_panel:
-                self.gui.mouse_button(button, True)
-            if over or self._mode is not None:
-                return
-            if button == glfw.MOUSE_BUTTON_LEFT:
-                self._mode = "pull" if self.start_pull(x, y) else "orbit"
-            elif button in (glfw.MOUSE_BUTTON_RIGHT, glfw.MOUSE_BUTTON_MIDDLE):
-                self._mode = "pan"
-            else:
-                return
-            self._mode_button = button
-        elif action == glfw.RELEASE:
-            self.gui.mouse_button(button, False)
-            if button == self._mode_button:
-                self._end_drag()
-
-    def on_scroll(self, dx: float, dy: float) -> None:
-        """Wheel turned (dy > 0: away from the user, zooms in)."""
-        if self._over_panel(*self._cursor):
-            self.gui.scroll(dx, dy)
-            return
-        self.camera.zoom(ZOOM_PER_NOTCH ** float(dy))
-
-    def on_char(self, codepoint: int) -> None:
-        """A character was typed (for the panel's text fields)."""
-        if self.show_panel:
-            self.gui.char(codepoint)
-
-    def on_key(self, key: int, scancode: int, action: int, mods: int) -> None:
-        """A key went down, repeated or up. Shortcuts act on presses while the panel does not
-        want the keyboard."""
-        if self.show_panel or action == glfw.RELEASE:
-            self.gui.key(key, action, mods)
-        if action != glfw.PRESS or (self.show_panel and self.gui.wants_keyboard):
-            return
-        binding = binding_for(key, mods)
-        if binding is not None:
-            getattr(self, binding.action)()
-
-    def on_resize(self, width: int, height: int) -> None:
-        """The framebuffer is now ``width`` × ``height`` pixels (0 × 0: minimised). Beyond the
-        GL's largest size (no window manager kept it within) the window is shrunk back, and
-        drawn only up to that size meanwhile."""
-        most = self.window.max_pixels
-        if width > most or height > most:
-            self.window.shrink_to(most)
-        self._fb = (min(max(int(width), 0), most), min(max(int(height), 0), most))
-        try:
-            self._win = tuple(self.window.size)
-        except Exception:  # pragma: no cover
-            self._win = self._fb
-
-    def on_window_size(self, width: int, height: int) -> None:
-        """The window is now ``width`` × ``height`` screen units."""
-        self._win = (max(int(width), 0), max(int(height), 0))
-
-    def on_focus(self, focused: bool) -> None:
-        """Focus gained or lost; losing it ends any drag and lets go of a pull."""
-        self.gui.focus(focused)
-        if not focused:
-            self._end_drag()
-
-    def on_cursor_enter(self, entered: bool) -> None:
-        if not entered:
-            self.gui.mouse_left()
-
-    def on_refresh(self) -> None:
-        """The window needs redrawing (nothing to do: the loop draws continuously)."""
-
     # ------------------------------------------------------------------ actions (keys.BINDINGS)
     def toggle_pause(self) -> None:
         """Pause or resume the simulation."""
@@ -589,12 +442,7 @@ class Viewer:
 
     def release(self) -> None:
         """Free the GL resources (the window stays open)."""
-        self.window.make_current()
-        if self._readback is not None:
-            self.ctx.screen.use()
-            for o in self._readback[1:]:
-                o.release()
-            self._readback = None
+        self.window.release_readback()
         if self.renderer is not None:
             self.renderer.release()
             self.renderer = None
