@@ -21,7 +21,7 @@ import pytest
 import treeanim as ta
 from treeanim.app import window as window_module
 from treeanim.app.gui import Gui
-from treeanim.app.settings import physics_toml, preset_text, save_preset
+from treeanim.app.save import physics_toml, preset_text, save_preset
 from treeanim.app.viewer import MAX_FRAME_DT, Viewer, run
 from treeanim.app.window import Window
 from treeanim.model.params import ModeRange
