@@ -18,16 +18,6 @@ from .table1 import PLURAL, ROWS, TABLE1, TABLE1_FPS
 DEFAULT_COMMAND = ["view"]
 
 
-def _season(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number in [0, 1], got {text!r}") from None
-    if not 0.0 <= value <= 1.0:
-        raise argparse.ArgumentTypeError(f"expected a number in [0, 1], got {text!r}")
-    return value
-
-
 #: Upper bound of times, rates and counts on the command line: large enough for any real use,
 #: small enough that products of them stay finite and allocations sane.
 LIMIT = 1e6
@@ -106,7 +96,7 @@ def _wind_speed(text: str) -> float:
 
 def add_season_option(p: argparse.ArgumentParser) -> None:
     """--season, for every command that builds a tree."""
-    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
+    p.add_argument("--season", type=_number(float, 0, 1, lo_open=False), default=0.0, help="0 = summer … 1 = winter (default 0)")
 
 
 def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:

@@ -10,7 +10,6 @@ interrupted save never leaves a half-written preset. ``treeanim.load_tree(path)`
 
 from __future__ import annotations
 
-import math
 import os
 import re
 import tomllib
@@ -21,6 +20,7 @@ from ..errors import PresetError
 from ..files import atomic_path
 from ..model.params import SCALAR_KEYS, PhysicsParams
 from ..model.tree import KINDS, Tree
+from ..validate import finite_float, positive_float
 
 __all__ = ["physics_toml", "preset_text", "save_preset", "original_preset_text"]
 
@@ -29,10 +29,7 @@ _TOP_SEED = re.compile(r"^\s*seed\s*=")
 
 
 def _num(x: float) -> str:
-    x = float(x)
-    if not math.isfinite(x):
-        raise ValueError(f"cannot write a non-finite number ({x!r}) into a preset")
-    return repr(x)
+    return repr(finite_float("a number written into a preset", x))
 
 
 def physics_toml(physics: PhysicsParams) -> str:
@@ -45,10 +42,8 @@ def physics_toml(physics: PhysicsParams) -> str:
     """
     lines = ["[physics]"]
     for k in SCALAR_KEYS:
-        v = float(getattr(physics, k))
-        if not (math.isfinite(v) and v > 0):
-            raise ValueError(f"physics.{k} = {v!r}: a preset holds only finite positive numbers here")
-        lines.append(f"{k} = {_num(v)}")
+        v = positive_float(f"physics.{k}", getattr(physics, k))  # the preset format holds no other
+        lines.append(f"{k} = {v!r}")
     for season in ("summer", "winter"):
         modes = getattr(physics, season)
         lines += ["", f"[physics.{season}]"]

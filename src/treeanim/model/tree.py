@@ -7,12 +7,12 @@ so each level is one contiguous slice of the object arrays (and of the node arra
 
 from __future__ import annotations
 
-import math
 import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..validate import finite_float
 from .geometry import polygon_area
 from .look import Bark
 from .params import PhysicsParams
@@ -203,13 +203,7 @@ class Tree:
         ValueError
             If ``season`` is not a finite real number.
         """
-        try:
-            season = float(season)
-        except (TypeError, ValueError):
-            raise ValueError(f"season must be a finite number, got {season!r}") from None
-        if not math.isfinite(season):
-            raise ValueError(f"season must be finite, got {season!r}")
-        season = min(max(season, 0.0), 1.0)
+        season = min(max(finite_float("season", season), 0.0), 1.0)
         n_leaves = int(np.count_nonzero(self.kind == "leaf"))
         keep = int(round(n_leaves + (self.winter_leaves - n_leaves) * season))
         fallen = n_leaves - keep

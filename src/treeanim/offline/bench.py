@@ -3,7 +3,6 @@ paper's, median simulation and render times, and the frame rate they allow."""
 
 from __future__ import annotations
 
-import math
 import os
 import platform
 import statistics
@@ -15,6 +14,7 @@ import numpy as np
 from ..errors import InputError
 from ..render.camera import framed_camera
 from ..table1 import ROWS, TABLE1, TABLE1_FPS
+from ..validate import float_within
 from .render import offscreen
 
 
@@ -108,8 +108,10 @@ def run_bench(keys, width: int = 1280, height: int = 720, frames: int = 20, step
 
     from ..physics.wind import MAX_SPEED
 
-    if not (math.isfinite(wind) and 0.0 <= wind <= MAX_SPEED):
-        raise InputError(f"--wind {wind:g}: expected a wind speed from 0 to {MAX_SPEED:g} m/s")
+    try:
+        float_within("--wind", wind, 0.0, MAX_SPEED, " m/s")
+    except ValueError as e:
+        raise InputError(str(e)) from None
 
     started = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
     machine = machine_info()

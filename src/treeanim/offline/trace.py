@@ -3,7 +3,6 @@ Figs. 1 and 4) as CSV and, with matplotlib, a plot."""
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -11,6 +10,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..files import atomic_path
+from ..validate import positive_float
 
 #: What to install for plots (``trace --plot`` and the examples), from the repository.
 PLOTS_HINT = "needs matplotlib: .venv/bin/pip install -e '.[plots]' (from the repository)"
@@ -43,9 +43,10 @@ def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float) ->
     """
     from ..physics.simulation import trace_tips
 
-    for name, value in (("--seconds", seconds), ("--rate", rate)):
-        if not (math.isfinite(value) and value > 0):
-            raise InputError(f"{name} {value:g}: expected a positive number")
+    try:
+        positive_float("--seconds", seconds), positive_float("--rate", rate)
+    except ValueError as e:
+        raise InputError(str(e)) from None
     samples = int(round(seconds * rate)) + 1  # trace_tips records the release and every step after it
     if samples < 2:
         raise InputError(f"--seconds {seconds:g} at --rate {rate:g} Hz gives {samples} sample after release; "
