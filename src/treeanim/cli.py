@@ -11,7 +11,7 @@ import signal
 import sys
 import threading
 
-from .errors import GLUnavailable, InputError
+from .errors import GLUnavailable, InputError, UsageError
 from .table1 import PLURAL, ROWS, TABLE1, TABLE1_FPS
 
 #: What plain ``treeanim`` runs.
@@ -137,7 +137,7 @@ def wind_settings(args) -> dict:
     kw = dict(model=model or ("paper" if getattr(args, "paper", False) else "physical"))
     if getattr(args, "wind_preset", None):
         if kw["model"] == "paper":
-            raise InputError("--wind-preset: the named winds are for --wind-model physical")
+            raise UsageError("--wind-preset: the named winds are for --wind-model physical")
         kw.update(wind_preset(args.wind_preset))
     kw.setdefault("speed", args.wind_default)
     if args.wind is not None:
@@ -164,15 +164,15 @@ def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, f
 
 
 def check_frames(seconds: float, fps: float, step_rate: float = 60.0) -> int:
-    """The number of frames ``seconds`` at ``fps`` give; InputError beyond :data:`MAX_FRAMES`,
+    """The number of frames ``seconds`` at ``fps`` give; UsageError beyond :data:`MAX_FRAMES`,
     or beyond :data:`MAX_STEPS` simulation steps (one a frame, and at least ``step_rate`` a
     second: scripted frames step at most 1/60 s at a time)."""
     n = seconds * fps
     if n > MAX_FRAMES:
-        raise InputError(f"--seconds {seconds:g} at --fps {fps:g} is {n:.3g} frames; at most {MAX_FRAMES:,}")
+        raise UsageError(f"--seconds {seconds:g} at --fps {fps:g} is {n:.3g} frames; at most {MAX_FRAMES:,}")
     steps = seconds * max(fps, step_rate)
     if steps > MAX_STEPS:
-        raise InputError(f"--seconds {seconds:g} takes {steps:.3g} simulation steps; at most {MAX_STEPS:,} "
+        raise UsageError(f"--seconds {seconds:g} takes {steps:.3g} simulation steps; at most {MAX_STEPS:,} "
                          f"(about {MAX_STEPS / 3600 / 60:.0f} hours of simulated time at 60 steps a second)")
     return int(round(n))
 
@@ -192,7 +192,7 @@ def make_simulation(args):
         sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed,
                             load_path=not getattr(args, "paper", False))
     except ValueError as e:
-        raise InputError(str(e)) from None
+        raise UsageError(str(e)) from None
     return tree, sim
 
 
@@ -204,11 +204,11 @@ def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
 
     path = Path(text)
     if path.suffix.lower() not in suffixes:
-        raise InputError(f"{option} {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
+        raise UsageError(f"{option} {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
     try:
         check_file(path, text)
     except InputError as e:
-        raise InputError(str(e).replace("--out ", f"{option} ", 1)) from None
+        raise UsageError(str(e).replace("--out ", f"{option} ", 1)) from None
     return path
 
 
@@ -225,12 +225,12 @@ def cmd_export(args) -> int:
     n = check_frames(args.seconds, args.fps)
     fade = check_frames(args.loop, args.fps)
     if n < 2:
-        raise InputError(f"--seconds {args.seconds:g} at --fps {args.fps:g} gives fewer than 2 frames")
+        raise UsageError(f"--seconds {args.seconds:g} at --fps {args.fps:g} gives fewer than 2 frames")
     if fade >= n:
-        raise InputError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
+        raise UsageError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
     size = (n + fade) * skel.count * 16
     if size > 8e9:
-        raise InputError(f"{n + fade:,} frames of {skel.count:,} joints would need {size / 1e9:.0f} GB of keys; "
+        raise UsageError(f"{n + fade:,} frames of {skel.count:,} joints would need {size / 1e9:.0f} GB of keys; "
                          "export fewer seconds or frames per second")
     keys = np.empty((n + fade, skel.count, 4), np.float32)
     bar = tqdm(total=n + fade, desc=f"baking {tree.name}", unit="frame", disable=args.quiet, leave=False)
@@ -302,7 +302,7 @@ def cmd_render(args) -> int:
                            samples=args.samples, quiet=args.quiet)
     check_frames(args.start + seconds, args.fps)
     if target.kind != "still" and job.frame_range()[1] < 1:
-        raise InputError(f"--seconds {seconds:g} at --fps {args.fps:g} gives no frame")
+        raise UsageError(f"--seconds {seconds:g} at --fps {args.fps:g} gives no frame")
     tree, sim = make_simulation(args)
     try:
         res = render.run_render(job, tree, sim, log=lambda m: print(m, file=sys.stderr))
@@ -342,12 +342,12 @@ def cmd_trace(args) -> int:
         try:
             import matplotlib  # noqa: F401
         except ImportError:
-            raise InputError(f"--plot {trace.PLOTS_HINT}") from None
+            raise UsageError(f"--plot {trace.PLOTS_HINT}") from None
     scene = argparse.Namespace(**vars(args))
     scene.pull = []
     tree, sim = make_simulation(scene)
     if not 0 <= args.object < tree.n_objects:
-        raise InputError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
+        raise UsageError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
     check_frames(args.hold + args.seconds, args.rate, step_rate=0.0)  # a trace steps once a sample
     tr = trace.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
     trace.write_trace_csv(out, tr)
@@ -380,7 +380,7 @@ def cmd_bench(args) -> int:
     known = list(ROWS) + [p for p in ta.list_presets() if p not in ROWS]
     for k in keys:
         if k not in known:
-            raise InputError(f"--presets {k}: unknown; expected some of {', '.join(known)}")
+            raise UsageError(f"--presets {k}: unknown; expected some of {', '.join(known)}")
     out = output_path(args.json, (".json",), "--json") if args.json else None
     w, h = args.size
     try:
@@ -407,7 +407,7 @@ def cmd_view(args) -> int:
              frames=args.frames,
              samples=args.samples)
     except (ViewerUnavailable, ValueError) as e:
-        raise InputError(str(e)) from None
+        raise UsageError(str(e)) from None
     return 0
 
 
@@ -578,7 +578,7 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # the reader went away (`treeanim info | head`): stop quietly
         _stdout_to_devnull()
         return 141
-    except InputError as e:  # a PresetError too
+    except InputError as e:  # UsageError, PresetError, the offline jobs' own
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 2
     except OSError as e:  # a write that failed (disk full, name too long ...): the old file is kept

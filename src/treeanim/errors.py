@@ -8,12 +8,16 @@ what to install or use instead. This module imports nothing, so every layer may 
 
 from __future__ import annotations
 
-__all__ = ["InputError", "PresetError", "GLUnavailable", "ViewerUnavailable"]
+__all__ = ["InputError", "UsageError", "PresetError", "GLUnavailable", "ViewerUnavailable"]
 
 
 class InputError(ValueError):
     """Bad user input (an option, a path, a number out of range); ``str(exc)`` is one line
     naming what was given and what is expected."""
+
+
+class UsageError(InputError):
+    """Bad command-line input found by the command line itself."""
 
 
 class PresetError(InputError):
