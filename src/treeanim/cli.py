@@ -13,7 +13,7 @@ import threading
 
 from . import options as opt
 from .errors import GLUnavailable, InputError, UsageError
-from .table1 import PLURAL, ROWS, TABLE1, TABLE1_FPS
+from .table1 import ROWS, TABLE1, TABLE1_FPS
 
 #: What plain ``treeanim`` runs.
 DEFAULT_COMMAND = ["view"]
@@ -240,6 +240,8 @@ def load_any(name_or_path: str):
 
 def cmd_info(args) -> int:
     """Print a preset's statistics beside the paper's Table 1 row."""
+    from treeanim.model.tree import PLURAL
+
     tree = load_any(args.preset)
     stats = tree.stats(args.season)
     key = tree.name + ("@winter" if args.season >= 1.0 and tree.name == "large_cherry" else "")

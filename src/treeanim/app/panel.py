@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from imgui_bundle import imgui
 
-from ..model.tree import KINDS
+from ..model.tree import KINDS, PLURAL
 from ..physics.wind import WIND_PRESETS
 from .keys import help_lines
 from .save import save_preset
@@ -31,7 +31,6 @@ WIND_SLIDERS = ("wind_speed", "wind_angle", "turbulence", "turbulence_paper", "g
                 "length_scale", "beta_u", "beta_vw", "c3", "c4")
 #: The Light section.
 LIGHT = ("sun_azimuth", "sun_elevation", "translucency", "shadows")
-_PLURAL = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
 _WINDOW_FLAGS = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize | imgui.WindowFlags_.no_saved_settings
 
 
@@ -244,8 +243,8 @@ class Panel:
         key = (id(sim.tree), sim.season)
         if key != self._text_key:  # the counts change only with the tree and the season
             st = v.stats()
-            kinds = [k for k in KINDS if st[_PLURAL[k]]]
-            self._text = ("  ".join(f"{st[_PLURAL[k]]:,} {_PLURAL[k]}" for k in kinds),
+            kinds = [k for k in KINDS if st[PLURAL[k]]]
+            self._text = ("  ".join(f"{st[PLURAL[k]]:,} {PLURAL[k]}" for k in kinds),
                           f"{st['objects']:,} objects  {st['nodes']:,} nodes  {st['triangles']:,} tris")
             self._text_key = key
         imgui.text(self._text[0])

@@ -18,6 +18,8 @@ from .look import Bark
 from .params import PhysicsParams
 
 KINDS = ("branch", "leaf", "blade")
+#: Each kind's plural: the keys of :meth:`Tree.stats`' counts.
+PLURAL = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
 
 #: Sides of a branch tube: 2 x 16 triangles per band of the tube plus a 16-triangle fan at
 #: each end (the paper's 32 triangles per node when every segment is one band).
@@ -238,10 +240,9 @@ class Tree:
         present = self.leaves_present(season)
         tris = self.triangles_per_object()
         out: dict = {}
-        plural = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
         for k in KINDS:
             m = present & (self.kind == k)
-            out[plural[k]] = int(m.sum())
+            out[PLURAL[k]] = int(m.sum())
             out[f"{k}_nodes"] = int(self.object_count[m].sum())
             out[f"{k}_triangles"] = int(tris[m].sum())
         out["objects"] = int(present.sum())
