@@ -130,7 +130,7 @@ def main(argv=None) -> int:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        from treeanim.offline import PLOTS_HINT
+        from treeanim.offline.trace import PLOTS_HINT
 
         print(f"lissajous.py {PLOTS_HINT}", file=sys.stderr)
         return 1

@@ -56,7 +56,7 @@ def main(argv: list[str] | None = None) -> int:
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
     except ImportError:
-        from treeanim.offline import PLOTS_HINT
+        from treeanim.offline.trace import PLOTS_HINT
 
         print(f"wind_spectrum.py {PLOTS_HINT}", file=sys.stderr)
         return 1

@@ -21,7 +21,7 @@ import pytest
 import treeanim as ta
 from treeanim.app import window as window_module
 from treeanim.app.gui import Gui
-from treeanim.app.settings import physics_toml, preset_text, save_preset
+from treeanim.app.save import physics_toml, preset_text, save_preset
 from treeanim.app.viewer import MAX_FRAME_DT, Viewer, run
 from treeanim.app.window import Window
 from treeanim.model.params import ModeRange
@@ -261,6 +261,71 @@ def test_orbit_pan_zoom_on_empty_sky(viewer):
     assert v.camera.distance == pytest.approx(d * 0.88**2)
     v.on_key(glfw.KEY_F, 0, glfw.PRESS, 0)  # frame the tree again
     assert v.frame(DT)
+
+
+def _scene_mask(v, w, h):
+    """Pixels where the tree differs from the same view without it (the panel not drawn)."""
+    v.show_panel, shown = False, v.show_panel
+    v.frame(DT)
+    scene = v.read_pixels()
+    r = v.renderer
+    r.update(v.sim.positions, v.sim.rotations, present=np.zeros(v.tree.n_objects, bool))
+    v.ctx.screen.use()
+    r.draw(v.camera, w, h, season=v.sim.season)
+    empty = v.read_pixels()
+    v._uploaded = None
+    v.show_panel = shown
+    return np.abs(scene.astype(int) - empty.astype(int)).max(axis=2) > 8  # blades are close to the ground's green
+
+
+def test_f_frames_the_grassland_beside_the_panel_and_the_orbit_pivots_on_it(viewer):
+    """F frames the whole meadow in the part of the window the panel leaves free (it reached
+    past the window's right edge), and orbiting turns about the framed centre."""
+    from treeanim.render.camera import tree_extent
+
+    v = viewer
+    w, h = 960, 540
+    glfw.set_window_size(v.window.handle, w, h)
+    _settle(v, (w, h))
+    v.frame(DT)
+    v.window.swap()  # Mesa resizes the window's buffers at a swap
+    shadow = v.scene.shadow
+    v.scene.shadow = False  # the blades' shadows fall beyond the meadow
+    try:
+        v.load_tree(ta.load_preset("grassland"))
+        v.show_panel = True
+        v.frame(DT)
+        v.on_key(glfw.KEY_F, 0, glfw.PRESS, 0)
+        left = v.panel.right
+        assert left >= v.panel.rect[2]  # the framed view starts where the panel ends
+        P, pad = tree_extent(v.tree, v.sim.shown)
+        x, y, _ = v.camera.project(P, w, h).T
+        assert x.min() > left and x.max() < w and y.min() > 0 and y.max() < h
+        mask = _scene_mask(v, w, h)
+        free = mask[:, int(np.ceil(left)):]
+        assert free.mean() > 0.05, "the meadow covers too little of the free view"
+        assert not free[0].any() and not free[-1].any() and not free[:, 0].any() and not free[:, -1].any()
+        assert not mask[:, : int(left)].any(), "the meadow reaches under the panel"
+        ys, xs = np.nonzero(free)
+        assert xs.min() < 0.1 * free.shape[1] and xs.max() > 0.9 * free.shape[1]  # it fills the free width
+        # The orbit pivots on the framed centre: its image stays put while the view turns.
+        centre = v.camera.target.copy()
+        lo, hi = P.min(axis=0), P.max(axis=0)
+        np.testing.assert_allclose(centre, 0.5 * (lo + hi))
+        before = v.camera.project(centre, w, h)[0, :2]
+        assert left < before[0] < w
+        x0, y0 = w - 10, 10
+        _press(v, x0, y0)
+        assert v._mode == "orbit"
+        v.frame(DT)  # imgui takes one mouse event a frame: leave none queued for the next test
+        v.on_cursor_pos(x0 - 60, y0 + 20)
+        v.frame(DT)
+        v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+        v.frame(DT)
+        np.testing.assert_allclose(v.camera.project(centre, w, h)[0, :2], before, atol=1e-3)
+    finally:
+        v.scene.shadow = shadow
+        v.load_tree(ta.load_preset("small_cherry"))
 
 
 def test_the_panel_keeps_the_mouse(viewer):

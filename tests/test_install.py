@@ -1,4 +1,4 @@
-"""A plain (non-editable) wheel install finds its presets and shaders."""
+"""A plain (non-editable) wheel install holds every subpackage and finds its presets and shaders."""
 
 import os
 import shutil
@@ -42,6 +42,11 @@ def test_installed_wheel_finds_assets(tmp_path):
     assert set(out["presets"]) == {"beam", "small_cherry", "large_cherry", "tulip_poplar", "grassland"}
     assert out["leaves"] == 816
     assert out["shaders"] == shaders
+    source = ROOT / "src" / "treeanim"
+    packages = sorted(str(p.parent.relative_to(source)) for p in source.rglob("__init__.py"))
+    installed = site / "treeanim"
+    assert sorted(str(p.parent.relative_to(installed)) for p in installed.rglob("__init__.py")
+                  if p.parent.name not in ("shaders", "presets")) == packages, "a subpackage is missing from the wheel"
 
 
 def test_scripts_view_runs_as_typed_from_another_folder_without_reinstalling(tmp_path):

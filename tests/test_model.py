@@ -11,7 +11,8 @@ import treeanim as ta
 from treeanim.model.generate import LevelSpec, TreeSpec, generate
 from treeanim.model.lamina import make_lamina
 from treeanim.model.presets import read_spec
-from treeanim.table1 import PLURAL, ROWS
+from treeanim.model.tree import PLURAL
+from treeanim.table1 import ROWS
 from treeanim.table1 import TABLE1 as PAPER
 
 # The paper's Table 1: (preset, season) -> {kind: (objects, nodes, triangles)}.

@@ -18,10 +18,10 @@ from treeanim.model.geometry import (
 )
 from treeanim.physics import modal
 from treeanim.physics.bending import BendingPlan, rest_frames
-from treeanim.physics.checks import finite_float
 from treeanim.physics.modal import ModalDraws
 from treeanim.physics.simulation import Simulation
 from treeanim.render import mesh
+from treeanim.validate import finite_float
 
 
 def test_unit_and_perpendicular():

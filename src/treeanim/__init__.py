@@ -17,7 +17,8 @@ __version__ = "0.1.0"
 _EXPORTS = {
     "Tree": "model.tree",
     "Lamina": "model.tree",
-    "PresetError": "model.errors",
+    "PresetError": "errors",
+    "InputError": "errors",
     "list_presets": "model.presets",
     "load_preset": "model.presets",
     "load_tree": "model.presets",

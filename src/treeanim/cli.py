@@ -11,187 +11,16 @@ import signal
 import sys
 import threading
 
-from .table1 import PLURAL, ROWS, TABLE1, TABLE1_FPS
+from . import options as opt
+from .errors import GLUnavailable, InputError, UsageError
+from .table1 import ROWS, TABLE1, TABLE1_FPS
 
 #: What plain ``treeanim`` runs.
 DEFAULT_COMMAND = ["view"]
 
 
-class UsageError(Exception):
-    """Bad command-line input: printed as one line, exit status 2."""
-
-
-def _season(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number in [0, 1], got {text!r}") from None
-    if not 0.0 <= value <= 1.0:
-        raise argparse.ArgumentTypeError(f"expected a number in [0, 1], got {text!r}")
-    return value
-
-
-#: Upper bound of times, rates and counts on the command line: large enough for any real use,
-#: small enough that products of them stay finite and allocations sane.
-LIMIT = 1e6
-#: Most frames (or samples) one command may produce.
-MAX_FRAMES = 1_000_000
-#: Most simulation steps one command may take (hours of work at a few ms a step).
-MAX_STEPS = 2_000_000
-
-
-def _number(kind, lo: float, hi: float, lo_open: bool):
-    """An argparse type: a ``kind`` (int or float) in (lo, hi] or [lo, hi]."""
-    fmt = (lambda x: f"{int(x):,}") if kind is int else (lambda x: f"{x:g}")
-    noun = "integer" if kind is int else "number"
-    if lo_open and lo == 0:
-        what = f"a positive {noun} up to {fmt(hi)}"
-    else:
-        what = f"{'an' if kind is int else 'a'} {noun} in [{fmt(lo)}, {fmt(hi)}]"
-
-    def parse(text: str):
-        try:
-            value = kind(text)
-        except ValueError:
-            value = float("nan")
-        if not ((value > lo) if lo_open else (value >= lo)) or not value <= hi:
-            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
-        return value
-
-    return parse
-
-
-def _positive(kind, hi: float = LIMIT):
-    return _number(kind, 0, hi, lo_open=True)
-
-
-_non_negative = _number(float, 0, LIMIT, lo_open=False)
-
-
-def _checked(parse):
-    """An argparse type from a parser that raises ValueError with a clear message."""
-
-    def checked(text: str):
-        try:
-            return parse(text)
-        except ValueError as e:
-            raise argparse.ArgumentTypeError(str(e)) from None
-
-    checked.__name__ = parse.__name__
-    return checked
-
-
-def _size(text: str) -> tuple[int, int]:
-    from treeanim.offline import parse_size
-
-    return _checked(parse_size)(text)
-
-
-def _vector(what: str, force: bool = False):
-    """An argparse type: X,Y,Z (a force: of at most the simulation's largest pull)."""
-    from treeanim.scripted import parse_force, parse_vector
-
-    parse = parse_force if force else parse_vector
-    return _checked(lambda text: parse(text, what))
-
-
-def _pull(text: str):
-    from treeanim.scripted import parse_pull
-
-    return _checked(parse_pull)(text)
-
-
-def _wind_speed(text: str) -> float:
-    from treeanim.physics.wind import MAX_SPEED
-
-    return _number(float, 0, MAX_SPEED, lo_open=False)(text)
-
-
-def add_season_option(p: argparse.ArgumentParser) -> None:
-    """--season, for every command that builds a tree."""
-    p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
-
-
-def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
-    """--wind and --wind-preset (the viewer's and the offline commands' wind)."""
-    from treeanim.physics.wind import WIND_PRESETS
-
-    names = ", ".join(f"{k} (Beaufort {v['beaufort']}, {v['speed']:g} m/s)" for k, v in WIND_PRESETS.items())
-    p.add_argument("--wind", type=_wind_speed, default=None, metavar="SPEED",
-                   help=f"mean wind speed at the canopy top, m/s (default {wind:g}, or the preset's; 0 = calm)")
-    p.add_argument("--wind-preset", choices=list(WIND_PRESETS), default=None, metavar="NAME",
-                   help=f"a named wind: {names}; --wind (and --turbulence where it exists) override its values")
-
-
-def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
-    """Wind, season and seed options (the scene around the tree)."""
-    from treeanim.physics.wind import MODELS
-
-    add_wind_speed_options(p, wind)
-    p.add_argument("--wind-model", choices=list(MODELS), default=None,
-                   help="physical (default: turbulence in metres carried downwind, gusts, canopy profile) "
-                   "or paper (Hu, Chiba & He 2012, Eqs. 13-18; the default with --paper)")
-    p.add_argument("--wind-dir", type=_vector("direction"), default=(1.0, 0.0, 0.0), metavar="X,Y,Z",
-                   help="wind direction; needs a horizontal part (default 1,0,0)")
-    p.add_argument("--turbulence", type=_number(float, 0, 2, lo_open=False), default=None, metavar="T",
-                   help="physical: turbulence intensity at the canopy top in [0, 1] (default 0.3); "
-                   "paper: lambda of Eq. 17 in [1, 2] (default 1.5)")
-    add_season_option(p)
-    p.add_argument("--seed", type=_number(int, 0, 2**32 - 1, lo_open=False), default=0,
-                   help="seed of the wind and the modal noise (default 0)")
-    p.set_defaults(wind_default=wind)
-
-
-def wind_settings(args) -> dict:
-    """WindField keyword arguments from :func:`add_wind_options` (speed 0 means calm: no field)."""
-    from treeanim.physics.wind import wind_preset
-
-    model = getattr(args, "wind_model", None)
-    kw = dict(model=model or ("paper" if getattr(args, "paper", False) else "physical"))
-    if getattr(args, "wind_preset", None):
-        if kw["model"] == "paper":
-            raise UsageError("--wind-preset: the named winds are for --wind-model physical")
-        kw.update(wind_preset(args.wind_preset))
-    kw.setdefault("speed", args.wind_default)
-    if args.wind is not None:
-        kw["speed"] = args.wind
-    if getattr(args, "turbulence", None) is not None:
-        kw["turbulence"] = args.turbulence
-    kw.update(direction=args.wind_dir, seed=args.seed)
-    return kw
-
-
-def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, fps: float = 30.0,
-                      seconds_help: str | None = None) -> None:
-    """Options shared by the offline commands: the preset, timing, wind, season and pulls."""
-    p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
-    p.add_argument("--seconds", type=_positive(float), default=seconds,
-                   help=seconds_help or f"duration in seconds (default {seconds:g})")
-    p.add_argument("--fps", type=_positive(float), default=fps, help=f"frames per second (default {fps:g})")
-    add_wind_options(p)
-    p.add_argument("--pull", type=_pull, action="append", default=[], metavar="OBJECT:FX,FY,FZ@T0-T1",
-                   help="pull OBJECT's tip with a world force in newtons from T0 to T1 s, then let go; repeatable")
-    p.add_argument("--paper", action="store_true",
-                   help="the paper's model: every object on its own, linear drag, the paper's wind field "
-                   "(default: the load path in the physical wind)")
-
-
-def check_frames(seconds: float, fps: float, step_rate: float = 60.0) -> int:
-    """The number of frames ``seconds`` at ``fps`` give; UsageError beyond :data:`MAX_FRAMES`,
-    or beyond :data:`MAX_STEPS` simulation steps (one a frame, and at least ``step_rate`` a
-    second: scripted frames step at most 1/60 s at a time)."""
-    n = seconds * fps
-    if n > MAX_FRAMES:
-        raise UsageError(f"--seconds {seconds:g} at --fps {fps:g} is {n:.3g} frames; at most {MAX_FRAMES:,}")
-    steps = seconds * max(fps, step_rate)
-    if steps > MAX_STEPS:
-        raise UsageError(f"--seconds {seconds:g} takes {steps:.3g} simulation steps; at most {MAX_STEPS:,} "
-                         f"(about {MAX_STEPS / 3600 / 60:.0f} hours of simulated time at 60 steps a second)")
-    return int(round(n))
-
-
 def make_simulation(args):
-    """The tree and a Simulation set up from :func:`add_scene_options`."""
+    """The tree and a Simulation set up from :func:`treeanim.options.add_scene_options`."""
     import treeanim as ta
     from treeanim.scripted import check_pulls
 
@@ -199,7 +28,7 @@ def make_simulation(args):
     try:
         check_pulls(args.pull, tree.n_objects)
         wind = None
-        kw = wind_settings(args)
+        kw = opt.wind_settings(args)
         if kw["speed"] > 0:
             wind = ta.WindField(**kw)
         sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed,
@@ -213,14 +42,14 @@ def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
     """Check an output path: a known extension and a folder where files can really be created."""
     from pathlib import Path
 
-    from treeanim import offline
+    from treeanim.offline.target import check_file
 
     path = Path(text)
     if path.suffix.lower() not in suffixes:
         raise UsageError(f"{option} {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
     try:
-        offline.check_file(path, text)
-    except offline.InputError as e:
+        check_file(path, text)
+    except InputError as e:
         raise UsageError(str(e).replace("--out ", f"{option} ", 1)) from None
     return path
 
@@ -235,8 +64,8 @@ def cmd_export(args) -> int:
     out = output_path(args.out, (".glb", ".gltf"))
     tree, sim = make_simulation(args)
     skel = export.skeleton(tree)
-    n = check_frames(args.seconds, args.fps)
-    fade = check_frames(args.loop, args.fps)
+    n = opt.check_frames(args.seconds, args.fps)
+    fade = opt.check_frames(args.loop, args.fps)
     if n < 2:
         raise UsageError(f"--seconds {args.seconds:g} at --fps {args.fps:g} gives fewer than 2 frames")
     if fade >= n:
@@ -272,55 +101,30 @@ def _one_line_errors(p: argparse.ArgumentParser) -> argparse.ArgumentParser:
     return p
 
 
-def _finite(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        value = float("nan")
-    if value != value or value in (float("inf"), float("-inf")):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
-    return value
-
-
-#: MSAA sample counts a GL implementation may offer (more are clamped to what it has).
-SAMPLES = (0, 1, 2, 4, 8, 16)
-
-
-def _samples(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        value = -1
-    if value not in SAMPLES:
-        raise argparse.ArgumentTypeError(f"expected one of {', '.join(map(str, SAMPLES))}, got {text!r}")
-    return value
-
-
 def _mb(n: int) -> str:
     return f"{n / 1e6:.1f} MB" if n >= 1e5 else f"{n / 1e3:.0f} kB"
 
 
 def cmd_render(args) -> int:
     """Render an MP4 / GIF, a folder of PNG frames, or one PNG still, offscreen."""
-    from treeanim import offline
+    from treeanim.offline import render
+    from treeanim.offline.sinks import FRAME_NAME
+    from treeanim.offline.target import render_target
 
-    try:
-        target = offline.render_target(args.out)
-    except offline.InputError as e:
-        raise UsageError(str(e)) from None
+    target = render_target(args.out)
     seconds = args.seconds if args.seconds is not None else (
-        offline.STILL_SECONDS if target.kind == "still" else 5.0)
+        render.STILL_SECONDS if target.kind == "still" else 5.0)
     w, h = args.size
-    job = offline.RenderJob(target, w, h, args.fps, seconds, start=args.start, season=args.season, pulls=args.pull,
-                            azimuth=args.azimuth, elevation=args.elevation, distance=args.distance,
-                            samples=args.samples, quiet=args.quiet)
-    check_frames(args.start + seconds, args.fps)
+    job = render.RenderJob(target, w, h, args.fps, seconds, start=args.start, season=args.season, pulls=args.pull,
+                           azimuth=args.azimuth, elevation=args.elevation, distance=args.distance,
+                           samples=args.samples, quiet=args.quiet)
+    opt.check_frames(args.start + seconds, args.fps)
     if target.kind != "still" and job.frame_range()[1] < 1:
         raise UsageError(f"--seconds {seconds:g} at --fps {args.fps:g} gives no frame")
     tree, sim = make_simulation(args)
     try:
-        res = offline.run_render(job, tree, sim, log=lambda m: print(m, file=sys.stderr))
-    except offline.GLUnavailable as e:
+        res = render.run_render(job, tree, sim, log=lambda m: print(m, file=sys.stderr))
+    except GLUnavailable as e:
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 1
     if target.kind == "still":
@@ -332,8 +136,8 @@ def cmd_render(args) -> int:
         pad = f", padded to {res.size[0]}×{res.size[1]}" if res.size != (w, h) else ""
         where = f"{res.path} ({w}×{h}{pad}, {dur}, {_mb(res.bytes)})"
     else:
-        last = offline.FRAME_NAME.format(max(res.frames - 1, 0))
-        where = f"{res.path}/: {offline.FRAME_NAME.format(0)} … {last} ({w}×{h}, {dur}, {_mb(res.bytes)})"
+        last = FRAME_NAME.format(max(res.frames - 1, 0))
+        where = f"{res.path}/: {FRAME_NAME.format(0)} … {last} ({w}×{h}, {dur}, {_mb(res.bytes)})"
     if res.interrupted:
         if res.kept:
             print(f"interrupted: kept {what} of {res.total} in {where}", file=sys.stderr)
@@ -348,7 +152,7 @@ def cmd_trace(args) -> int:
     """Pull one object's tip, let go, and record the tip's free swing as CSV (and a plot)."""
     import numpy as np
 
-    from treeanim import offline
+    from treeanim.offline import trace
 
     out = output_path(args.out, (".csv",))
     plot = output_path(args.plot, (".png", ".svg", ".pdf"), "--plot") if args.plot else None
@@ -356,25 +160,22 @@ def cmd_trace(args) -> int:
         try:
             import matplotlib  # noqa: F401
         except ImportError:
-            raise UsageError(f"--plot {offline.PLOTS_HINT}") from None
+            raise UsageError(f"--plot {trace.PLOTS_HINT}") from None
     scene = argparse.Namespace(**vars(args))
     scene.pull = []
     tree, sim = make_simulation(scene)
     if not 0 <= args.object < tree.n_objects:
         raise UsageError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
-    check_frames(args.hold + args.seconds, args.rate, step_rate=0.0)  # a trace steps once a sample
-    try:
-        tr = offline.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
-    except offline.InputError as e:
-        raise UsageError(str(e)) from None
-    offline.write_trace_csv(out, tr)
+    opt.check_frames(args.hold + args.seconds, args.rate, step_rate=0.0)  # a trace steps once a sample
+    tr = trace.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
+    trace.write_trace_csv(out, tr)
     if plot is not None:
-        offline.plot_trace(plot, tr, title=f"{tree.name}: pull {','.join(f'{v:g}' for v in args.pull)} N, "
-                                           f"released after {args.hold:g} s")
+        trace.plot_trace(plot, tr, title=f"{tree.name}: pull {','.join(f'{v:g}' for v in args.pull)} N, "
+                                         f"released after {args.hold:g} s")
     d = tr.tips - tr.rest
     f, z = tr.f, tr.zeta
-    fx = offline.zero_crossing_frequency(tr.times, d[:, 0] - d[-len(d) // 4:, 0].mean())
-    fz = offline.zero_crossing_frequency(tr.times, d[:, 2] - d[-len(d) // 4:, 2].mean())
+    fx = trace.zero_crossing_frequency(tr.times, d[:, 0] - d[-len(d) // 4:, 0].mean())
+    fz = trace.zero_crossing_frequency(tr.times, d[:, 2] - d[-len(d) // 4:, 2].mean())
     print(f"wrote {out}: {len(tr.times)} samples of object {args.object} ({tr.kind})'s tip over {args.seconds:g} s "
           f"after release at {args.rate:g} Hz" + (f"; plot {plot}" if plot else ""))
     crossing = ", ".join(f"{axis} {hz:.3f} Hz" if np.isfinite(hz) else f"{axis} too few to tell"
@@ -390,7 +191,8 @@ def cmd_bench(args) -> int:
     import json
 
     import treeanim as ta
-    from treeanim import offline
+    from treeanim.files import write_text
+    from treeanim.offline import bench
 
     keys = args.presets or list(ROWS)
     known = list(ROWS) + [p for p in ta.list_presets() if p not in ROWS]
@@ -400,14 +202,14 @@ def cmd_bench(args) -> int:
     out = output_path(args.json, (".json",), "--json") if args.json else None
     w, h = args.size
     try:
-        res = offline.run_bench(keys, w, h, frames=args.frames, steps=args.steps, samples=args.samples,
-                                wind=args.wind, quiet=args.quiet)
-    except offline.GLUnavailable as e:
+        res = bench.run_bench(keys, w, h, frames=args.frames, steps=args.steps, samples=args.samples,
+                              wind=args.wind, quiet=args.quiet)
+    except GLUnavailable as e:
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 1
-    print(offline.format_bench(res))
+    print(bench.format_bench(res))
     if out is not None:
-        offline.write_text(out, json.dumps(res, indent=2) + "\n")
+        write_text(out, json.dumps(res, indent=2) + "\n")
         print(f"wrote {out}")
     return 0
 
@@ -438,6 +240,8 @@ def load_any(name_or_path: str):
 
 def cmd_info(args) -> int:
     """Print a preset's statistics beside the paper's Table 1 row."""
+    from treeanim.model.tree import PLURAL
+
     tree = load_any(args.preset)
     stats = tree.stats(args.season)
     key = tree.name + ("@winter" if args.season >= 1.0 and tree.name == "large_cherry" else "")
@@ -481,15 +285,15 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("info", help="print a preset's statistics beside the paper's Table 1",
                        description="Print a preset's objects, nodes and triangles beside the paper's Table 1 row.")
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
-    add_season_option(p)
+    opt.add_season_option(p)
     p.set_defaults(func=cmd_info)
 
     p = sub.add_parser("export", help="bake the animation into a glTF 2.0 file (.glb or .gltf)",
                        description="Simulate and bake the motion into a glTF 2.0 file: the mesh, a skin with one "
                        "joint per segment and rotation keys at --fps. Opens in Blender, three.js and game engines.")
-    add_scene_options(p)
+    opt.add_scene_options(p)
     p.add_argument("--out", required=True, help="output file: tree.glb, or tree.gltf (+ tree.bin)")
-    p.add_argument("--loop", type=_non_negative, default=0.0, metavar="SECONDS",
+    p.add_argument("--loop", type=opt.non_negative, default=0.0, metavar="SECONDS",
                    help="make the clip loop by cross-fading this many seconds of its end into its start (default 0)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_export)
@@ -499,22 +303,22 @@ def build_parser() -> argparse.ArgumentParser:
         description="Simulate and render offscreen (EGL): a video (.mp4 H.264, or .gif), a folder of PNG frames "
         "(frame_00000.png, ...), or one .png still of the state after --seconds. Ctrl-C stops after the current "
         "frame and keeps a playable file of what was rendered.")
-    add_scene_options(p, seconds=None,  # a still's default differs from a clip's
+    opt.add_scene_options(p, seconds=None,  # a still's default differs from a clip's
                       seconds_help="clip length in seconds (default 5); for a .png, the time simulated before "
                       "the still (default 2)")
     p.add_argument("--out", required=True,
                    help="clip.mp4 | clip.gif | frames/ (a folder of PNG frames) | still.png")
-    p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH", help="image size (default 1280x720)")
-    p.add_argument("--start", type=_non_negative, default=0.0, metavar="SECONDS",
+    p.add_argument("--size", type=opt.size, default=(1280, 720), metavar="WxH", help="image size (default 1280x720)")
+    p.add_argument("--start", type=opt.non_negative, default=0.0, metavar="SECONDS",
                    help="simulated time of the first frame; the tree starts from rest at 0 (default 0)")
-    p.add_argument("--azimuth", type=_finite, default=0.0, metavar="DEG",
+    p.add_argument("--azimuth", type=opt.finite, default=0.0, metavar="DEG",
                    help="camera direction about the vertical; 0 looks along -z, the default wind blows left "
                    "to right (default 0)")
-    p.add_argument("--elevation", type=_finite, default=None, metavar="DEG",
-                   help="camera height angle above the horizon (default 2, or 25 for flat scenes like grass)")
-    p.add_argument("--distance", type=_positive(float), default=None, metavar="METRES",
+    p.add_argument("--elevation", type=opt.finite, default=None, metavar="DEG",
+                   help="camera height angle above the horizon (default 8, or 25 for flat scenes like grass)")
+    p.add_argument("--distance", type=opt.positive(float), default=None, metavar="METRES",
                    help="camera distance to the tree's centre (default: framed on the tree)")
-    p.add_argument("--samples", type=_samples, default=4, help="MSAA samples (default 4; 0 = none)")
+    p.add_argument("--samples", type=opt.samples, default=4, help="MSAA samples (default 4; 0 = none)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_render)
 
@@ -525,17 +329,17 @@ def build_parser() -> argparse.ArgumentParser:
         "second: the Lissajous / harmonograph trace of the paper's Figs. 1 and 4.")
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
     p.add_argument("--object", type=int, default=0, metavar="I", help="object index (default 0, e.g. the beam)")
-    p.add_argument("--pull", type=_vector("force", force=True), required=True, metavar="FX,FY,FZ",
+    p.add_argument("--pull", type=opt.vector("force", force=True), required=True, metavar="FX,FY,FZ",
                    help="world force on the tip in newtons, e.g. 1.5,0,1.2 for the beam")
-    p.add_argument("--hold", type=_positive(float), default=2.0, metavar="SECONDS",
+    p.add_argument("--hold", type=opt.positive(float), default=2.0, metavar="SECONDS",
                    help="how long the pull is held before release (default 2)")
-    p.add_argument("--seconds", type=_positive(float), default=10.0, help="seconds recorded after release (default 10)")
-    p.add_argument("--rate", type=_positive(float), default=240.0, metavar="HZ",
+    p.add_argument("--seconds", type=opt.positive(float), default=10.0, help="seconds recorded after release (default 10)")
+    p.add_argument("--rate", type=opt.positive(float), default=240.0, metavar="HZ",
                    help="samples (and simulation steps) per second (default 240)")
     p.add_argument("--out", required=True, help="trace.csv (columns t,x,y,z; t = 0 at release)")
     p.add_argument("--plot", default=None, metavar="FILE",
                    help="also plot the horizontal (x-z) trace: .png, .svg or .pdf (needs matplotlib)")
-    add_wind_options(p, wind=0.0)  # calm by default: a free swing
+    opt.add_wind_options(p, wind=0.0)  # calm by default: a free swing
     p.set_defaults(func=cmd_trace)
 
     p = sub.add_parser(
@@ -546,11 +350,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--presets", nargs="+", metavar="NAME",
                    help="rows to measure (default: small_cherry large_cherry large_cherry@winter tulip_poplar "
                    "grassland)")
-    p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH", help="render size (default 1280x720)")
-    p.add_argument("--frames", type=_positive(int), default=20, help="frames rendered per preset (default 20)")
-    p.add_argument("--steps", type=_positive(int), default=200, help="simulation steps per preset (default 200)")
-    p.add_argument("--samples", type=_samples, default=4, help="MSAA samples (default 4)")
-    p.add_argument("--wind", type=_wind_speed, default=5.0, metavar="SPEED", help="wind speed, m/s (default 5)")
+    p.add_argument("--size", type=opt.size, default=(1280, 720), metavar="WxH", help="render size (default 1280x720)")
+    p.add_argument("--frames", type=opt.positive(int), default=20, help="frames rendered per preset (default 20)")
+    p.add_argument("--steps", type=opt.positive(int), default=200, help="simulation steps per preset (default 200)")
+    p.add_argument("--samples", type=opt.samples, default=4, help="MSAA samples (default 4)")
+    p.add_argument("--wind", type=opt.wind_speed, default=5.0, metavar="SPEED", help="wind speed, m/s (default 5)")
     p.add_argument("--json", default=None, metavar="FILE", help="also write every figure to this .json file")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_bench)
@@ -561,14 +365,14 @@ def build_parser() -> argparse.ArgumentParser:
         "swing; sliders for wind, season and physics. Needs a display and OpenGL 3.3.")
     p.add_argument("preset", nargs="?", default="small_cherry",
                    help="preset name (see 'treeanim list') or path to a preset .toml (default small_cherry)")
-    add_season_option(p)
-    add_wind_speed_options(p)
-    p.add_argument("--size", type=_size, default=(1280, 720), metavar="WxH",
+    opt.add_season_option(p)
+    opt.add_wind_speed_options(p)
+    p.add_argument("--size", type=opt.size, default=(1280, 720), metavar="WxH",
                    help="window size (default 1280x720)")
-    p.add_argument("--samples", type=_samples, default=None, metavar="N",
+    p.add_argument("--samples", type=opt.samples, default=None, metavar="N",
                    help="MSAA samples: 0, 1, 2, 4, 8 or 16 (default 4, or 0 on a software renderer such as "
                         "llvmpipe)")
-    p.add_argument("--frames", type=_positive(int), default=None, metavar="N",
+    p.add_argument("--frames", type=opt.positive(int), default=None, metavar="N",
                    help="quit after N frames (for scripted runs)")
     p.set_defaults(func=cmd_view)
 
@@ -581,8 +385,6 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``treeanim`` console script."""
-    from treeanim.model.errors import PresetError
-
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminated)  # `kill`: unwind, so temporary files are removed
     try:  # building the parser imports the wind's presets: Ctrl-C may come that early
@@ -596,7 +398,7 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # the reader went away (`treeanim info | head`): stop quietly
         _stdout_to_devnull()
         return 141
-    except (PresetError, UsageError) as e:
+    except InputError as e:  # UsageError, PresetError, the offline jobs' own
         print(f"treeanim: error: {e}", file=sys.stderr)
         return 2
     except OSError as e:  # a write that failed (disk full, name too long ...): the old file is kept

@@ -12,8 +12,6 @@ TABLE1 = {
 #: The paper's frame rates (Table 1, Core2 Duo 2.8 GHz + GeForce 9500 GT).
 TABLE1_FPS = {"small_cherry": 45, "large_cherry": 10, "large_cherry@winter": 41, "tulip_poplar": 20, "grassland": 23}
 
-PLURAL = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
-
 #: Each row's preset and season (the rows the benchmark measures, in order).
 ROWS = {
     "small_cherry": ("small_cherry", 0.0),

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from .errors import HEADLESS_HINT, ViewerUnavailable, check_display
+from ..errors import ViewerUnavailable
+from .display import HEADLESS_HINT, check_display
 
 
 def view(tree, *, season: float = 0.0, wind_speed: float | None = None, wind_preset: str | None = None, size: tuple[int, int] = (1280, 720),

@@ -1,54 +1,36 @@
 """The viewer's imgui panel: preset, season, wind, modal ranges, stiffness, time, overlays,
 statistics, and saving or loading the settings as a preset.
 
-Every change goes through :meth:`Panel.apply`, which sets the simulation's checked properties
-(``sim.season``, ``sim.physics = dataclasses.replace(...)``, the wind's setters ...) and shows
-any refusal in the panel's status line instead of raising.
+The settings are the table :data:`treeanim.app.settings.SETTINGS`: :meth:`Panel.widget` draws
+one from it, and every change goes through :meth:`Panel.apply`, which applies it through the
+simulation's checked properties and shows any refusal in the panel's status line instead of
+raising.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from pathlib import Path
 
 import numpy as np
 from imgui_bundle import imgui
 
-from ..model.params import ModeRange
-from ..model.tree import KINDS
-from ..physics.simulation import INTEGRATORS
+from ..model.tree import KINDS, PLURAL
 from ..physics.wind import WIND_PRESETS
-from ..render.renderer import sun_angles, sun_direction
-from .settings import save_preset
-from .winddir import wind_angle
+from .keys import help_lines
+from .save import save_preset
+from .settings import EI_SPAN, SETTINGS
 
 #: Width of the panel in screen units at UI scale 1.
 PANEL_WIDTH = 330
+#: Gap between the panel and the window's top and left edges (and the scene), at UI scale 1.
+PANEL_GAP = 8
 
-#: Slider ranges: (min, max, format, logarithmic).
-RANGES = {
-    "season": (0.0, 1.0, "%.2f", False),
-    "wind_speed": (0.0, 30.0, "%.1f m/s", False),
-    "wind_angle": (0.0, 360.0, "%.0f°", False),
-    "turbulence": (0.0, 1.0, "%.2f", False),  # physical: intensity at the canopy top
-    "turbulence_paper": (1.0, 2.0, "%.2f", False),  # paper: λ of Eq. 17
-    "gust_strength": (0.0, 2.0, "%.2f", False),
-    "gust_rate": (0.0, 30.0, "%.1f /min", False),
-    "length_scale": (0.5, 100.0, "%.1f m", True),
-    "beta_u": (0.5, 3.0, "%.2f", False),
-    "beta_vw": (0.5, 3.0, "%.2f", False),
-    "c3": (0.0, 2.0, "%.2f", False),
-    "c4": (0.0, 2.0, "%.2f", False),
-    "ei_max": (0.0, 0.0, "%.3g N·m²", True),  # set per tree: the preset's value ÷ or × EI_SPAN
-    "time_scale": (0.05, 2.0, "%.2f×", True),
-    "sun_azimuth": (0.0, 360.0, "%.0f°", False),
-    "sun_elevation": (5.0, 90.0, "%.0f°", False),
-    "translucency": (0.0, 1.0, "%.2f", False),
-}
-#: The EI_max slider spans the preset's value divided or multiplied by this.
-EI_SPAN = 30.0
-_PLURAL = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
+#: The wind's sliders, in the panel's order (each shown only for its wind model).
+WIND_SLIDERS = ("wind_speed", "wind_angle", "turbulence", "turbulence_paper", "gust_strength", "gust_rate",
+                "length_scale", "beta_u", "beta_vw", "c3", "c4")
+#: The Light section.
+LIGHT = ("sun_azimuth", "sun_elevation", "translucency", "shadows")
 _WINDOW_FLAGS = imgui.WindowFlags_.no_move | imgui.WindowFlags_.no_resize | imgui.WindowFlags_.no_saved_settings
 
 
@@ -80,7 +62,7 @@ class Panel:
         self.rect: tuple[float, float, float, float] | None = None
         self._presets: list[str] | None = None
         self._kinds: list[str] = []
-        self._ranges: dict[str, tuple] = {}
+        self._ranges: dict[str, tuple[float, float]] = {}  # per tree: EI_max's
         self._pending: dict[str, float] = {}  # slider values applied when the slider is let go
         self.record_rects = False
         self.busy = False  # a widget is active or a popup is open (it owns the mouse)
@@ -94,6 +76,11 @@ class Panel:
     def width(self) -> float:
         """Width in screen units."""
         return PANEL_WIDTH * self.viewer.gui.scale
+
+    @property
+    def right(self) -> float:
+        """Screen units from the window's left edge to the scene beside the panel."""
+        return (PANEL_WIDTH + 2 * PANEL_GAP) * self.viewer.gui.scale
 
     def contains(self, x: float, y: float) -> bool:
         """Whether screen point (x, y) lies on the panel as last drawn."""
@@ -121,75 +108,21 @@ class Panel:
         self.edit_season = "summer" if v.sim.season < 0.5 else "winter"
         self._kinds = [k for k in KINDS if np.any(v.sim.tree.kind == k)]
         ei = float(v.sim.tree.physics.ei_max)
-        self._ranges = {"ei_max": (ei / EI_SPAN, ei * EI_SPAN, *RANGES["ei_max"][2:])}
+        self._ranges = {"ei_max": (ei / EI_SPAN, ei * EI_SPAN)}
         self._pending.clear()
 
     # ------------------------------------------------------------------ changes
     def apply(self, name: str, value) -> bool:
-        """Apply one setting; returns whether it was accepted (a refusal is shown in the panel).
-
-        Names: ``preset`` (a shipped preset's name), ``season``, ``wind_speed``, ``wind_angle``
-        (degrees about +y), ``wind_preset`` (calm, breeze, windy, gale, storm), ``turbulence``,
-        ``gust_strength``, ``gust_rate``, ``length_scale``, ``beta_u``, ``beta_vw``, ``c3``, ``c4``, ``ei_max``,
-        ``f:KIND`` and ``zeta:KIND`` ((min, max) of the edited season's table), ``time_scale``,
-        ``integrator``, ``coupling``, ``load_path``, ``paused``, ``show_trace``, ``show_frames``, ``show_wind``,
-        ``sun_azimuth`` and ``sun_elevation`` (degrees), ``shadows``, ``translucency``.
-        """
+        """Apply setting ``name`` (a key of :data:`~treeanim.app.settings.SETTINGS`: ``preset``,
+        ``season``, the wind's, ``ei_max``, ``f:KIND`` and ``zeta:KIND`` ((min, max) of the
+        edited season's table), ``time_scale``, ``integrator``, the switches, the light's);
+        returns whether it was accepted (a refusal is shown in the panel)."""
         v = self.viewer
-        sim = v.sim
         try:
-            if name == "preset":
-                from ..model.presets import load_preset
-
-                v.load_tree(load_preset(value))
-                v.say(f"loaded preset {value}")
-            elif name == "season":
-                sim.season = float(value)
-            elif name == "wind_speed":
-                v.set_wind(speed=float(value))
-            elif name == "wind_angle":
-                v.set_wind(angle=float(value))
-            elif name == "turbulence_paper":
-                v.set_wind(turbulence=float(value))
-            elif name in ("turbulence", "beta_u", "beta_vw", "c3", "c4", "gust_strength", "gust_rate",
-                          "length_scale"):
-                v.set_wind(**{name: float(value)})
-            elif name == "wind_preset":
-                v.set_wind(preset=str(value))
-                v.say(f"wind: {value}")
-            elif name == "ei_max":
-                sim.physics = dataclasses.replace(sim.physics, ei_max=float(value))
-            elif name.startswith(("f:", "zeta:")):
-                what, kind = name.split(":")
-                p = sim.physics
-                table = getattr(p, self.edit_season)
-                cur = table.of(kind) or p.modes(kind, sim.season)
-                lo, hi = sorted(float(x) for x in value)
-                new = ModeRange((lo, hi), cur.zeta) if what == "f" else ModeRange(cur.f, (lo, hi))
-                table = dataclasses.replace(table, **{kind: new})
-                sim.physics = dataclasses.replace(p, **{self.edit_season: table})
-            elif name == "time_scale":
-                lo, hi = RANGES["time_scale"][:2]
-                v.time_scale = min(max(float(value), lo), hi)
-            elif name == "integrator":
-                sim.integrator = value
-            elif name == "coupling":
-                sim.coupling = bool(value)
-            elif name == "load_path":
-                sim.load_path = bool(value)
-            elif name in ("paused", "show_trace", "show_frames", "show_wind"):
-                setattr(v, name, bool(value))
-            elif name in ("sun_azimuth", "sun_elevation"):
-                az, el = sun_angles(v.scene.sun_direction)
-                az, el = (float(value), el) if name == "sun_azimuth" else (az, float(value))
-                lo, hi = RANGES["sun_elevation"][:2]
-                v.scene.sun_direction = sun_direction(az % 360.0, min(max(el, lo), hi))
-            elif name == "shadows":
-                v.scene.shadow = bool(value)
-            elif name == "translucency":
-                v.scene.translucency = min(max(float(value), 0.0), 1.0)
-            else:
+            setting = SETTINGS.get(name)
+            if setting is None:
                 raise ValueError(f"unknown setting {name!r}")
+            setting.apply(v, value)
         except (ValueError, OSError) as e:
             v.say(f"error: {' '.join(str(e).split())}")
             return False
@@ -244,35 +177,56 @@ class Panel:
         self._rect(label)
         return shown
 
-    def _slider(self, label: str, name: str, value: float, deferred: bool = False) -> None:
-        lo, hi, fmt, log = self._ranges.get(name) or RANGES[name]
-        flags = imgui.SliderFlags_.logarithmic if log else 0
-        shown = self._pending.get(name, value)
-        changed, new = imgui.slider_float(label, shown, lo, hi, fmt, flags)
-        self._rect(label, frame_only=True)
-        if deferred:  # rebuilding noise grids on every drag step would stall the frame
-            if changed:
-                self._pending[name] = new
-            if name in self._pending and not imgui.is_item_active():
-                self.apply(name, self._pending.pop(name))
-        elif changed:
-            self.apply(name, new)
-
-    def _check(self, label: str, name: str, value: bool) -> None:
-        changed, new = imgui.checkbox(label, value)
-        self._rect(label)
+    def widget(self, name: str) -> None:
+        """Draw setting ``name``'s slider, checkbox or combo (as :data:`SETTINGS` describes it,
+        if it is shown for this wind) and apply a change."""
+        st = SETTINGS[name]
+        v = self.viewer
+        if st.shown is not None and not st.shown(v):
+            return
+        value = st.get(v)
+        if st.kind == "check":
+            changed, new = imgui.checkbox(st.label, value)
+            self._rect(st.label)
+        elif st.kind == "choice":
+            current = st.choices.index(value)
+            changed, idx = imgui.combo(st.label, current, list(st.choices))
+            self._rect(st.label)
+            new = st.choices[idx]
+        else:
+            lo, hi = self._ranges.get(name, (st.lo, st.hi))
+            flags = imgui.SliderFlags_.logarithmic if st.log else 0
+            changed, new = imgui.slider_float(st.label, self._pending.get(name, value), lo, hi, st.fmt, flags)
+            self._rect(st.label, frame_only=True)
+            if st.deferred:
+                if changed:
+                    self._pending[name] = new
+                if name in self._pending and not imgui.is_item_active():
+                    self.apply(name, self._pending.pop(name))
+                return
         if changed:
             self.apply(name, new)
+
+    def _range_pair(self, name: str, speed: float, fmt: str) -> None:
+        """Setting ``name``'s (min, max) pair as two linked drag fields (f or ζ of a kind)."""
+        st = SETTINGS[name]
+        r = st.get(self.viewer)
+        if r is None:
+            return
+        changed, lo, hi = imgui.drag_float_range2(st.label, r[0], r[1], speed, st.lo, st.hi, fmt, fmt,
+                                                  imgui.SliderFlags_.always_clamp)
+        self._rect(name.replace(":", " "))
+        if changed:
+            self.apply(name, (max(lo, st.lo), max(hi, st.lo)))
 
     def draw(self) -> None:
         """Build the panel for this frame (between ``imgui.new_frame`` and ``imgui.render``)."""
         v = self.viewer
         sim = v.sim
-        wind = sim.wind
         s = v.gui.scale
         ww, wh = v._win
         self.item_rects = {}
-        imgui.set_next_window_pos(imgui.ImVec2(8 * s, 8 * s), imgui.Cond_.always)
+        imgui.set_next_window_pos(imgui.ImVec2(PANEL_GAP * s, PANEL_GAP * s), imgui.Cond_.always)
         imgui.set_next_window_size_constraints(imgui.ImVec2(self.width, 0),
                                                imgui.ImVec2(self.width, max(wh - 16 * s, 60)))
         imgui.set_next_window_size(imgui.ImVec2(self.width, 0), imgui.Cond_.always)
@@ -289,8 +243,8 @@ class Panel:
         key = (id(sim.tree), sim.season)
         if key != self._text_key:  # the counts change only with the tree and the season
             st = v.stats()
-            kinds = [k for k in KINDS if st[_PLURAL[k]]]
-            self._text = ("  ".join(f"{st[_PLURAL[k]]:,} {_PLURAL[k]}" for k in kinds),
+            kinds = [k for k in KINDS if st[PLURAL[k]]]
+            self._text = ("  ".join(f"{st[PLURAL[k]]:,} {PLURAL[k]}" for k in kinds),
                           f"{st['objects']:,} objects  {st['nodes']:,} nodes  {st['triangles']:,} tris")
             self._text_key = key
         imgui.text(self._text[0])
@@ -319,36 +273,21 @@ class Panel:
         self._rect("preset")
         if changed and idx != current and idx < len(presets):
             self.apply("preset", presets[idx])
-            sim, wind = v.sim, v.sim.wind
-        self._slider("season", "season", sim.season)
+        self.widget("season")
 
         # --- wind
         if self._header("Wind", open_=True):
-            physical = wind.model == "physical"
-            if physical:
+            if SETTINGS["wind_preset"].shown(v):
                 names = list(WIND_PRESETS)
                 changed, idx = imgui.combo("named wind", -1, [f"{n} (Bf {WIND_PRESETS[n]['beaufort']})" for n in names])
                 self._rect("named wind", frame_only=True)
                 if changed and 0 <= idx < len(names):
                     self.apply("wind_preset", names[idx])
-            self._slider("speed", "wind_speed", wind.speed)
-            self._slider("direction", "wind_angle", wind_angle(wind.direction))
-            if physical:
-                self._slider("turbulence", "turbulence", wind.turbulence)
-                self._slider("gust strength", "gust_strength", wind.gust_strength)
-                self._slider("gust rate", "gust_rate", wind.gust_rate)
-                self._slider("length scale", "length_scale", wind.length_scale)
-            else:
-                self._slider("turbulence λ", "turbulence_paper", wind.turbulence)
-            self._slider("β_u", "beta_u", wind.beta_u, deferred=True)
-            self._slider("β_vw", "beta_vw", wind.beta_vw, deferred=True)
-            if not physical:
-                self._slider("c3 (vertical)", "c3", wind.c3)
-                self._slider("c4 (lateral)", "c4", wind.c4)
+            for name in WIND_SLIDERS:
+                self.widget(name)
 
         # --- physics
         if self._header("Physics", open_=True):
-            p = sim.physics
             imgui.text("ranges of")
             imgui.same_line()
             if imgui.radio_button("summer", self.edit_season == "summer"):
@@ -356,34 +295,18 @@ class Panel:
             imgui.same_line()
             if imgui.radio_button("winter", self.edit_season == "winter"):
                 self.edit_season = "winter"
-            table = getattr(p, self.edit_season)
             for kind in self._kinds:
-                r = table.of(kind) or p.modes(kind, sim.season)
-                if r is None:
-                    continue
-                changed, lo, hi = imgui.drag_float_range2(f"f {kind} (Hz)", r.f[0], r.f[1], 0.01, 0.05, 20.0,
-                                                          "%.2f", "%.2f", imgui.SliderFlags_.always_clamp)
-                self._rect(f"f {kind}")
-                if changed:
-                    self.apply(f"f:{kind}", (max(lo, 0.05), max(hi, 0.05)))
-                changed, lo, hi = imgui.drag_float_range2(f"ζ {kind}", r.zeta[0], r.zeta[1], 0.002, 0.0, 2.0,
-                                                          "%.3f", "%.3f", imgui.SliderFlags_.always_clamp)
-                self._rect(f"zeta {kind}")
-                if changed:
-                    self.apply(f"zeta:{kind}", (max(lo, 0.0), max(hi, 0.0)))
-            self._slider("EI_max", "ei_max", p.ei_max)
+                self._range_pair(f"f:{kind}", 0.01, "%.2f")
+                self._range_pair(f"zeta:{kind}", 0.002, "%.3f")
+            self.widget("ei_max")
 
         # --- time
         if self._header("Simulation", open_=True):
-            self._slider("time scale", "time_scale", v.time_scale)
-            current = INTEGRATORS.index(sim.integrator)
-            changed, idx = imgui.combo("integrator", current, list(INTEGRATORS))
-            self._rect("integrator")
-            if changed:
-                self.apply("integrator", INTEGRATORS[idx])
-            self._check("coupling", "coupling", sim.coupling)
+            self.widget("time_scale")
+            self.widget("integrator")
+            self.widget("coupling")
             imgui.same_line()
-            self._check("load path", "load_path", sim.load_path)
+            self.widget("load_path")
             imgui.same_line()
             if imgui.button("Resume" if v.paused else "Pause"):
                 self.apply("paused", not v.paused)
@@ -398,18 +321,15 @@ class Panel:
 
         # --- overlays
         if self._header("Overlays", open_=True):
-            self._check("pull trace", "show_trace", v.show_trace)
+            self.widget("show_trace")
             imgui.same_line()
-            self._check("local frames", "show_frames", v.show_frames)
-            self._check("wind slices + arrow", "show_wind", v.show_wind)
+            self.widget("show_frames")
+            self.widget("show_wind")
 
         # --- light
         if self._header("Light"):
-            az, el = sun_angles(v.scene.sun_direction)
-            self._slider("sun azimuth", "sun_azimuth", az)
-            self._slider("sun elevation", "sun_elevation", el)
-            self._slider("translucency", "translucency", v.scene.translucency)
-            self._check("shadows", "shadows", v.scene.shadow)
+            for name in LIGHT:
+                self.widget(name)
 
         # --- preset file
         if self._header("Preset file"):
@@ -435,9 +355,7 @@ class Panel:
             else:
                 imgui.text_wrapped(line)
         if self._header("Controls"):
-            for line in ("left-drag a branch or leaf: pull, let go: swing", "left-drag the sky: orbit",
-                         "right/middle-drag: pan   wheel: zoom", "F frame  Space pause  R reset  H panel",
-                         "S/F12 screenshot  F11 full screen  Esc/Q quit"):
+            for line in help_lines():
                 imgui.push_style_color(imgui.Col_.text, imgui.get_style_color_vec4(imgui.Col_.text_disabled))
                 imgui.text_wrapped(line)  # the panel is narrow: lines wrap rather than run off its edge
                 imgui.pop_style_color()

@@ -1,219 +1,187 @@
-"""Save the viewer's settings as a preset TOML, and load them back.
+"""The panel's settings in one table: :data:`SETTINGS` (name → :class:`Setting`: its widget's
+label and range, how to read it from the viewer and how to apply it), which drives both the
+panel's drawing (:meth:`Panel.widget <treeanim.app.panel.Panel.widget>`) and
+:meth:`Panel.apply <treeanim.app.panel.Panel.apply>`. A new setting is one entry here.
 
-A saved file is a preset like those in ``assets/presets/``: the original preset's text with
-its shape tables (trunk, levels, leaves, lamina, grass, beam) and comments kept as they were,
-the top-level ``seed`` set, and the ``[physics]`` tables replaced by the current values. It is
-checked with the preset reader before it replaces anything, and written atomically
-(:func:`treeanim.files.atomic_path`: a temporary file in the same folder, then a rename), so an
-interrupted save never leaves a half-written preset. ``treeanim.load_tree(path)`` loads it.
+Every setter goes through a checked property (``sim.season``, ``sim.physics =
+dataclasses.replace(...)``, the wind's setters ...) and raises ValueError on a refusal, which
+the panel shows in its status line.
 """
 
 from __future__ import annotations
 
-import math
-import os
-import re
-import tomllib
-from importlib import resources
-from pathlib import Path
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, Callable
 
-from ..files import atomic_path
-from ..model.errors import PresetError
-from ..model.params import SCALAR_KEYS, PhysicsParams
-from ..model.tree import KINDS, Tree
+from ..model.params import ModeRange
+from ..model.tree import KINDS
+from ..physics.simulation import INTEGRATORS
+from ..render.renderer import sun_angles, sun_direction
+from .winddir import wind_angle
 
-__all__ = ["physics_toml", "preset_text", "save_preset", "original_preset_text"]
+__all__ = ["Setting", "SETTINGS", "EI_SPAN"]
 
-_HEADER = re.compile(r"^\s*\[\[?\s*([A-Za-z0-9_.\"' -]+?)\s*\]\]?\s*(#.*)?$")
-_TOP_SEED = re.compile(r"^\s*seed\s*=")
+#: The EI_max slider spans the preset's value divided or multiplied by this.
+EI_SPAN = 30.0
 
 
-def _num(x: float) -> str:
-    x = float(x)
-    if not math.isfinite(x):
-        raise ValueError(f"cannot write a non-finite number ({x!r}) into a preset")
-    return repr(x)
+@dataclass(frozen=True)
+class Setting:
+    """One setting of the panel.
 
-
-def physics_toml(physics: PhysicsParams) -> str:
-    """The ``[physics]`` tables of a preset for ``physics`` (exact: floats written by repr).
-
-    Raises
-    ------
-    ValueError
-        A scalar the preset format cannot hold (it must be finite and > 0).
+    Attributes
+    ----------
+    label : str
+        The widget's label.
+    get : callable
+        ``get(viewer)``: the current value.
+    set : callable
+        ``set(viewer, value)``: apply a value (ValueError: refused).
+    kind : {'slider', 'check', 'choice', 'custom'}
+        The widget: a float slider, a checkbox, a combo of :attr:`choices`, or drawn by the
+        panel's own code (a preset list, a range pair).
+    lo, hi : float
+        A slider's range (a value beyond it is clamped where :attr:`clamp`).
+    fmt : str
+        A slider's display format.
+    log : bool
+        A logarithmic slider.
+    deferred : bool
+        Applied when the slider is let go (rebuilding noise grids on every drag step would
+        stall the frame).
+    clamp : bool
+        Clamp the value to [lo, hi] before applying it.
+    shown : callable or None
+        ``shown(viewer)``: whether the widget is drawn (None: always).
+    choices : tuple of str
+        A combo's items.
     """
-    lines = ["[physics]"]
-    for k in SCALAR_KEYS:
-        v = float(getattr(physics, k))
-        if not (math.isfinite(v) and v > 0):
-            raise ValueError(f"physics.{k} = {v!r}: a preset holds only finite positive numbers here")
-        lines.append(f"{k} = {_num(v)}")
-    for season in ("summer", "winter"):
-        modes = getattr(physics, season)
-        lines += ["", f"[physics.{season}]"]
-        for kind in KINDS:
-            r = modes.of(kind)
-            if r is None:
-                continue
-            lines.append(f"{kind} = {{ f = [{_num(r.f[0])}, {_num(r.f[1])}], "
-                         f"zeta = [{_num(r.zeta[0])}, {_num(r.zeta[1])}] }}")
-    return "\n".join(lines) + "\n"
+
+    label: str
+    get: Callable[[Any], Any]
+    set: Callable[[Any, Any], None]
+    kind: str = "slider"
+    lo: float = 0.0
+    hi: float = 1.0
+    fmt: str = "%.2f"
+    log: bool = False
+    deferred: bool = False
+    clamp: bool = False
+    shown: Callable[[Any], bool] | None = None
+    choices: tuple[str, ...] = ()
+
+    def apply(self, viewer, value) -> None:
+        """Apply ``value`` (clamped to the range where :attr:`clamp`)."""
+        if self.clamp:
+            value = min(max(float(value), self.lo), self.hi)
+        self.set(viewer, value)
 
 
-def original_preset_text(tree: Tree) -> str:
-    """The text of the preset file ``tree`` was generated from.
-
-    Raises
-    ------
-    ValueError
-        The tree has no readable source file (e.g. it was built in code).
-    """
-    if tree.source:
-        try:
-            return Path(tree.source).read_text(encoding="utf-8")
-        except OSError:
-            pass
-    try:  # a shipped preset read through a temporary copy that is gone now
-        from ..model.presets import list_presets
-
-        if tree.name in list_presets():
-            return (resources.files("treeanim.presets") / f"{tree.name}.toml").read_text(encoding="utf-8")
-    except OSError:  # pragma: no cover
-        pass
-    raise ValueError(f"tree {tree.name!r} was not loaded from a preset file; there is no shape to save")
+def _physical(v) -> bool:
+    return v.sim.wind.model == "physical"
 
 
-def _strip_physics(text: str) -> tuple[list[str], int]:
-    """Lines of ``text`` without its physics tables, and the index of the first table header."""
-    out: list[str] = []
-    skipping = False
-    first_header = None
-    for line in text.splitlines():
-        m = _HEADER.match(line)
-        if m:
-            name = m.group(1).replace('"', "").replace("'", "").replace(" ", "")
-            skipping = name == "physics" or name.startswith("physics.")
-            if first_header is None and not skipping:
-                first_header = len(out)
-        if not skipping:
-            out.append(line)
-    if first_header is None:
-        first_header = len(out)
-    return out, first_header
+def _paper(v) -> bool:
+    return v.sim.wind.model != "physical"
 
 
-def preset_text(original: str, physics: PhysicsParams, seed: int | None = None) -> str:
-    """A preset's text: ``original`` with its physics replaced and its top-level seed set.
-
-    The shape tables keep their text (and comments) where the original's physics sits in
-    tables of their own, as in the shipped presets; otherwise the whole file is rewritten from
-    its parsed values. Either way the result parses to the original's data except for
-    ``physics`` and ``seed``.
-    """
-    data = tomllib.loads(original)
-    lines, first = _strip_physics(original)
-    if seed is not None:
-        seed = int(seed)
-        head = lines[:first]
-        for i, line in enumerate(head):
-            if _TOP_SEED.match(line):
-                lines[i] = f"seed = {seed}"
-                break
-        else:
-            lines.insert(first, f"seed = {seed}\n" if first < len(lines) else f"seed = {seed}")
-    while lines and not lines[-1].strip():
-        lines.pop()
-    text = "\n".join(lines) + "\n\n" + physics_toml(physics)
-    want = {k: v for k, v in data.items() if k != "physics"}
-    if seed is not None:
-        want["seed"] = seed
-    try:
-        got = tomllib.loads(text)
-        ok = {k: v for k, v in got.items() if k != "physics"} == want
-    except tomllib.TOMLDecodeError:
-        ok = False
-    if not ok:  # an unusual layout (physics in dotted keys, inline tables ...): rewrite it all
-        text = _dump(want) + "\n" + physics_toml(physics)
-    return text
+def _wind(name: str, label: str, lo: float, hi: float, fmt: str = "%.2f", **kw) -> Setting:
+    """A wind field setting, through the WindField's checked setter of ``name``."""
+    return Setting(label, lambda v: getattr(v.sim.wind, name), lambda v, x: v.set_wind(**{name: float(x)}),
+                   lo=lo, hi=hi, fmt=fmt, **kw)
 
 
-def save_preset(path, tree: Tree, physics: PhysicsParams, seed: int | None = None) -> Path:
-    """Write ``tree``'s preset with ``physics`` (and ``seed``, default the tree's) to ``path``.
-
-    The file is checked with the preset reader, then moved into place atomically.
-
-    Returns
-    -------
-    Path
-        The file written.
-
-    Raises
-    ------
-    ValueError
-        No source preset, an unwritable folder, or values a preset cannot hold (the message is
-        one line).
-    """
-    path = Path(path).expanduser()
-    if path.suffix.lower() != ".toml":
-        raise ValueError(f"{path}: a preset file must end in .toml")
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise ValueError(f"{path}: folder {folder} does not exist")
-    text = preset_text(original_preset_text(tree), physics, tree.seed if seed is None else seed)
-    from ..model.presets import read_spec
-
-    try:
-        with atomic_path(path, ".toml") as tmp:
-            with open(tmp, "w", encoding="utf-8") as f:
-                f.write(text)
-                f.flush()
-                os.fsync(f.fileno())
-            try:
-                read_spec(tmp)
-            except PresetError as e:
-                raise ValueError(str(e).replace(str(tmp), str(path))) from None
-    except OSError as e:
-        raise ValueError(f"{path}: cannot write in {folder} ({e.strerror or e})") from None
-    return path
+def _flag(owner: Callable[[Any], Any], name: str, label: str) -> Setting:
+    """A checkbox for boolean attribute ``name`` of ``owner(viewer)``."""
+    return Setting(label, lambda v: getattr(owner(v), name), lambda v, x: setattr(owner(v), name, bool(x)),
+                   kind="check")
 
 
-# ---------------------------------------------------------------------------- fallback writer
-def _value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, float):
-        return _num(v)
-    if isinstance(v, str):
-        return '"' + v.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n") + '"'
-    if isinstance(v, list):
-        return "[" + ", ".join(_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{ " + ", ".join(f"{_key(k)} = {_value(x)}" for k, x in v.items()) + " }"
-    raise ValueError(f"cannot write {type(v).__name__} into a preset")
+def _load_preset(v, name) -> None:
+    from ..model.presets import load_preset
+
+    v.load_tree(load_preset(name))
+    v.say(f"loaded preset {name}")
 
 
-def _key(k: str) -> str:
-    return k if re.fullmatch(r"[A-Za-z0-9_-]+", k) else _value(k)
+def _wind_preset(v, name) -> None:
+    v.set_wind(preset=str(name))
+    v.say(f"wind: {name}")
 
 
-def _dump(data: dict) -> str:
-    """A TOML text of ``data`` (scalars, arrays, tables, arrays of tables)."""
-    lines: list[str] = []
-    tables: list[tuple[str, dict]] = []
-    arrays: list[tuple[str, list]] = []
-    for k, v in data.items():
-        if isinstance(v, dict):
-            tables.append((k, v))
-        elif isinstance(v, list) and v and all(isinstance(x, dict) for x in v):
-            arrays.append((k, v))
-        else:
-            lines.append(f"{_key(k)} = {_value(v)}")
-    for k, v in tables:
-        lines += ["", f"[{_key(k)}]"] + [f"{_key(a)} = {_value(b)}" for a, b in v.items()]
-    for k, v in arrays:
-        for item in v:
-            lines += ["", f"[[{_key(k)}]]"] + [f"{_key(a)} = {_value(b)}" for a, b in item.items()]
-    return "\n".join(lines) + "\n"
+def _set_ei_max(v, x) -> None:
+    v.sim.physics = dataclasses.replace(v.sim.physics, ei_max=float(x))
+
+
+def _set_sun(v, azimuth=None, elevation=None) -> None:
+    az, el = sun_angles(v.scene.sun_direction)
+    az = az if azimuth is None else float(azimuth)
+    el = el if elevation is None else float(elevation)
+    lo, hi = SETTINGS["sun_elevation"].lo, SETTINGS["sun_elevation"].hi
+    v.scene.sun_direction = sun_direction(az % 360.0, min(max(el, lo), hi))
+
+
+def _modes(what: str, kind: str) -> Setting:
+    """The (min, max) f or ζ range of ``kind`` in the season table the panel edits."""
+
+    def table(v):
+        return getattr(v.sim.physics, v.panel.edit_season)
+
+    def get(v):
+        r = table(v).of(kind) or v.sim.physics.modes(kind, v.sim.season)
+        return None if r is None else getattr(r, what)
+
+    def put(v, value):
+        p = v.sim.physics
+        cur = table(v).of(kind) or p.modes(kind, v.sim.season)
+        lo, hi = sorted(float(x) for x in value)
+        new = ModeRange((lo, hi), cur.zeta) if what == "f" else ModeRange(cur.f, (lo, hi))
+        v.sim.physics = dataclasses.replace(p, **{v.panel.edit_season: dataclasses.replace(table(v), **{kind: new})})
+
+    return Setting(f"f {kind} (Hz)" if what == "f" else f"ζ {kind}", get, put, kind="custom",
+                   lo=0.05 if what == "f" else 0.0, hi=20.0 if what == "f" else 2.0)
+
+
+#: Every setting the panel shows or :meth:`Panel.apply` takes, by name.
+SETTINGS: dict[str, Setting] = {
+    "preset": Setting("preset", lambda v: v.sim.tree.name, _load_preset, kind="custom"),
+    "season": Setting("season", lambda v: v.sim.season, lambda v, x: setattr(v.sim, "season", float(x))),
+    # wind
+    "wind_preset": Setting("named wind", lambda v: None, _wind_preset, kind="custom", shown=_physical),
+    "wind_speed": _wind("speed", "speed", 0.0, 30.0, "%.1f m/s"),
+    "wind_angle": Setting("direction", lambda v: wind_angle(v.sim.wind.direction),
+                          lambda v, x: v.set_wind(angle=float(x)), lo=0.0, hi=360.0, fmt="%.0f°"),
+    "turbulence": _wind("turbulence", "turbulence", 0.0, 1.0, shown=_physical),  # intensity at the canopy top
+    "turbulence_paper": _wind("turbulence", "turbulence λ", 1.0, 2.0, shown=_paper),  # λ of Eq. 17
+    "gust_strength": _wind("gust_strength", "gust strength", 0.0, 2.0, shown=_physical),
+    "gust_rate": _wind("gust_rate", "gust rate", 0.0, 30.0, "%.1f /min", shown=_physical),
+    "length_scale": _wind("length_scale", "length scale", 0.5, 100.0, "%.1f m", log=True, shown=_physical),
+    "beta_u": _wind("beta_u", "β_u", 0.5, 3.0, deferred=True),
+    "beta_vw": _wind("beta_vw", "β_vw", 0.5, 3.0, deferred=True),
+    "c3": _wind("c3", "c3 (vertical)", 0.0, 2.0, shown=_paper),
+    "c4": _wind("c4", "c4 (lateral)", 0.0, 2.0, shown=_paper),
+    # physics: the range is the preset's value ÷ or × EI_SPAN (Panel.tree_changed)
+    "ei_max": Setting("EI_max", lambda v: v.sim.physics.ei_max, _set_ei_max, fmt="%.3g N·m²", log=True),
+    **{f"{what}:{kind}": _modes(what, kind) for kind in KINDS for what in ("f", "zeta")},
+    # simulation
+    "time_scale": Setting("time scale", lambda v: v.time_scale, lambda v, x: setattr(v, "time_scale", float(x)),
+                          lo=0.05, hi=2.0, fmt="%.2f×", log=True, clamp=True),
+    "integrator": Setting("integrator", lambda v: v.sim.integrator, lambda v, x: setattr(v.sim, "integrator", x),
+                          kind="choice", choices=tuple(INTEGRATORS)),
+    "coupling": _flag(lambda v: v.sim, "coupling", "coupling"),
+    "load_path": _flag(lambda v: v.sim, "load_path", "load path"),
+    "paused": _flag(lambda v: v, "paused", "paused"),
+    # overlays
+    "show_trace": _flag(lambda v: v, "show_trace", "pull trace"),
+    "show_frames": _flag(lambda v: v, "show_frames", "local frames"),
+    "show_wind": _flag(lambda v: v, "show_wind", "wind slices + arrow"),
+    # light
+    "sun_azimuth": Setting("sun azimuth", lambda v: sun_angles(v.scene.sun_direction)[0],
+                           lambda v, x: _set_sun(v, azimuth=x), lo=0.0, hi=360.0, fmt="%.0f°"),
+    "sun_elevation": Setting("sun elevation", lambda v: sun_angles(v.scene.sun_direction)[1],
+                             lambda v, x: _set_sun(v, elevation=x), lo=5.0, hi=90.0, fmt="%.0f°"),
+    "translucency": Setting("translucency", lambda v: v.scene.translucency,
+                            lambda v, x: setattr(v.scene, "translucency", float(x)), clamp=True),
+    "shadows": _flag(lambda v: v.scene, "shadow", "shadows"),
+}

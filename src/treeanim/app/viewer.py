@@ -5,38 +5,29 @@ imgui panel.
 window's GLFW callbacks call its input handlers (``on_mouse_button``, ``on_cursor_pos``,
 ``on_scroll``, ``on_key``, ``on_char``, ``on_resize``, ``on_focus``); tests call the same
 handlers. :meth:`Viewer.frame` advances the simulation by the elapsed time and draws one frame;
-:func:`run` is the main loop.
-
-Controls
---------
-left-drag on a branch, leaf or blade   pull it (a spring to the cursor); let go to release
-left-drag elsewhere                    orbit
-right- or middle-drag                  pan
-wheel                                  zoom
-F frame the tree · Space pause · R reset · S or F12 screenshot · H hide the panel
-F11 full screen · Ctrl+S save the preset · Ctrl+O load it · Esc or Q quit
+:func:`run` is the main loop. The controls are the table in :mod:`treeanim.app.keys`.
 """
 
 from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass
 from datetime import datetime
 from pathlib import Path
 
-import glfw
 import numpy as np
 
 from ..model.tree import Tree
-from ..physics.simulation import MAX_PULL, Simulation
+from ..physics.pull import SpringPull
+from ..physics.simulation import Simulation
 from ..physics.wind import WindField
 from ..physics.wind import wind_preset as wind_preset_kwargs
-from ..render.camera import OrbitCamera
+from ..render.camera import TREE_ELEVATION, OrbitCamera, frame_tree
 from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
 from ..render.picking import Picker
 from ..render.renderer import Renderer, Scene
 from .gui import Gui
+from .input import ViewerInput
 from .winddir import wind_direction
 from .window import Window
 
@@ -46,82 +37,6 @@ from .window import Window
 MAX_FRAME_DT = 0.5
 #: Longest simulation sub-step (s of simulated time).
 MAX_SUBSTEP = 1.0 / 60.0
-#: Time constant (s, simulated) of the low-pass on the pull force: it damps the loop between
-#: the spring and the beam's static deflection, so the grabbed point settles without ringing.
-PULL_TAU = 0.04
-#: The spring's loop gain: at equilibrium the grabbed point covers GAIN / (1 + GAIN) of the
-#: distance to the cursor (60 % for a small drag; a stiff beam bends less than that).
-PULL_GAIN = 1.5
-#: The pull force saturates at the spring force of a drag this many object lengths long.
-PULL_MAX_LENGTHS = 2.0
-#: Orbit speed, degrees per screen unit of drag.
-ORBIT_DEG_PER_UNIT = 0.35
-#: Zoom factor per wheel notch.
-ZOOM_PER_NOTCH = 0.88
-
-
-@dataclass
-class Grab:
-    """A pull in progress.
-
-    Attributes
-    ----------
-    object : int
-        The grabbed object.
-    node : int
-        Global index of the first node of the segment holding the anchor.
-    s : float
-        Where the anchor lies along that segment, 0 … 1.
-    offset : (3,) float
-        Picked point minus anchor at grab time (the picked point may lie on a leaf's lamina).
-    plane_point, plane_normal : (3,) float
-        The plane facing the camera through the picked point; the cursor is projected on it.
-    target : (3,) float
-        The cursor's point on that plane.
-    k : float
-        Spring constant, N/m.
-    f_max : float
-        Largest force, N.
-    force : (3,) float
-        The current (low-passed) pull force, N.
-    ratio : float
-        Metres the grabbed point moves per metre the object's tip moves while bent by a tip
-        force (the ratio of their compliances): between a frame's sub-steps the grabbed point
-        is followed through :meth:`Simulation.tip_position` instead of the whole pose.
-    frame_anchor, frame_tip : (3,) float or None
-        The grabbed point and the tip at the frame's first sub-step (exact, from the pose).
-    """
-
-    object: int
-    node: int
-    s: float
-    offset: np.ndarray
-    plane_point: np.ndarray
-    plane_normal: np.ndarray
-    target: np.ndarray
-    k: float
-    f_max: float
-    force: np.ndarray
-    ratio: float = 1.0
-    frame_anchor: np.ndarray | None = None
-    frame_tip: np.ndarray | None = None
-
-
-class ViewCamera(OrbitCamera):
-    """An :class:`OrbitCamera` whose view·projection matrix is kept until the camera or the
-    viewport changes (building it through pyrr costs ~0.2 ms, and most frames reuse it)."""
-
-    _vp_key = None
-    _vp = None
-
-    def view_projection(self, width: int, height: int) -> np.ndarray:
-        key = (self.target.tobytes(), self.distance, self.azimuth, self.elevation, self.fov_y, self.near, self.far,
-               width, height)
-        if key != self._vp_key:
-            vp = super().view_projection(width, height)
-            vp.setflags(write=False)
-            self._vp, self._vp_key = vp, key
-        return self._vp
 
 
 def _clone_wind(w: WindField | None, **changes) -> WindField:
@@ -145,7 +60,7 @@ class _Ema:
         self.value = x if self.value is None else self.value + self.w * (x - self.value)
 
 
-class Viewer:
+class Viewer(ViewerInput):
     """A tree in wind in a window: simulation, renderer, camera, mouse and keys, panel.
 
     Parameters
@@ -170,8 +85,7 @@ class Viewer:
     ----------
     sim : Simulation
     renderer : Renderer
-    camera : ViewCamera
-        An OrbitCamera (with its matrix cached).
+    camera : OrbitCamera
     paused : bool
     time_scale : float
         Simulated seconds per real second (0.05 … 2).
@@ -179,8 +93,8 @@ class Viewer:
         The OpenGL renderer's name.
     show_trace, show_frames, show_wind : bool
         Overlays: the pulled tip's trace, the local frames, the wind slices and arrow.
-    grab : Grab or None
-        The pull in progress.
+    grab : SpringPull or None
+        The pull in progress (:mod:`treeanim.physics.pull`).
     last_sim_s, last_draw_s : float
         Wall time of the last frame's simulation sub-steps and of its drawing (pose upload,
         draw calls, panel), seconds; ``sim_ms`` and ``render_ms`` are their moving averages.
@@ -200,10 +114,10 @@ class Viewer:
         self.show_trace = True
         self.show_frames = False
         self.show_wind = False
-        self.grab: Grab | None = None
+        self.grab: SpringPull | None = None
         self.traced: int | None = None  # object whose tip the trace follows
         self.trace = PullTrace(capacity=2400)
-        self.camera = ViewCamera(azimuth=20.0, elevation=8.0)
+        self.camera = OrbitCamera(azimuth=20.0, elevation=TREE_ELEVATION)
         self.messages: list[str] = []  # lines for the panel's status line (newest last)
         self.screenshots: list[Path] = []
         self.sim_ms, self.render_ms, self.frame_s = _Ema(), _Ema(), _Ema(0.05)
@@ -211,11 +125,7 @@ class Viewer:
         self.last_sim_s = self.last_draw_s = 0.0  # the last frame's advance() and draw(), s
         self._acc = 0.0
         self._last_time: float | None = None
-        self._mode: str | None = None  # 'orbit', 'pan', 'pull' while a button is held
-        self._mode_button: int | None = None
-        self._cursor = (0.0, 0.0)
         self._screenshot_pending: list[Path | None] = []
-        self._readback = None
         self._uploaded = None
         self._stats_key = None
         self._stats: dict = {}
@@ -302,22 +212,14 @@ class Viewer:
                 setattr(w, k, v)
 
     # ------------------------------------------------------------------ camera
-    @property
-    def panel_width(self) -> float:
-        """Screen units the panel covers at the left (0 when hidden)."""
-        return self.panel.width if self.show_panel else 0.0
-
     def frame_camera(self) -> None:
-        """Aim at the tree so it fills the view beside the panel."""
+        """Frame the tree beside the panel (:func:`~treeanim.render.camera.frame_tree`, the
+        offline commands' framing): the orbit then pivots on the tree's centre."""
         w, h = self._win
         if w <= 0 or h <= 0:
             w, h = 16, 9
-        free = max(w - self.panel_width, 0.4 * w)
-        lo, hi = self.renderer.bounds()
-        flat = (hi[1] - lo[1]) < 0.5 * max(hi[0] - lo[0], hi[2] - lo[2])
-        self.camera.elevation = 25.0 if flat else 8.0  # look down on a meadow, along a tree
-        self.camera.frame((lo, hi), aspect=free / h)
-        self.camera.pan((w - free) / 2.0, 0.0, h)  # the tree moves right, beside the panel
+        left = self.panel.right if self.show_panel else 0.0
+        frame_tree(self.camera, self.tree, w, h, present=self.sim.shown, left=min(left, 0.6 * w))
 
     # ------------------------------------------------------------------ time
     @property
@@ -342,7 +244,7 @@ class Viewer:
         sim = self.sim
         for j in range(n):
             if self.grab is not None:
-                self._update_pull(h, exact=j == 0)
+                self.grab.step(sim, h, exact=j == 0)
             sim.step(h)
             if self.traced is not None:
                 self.trace.push(sim.tip_position(self.traced))
@@ -428,31 +330,8 @@ class Viewer:
     # ------------------------------------------------------------------ pixels
     def read_pixels(self) -> np.ndarray:
         """The back buffer as drawn so far, (height, width, 3) uint8, row 0 at the top
-        (a multisampled buffer is resolved first)."""
-        fw, fh = self._fb
-        if fw <= 0 or fh <= 0:
-            return np.zeros((max(fh, 0), max(fw, 0), 3), np.uint8)
-        from OpenGL import GL
-
-        self.window.make_current()
-        ctx = self.ctx
-        if self._readback is None or self._readback[0] != (fw, fh):
-            if self._readback is not None:
-                ctx.screen.use()
-                for o in self._readback[1:]:
-                    o.release()
-            rb = ctx.renderbuffer((fw, fh), 4)
-            fbo = ctx.framebuffer([rb])
-            self._readback = ((fw, fh), fbo, rb)
-        fbo = self._readback[1]
-        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, 0)
-        GL.glReadBuffer(GL.GL_BACK)
-        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, fbo.glo)
-        GL.glBlitFramebuffer(0, 0, fw, fh, 0, 0, fw, fh, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
-        data = fbo.read(components=3, alignment=1)
-        ctx.screen.use()
-        img = np.frombuffer(data, np.uint8).reshape(fh, fw, 3)
-        return np.ascontiguousarray(img[::-1])
+        (:meth:`Window.read_pixels`)."""
+        return self.window.read_pixels(*self._fb)
 
     def request_screenshot(self, path=None) -> None:
         """Write a screenshot after the next frame is drawn (see :meth:`screenshot`)."""
@@ -499,197 +378,60 @@ class Viewer:
         return self.picker.pick(self.sim.positions, self.sim.rotations, o, d, present=self.sim.present,
                                 pixel_angle=self.camera.pixel_angle(max(self._win[1], 1)), min_pixels=4.0)
 
-    def _cursor_target(self, x: float, y: float, g: Grab) -> np.ndarray:
-        o, d = self._ray(x, y)
-        denom = float(d @ g.plane_normal)
-        if abs(denom) < 1e-9:
-            return g.target
-        t = float((g.plane_point - o) @ g.plane_normal) / denom
-        return o + max(t, 0.0) * d
-
     def start_pull(self, x: float, y: float) -> bool:
         """Grab the object under (x, y), if any. Returns whether something was grabbed."""
         hit = self.pick(x, y)
         if hit is None:
             return False
-        tree, sim = self.sim.tree, self.sim
-        obj = hit.object
-        nodes = tree.object_nodes(obj)
-        P = sim.positions
-        a, b = P[nodes[:-1]], P[nodes[1:]]
-        e = b - a
-        s = np.clip(np.einsum("ij,ij->i", hit.point - a, e) / np.maximum(np.einsum("ij,ij->i", e, e), 1e-30), 0, 1)
-        dist = np.linalg.norm(a + s[:, None] * e - hit.point, axis=1)
-        k = int(np.argmin(dist))
-        anchor = a[k] + s[k] * e[k]
-        point = np.asarray(hit.point, float)
-        G = max(sim.compliance(obj, k, float(s[k]), point - anchor), 1e-12)
-        G_tip = max(sim.compliance(obj, len(nodes) - 2, 1.0), 1e-12)
-        spring = PULL_GAIN / G
-        length = float(np.sum(np.linalg.norm(np.diff(tree.rest_positions[nodes], axis=0), axis=1)))
-        length += float(tree.lamina_length[obj])
-        self.grab = Grab(object=obj, node=int(nodes[k]), s=float(s[k]), offset=point - anchor,
-                         plane_point=point.copy(), plane_normal=self.camera.forward.copy(), target=point.copy(),
-                         k=spring, f_max=spring * PULL_MAX_LENGTHS * length, force=np.zeros(3),
-                         ratio=G / G_tip)
+        self.grab = SpringPull.grab(self.sim, hit.object, hit.point, self.camera.forward)
         self.trace.clear()
-        self.traced = obj
-        self.trace.push(sim.tip_position(obj))
+        self.traced = hit.object
+        self.trace.push(self.sim.tip_position(hit.object))
         return True
 
     def anchor_point(self) -> np.ndarray | None:
         """Where the grabbed point is now (world), or None."""
-        g = self.grab
-        if g is None:
-            return None
-        P = self.sim.positions
-        return P[g.node] + g.s * (P[g.node + 1] - P[g.node]) + g.offset
+        return None if self.grab is None else self.grab.anchor(self.sim)
 
     def _grabbed_point(self, exact: bool) -> np.ndarray:
-        """Where the grabbed point is: exact from the pose when ``exact`` (a frame's first
-        sub-step, whose pose the last frame drew, so it is built already), else followed from
-        the frame's exact point by the tip's motion since (one tip, not N nodes, a sub-step)."""
-        g = self.grab
-        tip = self.sim.tip_position(g.object)
-        if exact or g.frame_anchor is None:
-            g.frame_anchor, g.frame_tip = self.anchor_point(), tip
-            return g.frame_anchor
-        return g.frame_anchor + g.ratio * (tip - g.frame_tip)
-
-    def _update_pull(self, h: float, exact: bool = True) -> None:
-        g = self.grab
-        raw = g.k * (g.target - self._grabbed_point(exact))
-        mag = float(np.linalg.norm(raw))
-        f_max = min(g.f_max, MAX_PULL)  # what Simulation.pull accepts, whatever the spring says
-        if mag > f_max:
-            raw *= f_max / mag
-        g.force += (h / (PULL_TAU + h)) * (raw - g.force)
-        self.sim.pull(g.object, g.force)
+        """The grabbed point, exact on a frame's first sub-step (whose pose the last frame
+        drew, so it is built already), else followed through the tip
+        (:meth:`SpringPull.grabbed_point`)."""
+        return self.grab.grabbed_point(self.sim, exact)
 
     def end_pull(self) -> None:
         """Let go of the grabbed object (it swings freely; the trace goes on)."""
         if self.grab is not None:
-            self.sim.release(self.grab.object)
+            self.grab.release(self.sim)
             self.grab = None
 
-    def _end_drag(self) -> None:
-        self.end_pull()
-        self._mode = None
-        self._mode_button = None
+    # ------------------------------------------------------------------ actions (keys.BINDINGS)
+    def toggle_pause(self) -> None:
+        """Pause or resume the simulation."""
+        self.paused = not self.paused
 
-    # ------------------------------------------------------------------ input handlers
-    def _over_panel(self, x: float, y: float) -> bool:
-        return self.show_panel and self.panel.owns_mouse(x, y)
-
-    def on_cursor_pos(self, x: float, y: float) -> None:
-        """Cursor moved to (x, y) screen units, origin top-left."""
-        px, py = self._cursor
-        self._cursor = (float(x), float(y))
+    def toggle_panel(self) -> None:
+        """Hide or show the panel."""
+        self.show_panel = not self.show_panel
         if self.show_panel:
-            self.gui.mouse_pos(x, y)
-        dx, dy = x - px, y - py
-        if self._mode == "orbit":
-            self.camera.orbit(-ORBIT_DEG_PER_UNIT * dx, ORBIT_DEG_PER_UNIT * dy)
-        elif self._mode == "pan":
-            self.camera.pan(dx, dy, max(self._win[1], 1))
-        elif self._mode == "pull" and self.grab is not None:
-            self.grab.target = self._cursor_target(x, y, self.grab)
+            self.gui.mouse_pos(*self._cursor)
 
-    def on_mouse_button(self, button: int, action: int, mods: int = 0) -> None:
-        """A mouse button went down (``glfw.PRESS``) or up (``glfw.RELEASE``)."""
-        x, y = self._cursor
-        if action == glfw.PRESS:
-            over = self._over_panel(x, y)
-            if self.show_panel:
-                self.gui.mouse_button(button, True)
-            if over or self._mode is not None:
-                return
-            if button == glfw.MOUSE_BUTTON_LEFT:
-                self._mode = "pull" if self.start_pull(x, y) else "orbit"
-            elif button in (glfw.MOUSE_BUTTON_RIGHT, glfw.MOUSE_BUTTON_MIDDLE):
-                self._mode = "pan"
-            else:
-                return
-            self._mode_button = button
-        elif action == glfw.RELEASE:
-            self.gui.mouse_button(button, False)
-            if button == self._mode_button:
-                self._end_drag()
+    def toggle_fullscreen(self) -> None:
+        """Full screen on the window's monitor, or back."""
+        self.window.toggle_fullscreen()
 
-    def on_scroll(self, dx: float, dy: float) -> None:
-        """Wheel turned (dy > 0: away from the user, zooms in)."""
-        if self._over_panel(*self._cursor):
-            self.gui.scroll(dx, dy)
-            return
-        self.camera.zoom(ZOOM_PER_NOTCH ** float(dy))
+    def save_preset(self) -> None:
+        """Save the settings as a preset at the panel's file name (:meth:`Panel.save`)."""
+        self.panel.save()
 
-    def on_char(self, codepoint: int) -> None:
-        """A character was typed (for the panel's text fields)."""
-        if self.show_panel:
-            self.gui.char(codepoint)
+    def load_preset(self) -> None:
+        """Load the preset at the panel's file name (:meth:`Panel.load`)."""
+        self.panel.load()
 
-    def on_key(self, key: int, scancode: int, action: int, mods: int) -> None:
-        """A key went down, repeated or up. Shortcuts act on presses while the panel does not
-        want the keyboard."""
-        if self.show_panel or action == glfw.RELEASE:
-            self.gui.key(key, action, mods)
-        if action != glfw.PRESS or (self.show_panel and self.gui.wants_keyboard):
-            return
-        ctrl = bool(mods & glfw.MOD_CONTROL)
-        if ctrl and key == glfw.KEY_S:
-            self.panel.save()
-        elif ctrl and key == glfw.KEY_O:
-            self.panel.load()
-        elif ctrl:
-            return
-        elif key in (glfw.KEY_ESCAPE, glfw.KEY_Q):
-            self.window.request_close()
-        elif key == glfw.KEY_SPACE:
-            self.paused = not self.paused
-        elif key == glfw.KEY_R:
-            self.reset()
-        elif key == glfw.KEY_F:
-            self.frame_camera()
-        elif key in (glfw.KEY_S, glfw.KEY_F12):
-            self.request_screenshot()
-        elif key == glfw.KEY_F11:
-            self.window.toggle_fullscreen()
-        elif key == glfw.KEY_H:
-            self.show_panel = not self.show_panel
-            if self.show_panel:
-                self.gui.mouse_pos(*self._cursor)
+    def quit(self) -> None:
+        """Close the window (the main loop ends)."""
+        self.window.request_close()
 
-    def on_resize(self, width: int, height: int) -> None:
-        """The framebuffer is now ``width`` × ``height`` pixels (0 × 0: minimised). Beyond the
-        GL's largest size (no window manager kept it within) the window is shrunk back, and
-        drawn only up to that size meanwhile."""
-        most = self.window.max_pixels
-        if width > most or height > most:
-            self.window.shrink_to(most)
-        self._fb = (min(max(int(width), 0), most), min(max(int(height), 0), most))
-        try:
-            self._win = tuple(self.window.size)
-        except Exception:  # pragma: no cover
-            self._win = self._fb
-
-    def on_window_size(self, width: int, height: int) -> None:
-        """The window is now ``width`` × ``height`` screen units."""
-        self._win = (max(int(width), 0), max(int(height), 0))
-
-    def on_focus(self, focused: bool) -> None:
-        """Focus gained or lost; losing it ends any drag and lets go of a pull."""
-        self.gui.focus(focused)
-        if not focused:
-            self._end_drag()
-
-    def on_cursor_enter(self, entered: bool) -> None:
-        if not entered:
-            self.gui.mouse_left()
-
-    def on_refresh(self) -> None:
-        """The window needs redrawing (nothing to do: the loop draws continuously)."""
-
-    # ------------------------------------------------------------------ actions
     def reset(self) -> None:
         """Back to rest: the simulation at time 0, no pull, no trace."""
         self._end_drag()
@@ -700,12 +442,7 @@ class Viewer:
 
     def release(self) -> None:
         """Free the GL resources (the window stays open)."""
-        self.window.make_current()
-        if self._readback is not None:
-            self.ctx.screen.use()
-            for o in self._readback[1:]:
-                o.release()
-            self._readback = None
+        self.window.release_readback()
         if self.renderer is not None:
             self.renderer.release()
             self.renderer = None

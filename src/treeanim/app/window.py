@@ -17,8 +17,10 @@ import glfw
 # the process holds one GLFW state (the order matters only when both are imported).
 import imgui_bundle  # noqa: F401  (side effect: PYGLFW_LIBRARY)
 import moderngl
+import numpy as np
 
-from .errors import HEADLESS_HINT, ViewerUnavailable, check_display
+from ..errors import ViewerUnavailable
+from .display import HEADLESS_HINT, check_display
 
 __all__ = ["Window", "ViewerUnavailable", "HEADLESS_HINT", "SOFTWARE_RENDERER"]
 
@@ -68,6 +70,7 @@ class Window:
         self._windowed: tuple[int, int, int, int] | None = None
         self._callbacks: list = []  # keep the Python callables alive
         self._closed = False
+        self._readback = None  # ((w, h), framebuffer, renderbuffer) for read_pixels
         scale = self.content_scale
         most = int(self.max_pixels / scale)  # the window manager keeps the window within the GL's limits
         glfw.set_window_size_limits(handle, glfw.DONT_CARE, glfw.DONT_CARE, most, most)
@@ -271,13 +274,45 @@ class Window:
         """GLFW's clock, seconds."""
         return glfw.get_time()
 
+    def read_pixels(self, width: int, height: int) -> np.ndarray:
+        """The back buffer's ``width`` × ``height`` pixels as drawn so far, (height, width, 3)
+        uint8, row 0 at the top (a multisampled buffer is resolved first)."""
+        if width <= 0 or height <= 0:
+            return np.zeros((max(height, 0), max(width, 0), 3), np.uint8)
+        from OpenGL import GL
+
+        self.make_current()
+        ctx = self.ctx
+        if self._readback is None or self._readback[0] != (width, height):
+            self.release_readback()
+            rb = ctx.renderbuffer((width, height), 4)
+            self._readback = ((width, height), ctx.framebuffer([rb]), rb)
+        fbo = self._readback[1]
+        GL.glBindFramebuffer(GL.GL_READ_FRAMEBUFFER, 0)
+        GL.glReadBuffer(GL.GL_BACK)
+        GL.glBindFramebuffer(GL.GL_DRAW_FRAMEBUFFER, fbo.glo)
+        GL.glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL.GL_COLOR_BUFFER_BIT, GL.GL_NEAREST)
+        data = fbo.read(components=3, alignment=1)
+        ctx.screen.use()
+        img = np.frombuffer(data, np.uint8).reshape(height, width, 3)
+        return np.ascontiguousarray(img[::-1])
+
+    def release_readback(self) -> None:
+        """Free :meth:`read_pixels`' buffers (made again when next needed)."""
+        if self._readback is not None:
+            self.make_current()
+            self.ctx.screen.use()
+            for o in self._readback[1:]:
+                o.release()
+            self._readback = None
+
     def close(self) -> None:
         """Destroy the window and stop GLFW (idempotent)."""
         if self._closed:
             return
         self._closed = True
         try:
-            self.make_current()
+            self.release_readback()
             self.ctx.release()
         except Exception:  # pragma: no cover
             pass

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import PresetError
+from ..errors import PresetError
 from .generate import BeamSpec, CrownSpec, GrassSpec, LaminaSpec, LeafSpec, LevelSpec, TreeSpec, generate
 from .look import Bark
 from .params import SCALAR_KEYS, SCALAR_MAX, ModeRange, PhysicsParams, SeasonModes

@@ -7,17 +7,19 @@ so each level is one contiguous slice of the object arrays (and of the node arra
 
 from __future__ import annotations
 
-import math
 import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..validate import finite_float
 from .geometry import polygon_area
 from .look import Bark
 from .params import PhysicsParams
 
 KINDS = ("branch", "leaf", "blade")
+#: Each kind's plural: the keys of :meth:`Tree.stats`' counts.
+PLURAL = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
 
 #: Sides of a branch tube: 2 x 16 triangles per band of the tube plus a 16-triangle fan at
 #: each end (the paper's 32 triangles per node when every segment is one band).
@@ -203,13 +205,7 @@ class Tree:
         ValueError
             If ``season`` is not a finite real number.
         """
-        try:
-            season = float(season)
-        except (TypeError, ValueError):
-            raise ValueError(f"season must be a finite number, got {season!r}") from None
-        if not math.isfinite(season):
-            raise ValueError(f"season must be finite, got {season!r}")
-        season = min(max(season, 0.0), 1.0)
+        season = min(max(finite_float("season", season), 0.0), 1.0)
         n_leaves = int(np.count_nonzero(self.kind == "leaf"))
         keep = int(round(n_leaves + (self.winter_leaves - n_leaves) * season))
         fallen = n_leaves - keep
@@ -244,10 +240,9 @@ class Tree:
         present = self.leaves_present(season)
         tris = self.triangles_per_object()
         out: dict = {}
-        plural = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
         for k in KINDS:
             m = present & (self.kind == k)
-            out[plural[k]] = int(m.sum())
+            out[PLURAL[k]] = int(m.sum())
             out[f"{k}_nodes"] = int(self.object_count[m].sum())
             out[f"{k}_triangles"] = int(tris[m].sum())
         out["objects"] = int(present.sum())

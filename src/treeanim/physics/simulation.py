@@ -10,7 +10,7 @@ import numpy as np
 
 from ..model.params import SCALAR_KEYS, SCALAR_MAX, PhysicsParams
 from ..model.tree import KINDS, Tree
-from .checks import finite_float, finite_vector3
+from ..validate import finite_float, finite_vector3
 from .derived import Derived
 from .modal import ModalDraws, ModalParameters
 from .rotation import qrot

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .checks import finite_float
+from ..validate import finite_float
 from .simulation import Simulation
 
 __all__ = ["trace_tips", "MAX_TRACE_VALUES"]

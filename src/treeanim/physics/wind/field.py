@@ -7,7 +7,7 @@ import threading
 
 import numpy as np
 
-from ..checks import finite_float, finite_vector3
+from ...validate import finite_float, finite_vector3
 from .paper import _cached_grid, _sample_chunk, _Workspace, _wrap_shift
 from .physical import _canopy_mean, _sample_physical
 from .settings import (

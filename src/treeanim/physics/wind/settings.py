@@ -6,7 +6,7 @@ import operator
 
 import numpy as np
 
-from ..checks import finite_float
+from ...validate import finite_float
 
 MODELS = ("physical", "paper")
 #: Default bounds ((x0, y0, z0), (x1, y1, z1)) in metres, until a Simulation fits the field.

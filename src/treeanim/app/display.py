@@ -1,17 +1,15 @@
-"""Why the viewer cannot run here (importable without GLFW, OpenGL or imgui)."""
+"""Whether a window can be opened here (importable without GLFW, OpenGL or imgui)."""
 
 from __future__ import annotations
 
 import os
 import sys
 
+from ..errors import ViewerUnavailable
+
 #: What to use where no window can be opened.
 HEADLESS_HINT = ("the headless commands need no window: 'treeanim render PRESET --out FILE' "
                  "(images, video) and 'treeanim export PRESET --out FILE.glb'")
-
-
-class ViewerUnavailable(RuntimeError):
-    """The viewer cannot open its window here; ``str(exc)`` is one line saying why."""
 
 
 def check_display() -> None:

@@ -1,0 +1,70 @@
+"""The viewer's controls in one table: :data:`BINDINGS` (key → action, description) drives
+both :meth:`Viewer.on_key <treeanim.app.viewer.Viewer.on_key>` and the panel's Controls help
+(:func:`help_lines`); :data:`MOUSE` describes the mouse."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import glfw
+
+__all__ = ["Binding", "BINDINGS", "MOUSE", "binding_for", "help_lines"]
+
+
+@dataclass(frozen=True)
+class Binding:
+    """One shortcut.
+
+    Attributes
+    ----------
+    keys : tuple of int
+        GLFW key codes that trigger it.
+    label : str
+        The keys as the help shows them.
+    action : str
+        The :class:`~treeanim.app.viewer.Viewer` method it calls (no arguments).
+    does : str
+        What it does, for the help.
+    ctrl : bool
+        Only with Ctrl held (and never without it).
+    """
+
+    keys: tuple[int, ...]
+    label: str
+    action: str
+    does: str
+    ctrl: bool = False
+
+
+#: Every shortcut, in the order the help lists them.
+BINDINGS = (
+    Binding((glfw.KEY_F,), "F", "frame_camera", "frame the tree"),
+    Binding((glfw.KEY_SPACE,), "Space", "toggle_pause", "pause"),
+    Binding((glfw.KEY_R,), "R", "reset", "reset"),
+    Binding((glfw.KEY_H,), "H", "toggle_panel", "hide the panel"),
+    Binding((glfw.KEY_S, glfw.KEY_F12), "S/F12", "request_screenshot", "screenshot"),
+    Binding((glfw.KEY_F11,), "F11", "toggle_fullscreen", "full screen"),
+    Binding((glfw.KEY_S,), "Ctrl+S", "save_preset", "save the preset", ctrl=True),
+    Binding((glfw.KEY_O,), "Ctrl+O", "load_preset", "load it", ctrl=True),
+    Binding((glfw.KEY_ESCAPE, glfw.KEY_Q), "Esc/Q", "quit", "quit"),
+)
+#: The mouse: (what, does).
+MOUSE = (
+    ("left-drag a branch or leaf", "pull, let go: swing"),
+    ("left-drag the sky", "orbit"),
+    ("right/middle-drag", "pan"),
+    ("wheel", "zoom"),
+)
+
+
+def binding_for(key: int, mods: int) -> Binding | None:
+    """The binding a press of ``key`` with modifier bits ``mods`` triggers, or None."""
+    ctrl = bool(mods & glfw.MOD_CONTROL)
+    return next((b for b in BINDINGS if b.ctrl == ctrl and key in b.keys), None)
+
+
+def help_lines() -> list[str]:
+    """The controls as short lines: the mouse's, then two shortcuts a line."""
+    lines = [f"{what}: {does}" for what, does in MOUSE]
+    keys = [f"{b.label} {b.does}" for b in BINDINGS]
+    return lines + ["   ".join(keys[i:i + 2]) for i in range(0, len(keys), 2)]

@@ -1,0 +1,260 @@
+"""Where rendered frames go: a video (:class:`VideoSink`, one entry of :data:`VIDEO_FORMATS`
+per file suffix), a folder of PNG frames (:class:`FrameSink`) or one PNG (:func:`write_png`).
+
+:data:`SUFFIX_KINDS` says what an ``--out`` name's suffix makes (a new format is one entry in
+:data:`VIDEO_FORMATS`), :data:`SINKS` which sink writes each kind's frames. Every sink has
+``write(img)``, ``finish() -> kept``, ``abort()``, ``count``, ``size``, ``broken``,
+``nbytes()`` and ``stale()``.
+"""
+
+from __future__ import annotations
+
+import errno
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..files import atomic_path, temp_beside
+
+#: Name pattern of the frames written into a folder.
+FRAME_NAME = "frame_{:05d}.png"
+#: The still's extension.
+STILL_SUFFIX = ".png"
+
+
+@dataclass(frozen=True)
+class VideoFormat:
+    """How imageio-ffmpeg encodes one video format.
+
+    Attributes
+    ----------
+    codec, pix_fmt : str
+        ffmpeg's encoder and output pixel format.
+    params : tuple of str
+        Further ffmpeg output options.
+    even : bool
+        The pixel format needs even sides: odd frames are padded (:func:`pad_even`).
+    """
+
+    codec: str
+    pix_fmt: str
+    params: tuple[str, ...]
+    even: bool = False
+
+
+#: Video formats by file suffix: H.264 MP4 (yuv420p, CRF 18, playable while it streams), and
+#: GIF with one palette for the whole clip.
+VIDEO_FORMATS = {
+    ".mp4": VideoFormat("libx264", "yuv420p", ("-crf", "18", "-preset", "medium", "-movflags", "+faststart"),
+                        even=True),
+    ".gif": VideoFormat("gif", "pal8", ("-vf", "split[a][b];[a]palettegen=stats_mode=full[p];"
+                                               "[b][p]paletteuse=dither=bayer:bayer_scale=4", "-loop", "0")),
+}
+#: What ``--out NAME.SUFFIX`` makes ('video' or 'still'); a folder (or a new name with no
+#: suffix) is 'frames'.
+SUFFIX_KINDS = {**dict.fromkeys(VIDEO_FORMATS, "video"), STILL_SUFFIX: "still"}
+
+
+def pad_even(img: np.ndarray) -> np.ndarray:
+    """``img`` (H, W, 3) padded to even sides by repeating its last row / column (yuv420p
+    video needs even sizes)."""
+    h, w = img.shape[:2]
+    if h % 2 == 0 and w % 2 == 0:
+        return img
+    return np.pad(img, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
+
+
+class _Abort(BaseException):
+    """Thrown into imageio-ffmpeg's writer to make it kill ffmpeg rather than finish the file."""
+
+
+class VideoSink:
+    """Frames into an .mp4 (H.264, yuv420p, CRF 18) or a .gif (one palette for the whole clip)
+    through imageio-ffmpeg, via a temporary file renamed over ``path`` by :meth:`finish`.
+
+    The format is :data:`VIDEO_FORMATS` [the suffix]; frames of odd width or height are padded
+    to even by repeating the last row/column where it needs even sides (MP4).
+
+    The temporary file comes from :func:`treeanim.files.temp_beside` rather than
+    :func:`~treeanim.files.atomic_path`: an interrupted render keeps the frames encoded so far
+    (:meth:`finish` renames them into place), which "remove on any error" would throw away.
+
+    Attributes
+    ----------
+    path : Path
+        The video's final name.
+    tmp : Path
+        The hidden temporary file ffmpeg writes to.
+    size : (int, int)
+        Width and height encoded (an MP4's odd sides padded to even).
+    count : int
+        Frames encoded so far.
+    broken : bool
+        ffmpeg failed: the file is dropped, never kept.
+    """
+
+    def __init__(self, path: Path, width: int, height: int, fps: float) -> None:
+        import imageio_ffmpeg
+
+        self.path = Path(path)
+        self.format = VIDEO_FORMATS.get(self.path.suffix.lower())
+        if self.format is None:
+            raise InputError(f"unknown video format {self.path.suffix!r}")
+        self.count = 0
+        self.broken = False
+        even = self.format.even
+        self.size = (width + width % 2, height + height % 2) if even else (width, height)
+        self.tmp = temp_beside(self.path, self.path.suffix.lower())
+        try:
+            self._gen = imageio_ffmpeg.write_frames(
+                str(self.tmp), self.size, fps=float(fps), macro_block_size=1, ffmpeg_log_level="error",
+                codec=self.format.codec, pix_fmt_out=self.format.pix_fmt, quality=None,
+                output_params=list(self.format.params))
+            self._gen.send(None)  # starts ffmpeg
+        except BaseException:
+            self.tmp.unlink(missing_ok=True)
+            raise
+
+    def write(self, img: np.ndarray) -> None:
+        """Encode one frame.
+
+        Parameters
+        ----------
+        img : (height, width, 3) uint8
+            The frame, row 0 at the top, of the size given to the constructor (an MP4's odd
+            side is padded here).
+
+        Raises
+        ------
+        Exception
+            Whatever ffmpeg's writer raised; the sink is then :attr:`broken` and its file is
+            not kept.
+        """
+        if self.format.even:
+            img = pad_even(img)
+        try:
+            self._gen.send(np.ascontiguousarray(img))
+        except Exception:
+            self.broken = True  # ffmpeg failed: the file is not worth keeping
+            raise
+        self.count += 1
+
+    def finish(self) -> bool:
+        """Close the encoder; keep the file (renamed to ``path``) if it holds a frame. Returns
+        whether it was kept."""
+        if self.count == 0:
+            self.abort()
+            return False
+        gen, self._gen = self._gen, None
+        try:
+            if gen is not None:
+                gen.close()  # ffmpeg gets EOF and writes the trailer (a playable file)
+            self._check()
+        except BaseException:
+            self.tmp.unlink(missing_ok=True)
+            raise
+        os.replace(self.tmp, self.path)
+        return True
+
+    def nbytes(self) -> int:
+        """Bytes of the file :meth:`finish` kept."""
+        return self.path.stat().st_size
+
+    def stale(self) -> int:
+        """Older files this run left beside its own (none: a video replaces the file)."""
+        return 0
+
+    def _check(self) -> None:
+        """OSError unless the file ffmpeg wrote holds every frame: imageio-ffmpeg does not report
+        an encoder that died on a write error (a full disk), which leaves a truncated file."""
+        import imageio_ffmpeg
+
+        try:
+            frames, _ = imageio_ffmpeg.count_frames_and_secs(str(self.tmp))
+        except Exception:  # noqa: BLE001 - ffmpeg cannot read it back: it is broken
+            frames = -1
+        if frames != self.count:
+            self.broken = True
+            raise OSError(errno.EIO, "the video encoder could not finish it (is the disk full?); "
+                                     "any previous file is kept", str(self.path))
+
+    def abort(self) -> None:
+        """Stop the encoder and drop the file, quietly."""
+        import logging
+
+        gen, self._gen = self._gen, None
+        if gen is not None:
+            log = logging.getLogger("imageio_ffmpeg")
+            level = log.level
+            log.setLevel(logging.CRITICAL)  # not "no frames have been written"
+            try:
+                gen.throw(_Abort())  # a BaseException: imageio-ffmpeg kills ffmpeg, no trailer
+            except BaseException:
+                pass
+            finally:
+                log.setLevel(level)
+        self.tmp.unlink(missing_ok=True)
+
+
+def write_png(path: Path, img: np.ndarray) -> None:
+    """One PNG, written beside ``path`` and renamed over it (never a half-written file)."""
+    import imageio.v3 as iio
+
+    with atomic_path(path, ".png") as tmp:
+        iio.imwrite(tmp, img, extension=".png")
+
+
+class FrameSink:
+    """Frames as ``frame_00000.png`` … in a folder (created if new; removed again if no frame
+    was written into it)."""
+
+    broken = False  # each frame file is complete once written: there is nothing to drop
+
+    def __init__(self, folder: Path, width: int, height: int, fps: float = 0.0) -> None:
+        self.path = Path(folder)
+        self.size = (int(width), int(height))
+        self.created = not self.path.exists()
+        self.path.mkdir(exist_ok=True)
+        self.count = 0
+
+    def write(self, img: np.ndarray) -> None:
+        """Write ``img`` ((height, width, 3) uint8, row 0 at the top) as the next frame file."""
+        write_png(self.path / FRAME_NAME.format(self.count), img)
+        self.count += 1
+
+    def nbytes(self) -> int:
+        """Bytes of the frame files written by this run."""
+        return sum((self.path / FRAME_NAME.format(i)).stat().st_size for i in range(self.count))
+
+    def stale(self) -> int:
+        """Older frame files past the ones written by this run."""
+        n = 0
+        while (self.path / FRAME_NAME.format(self.count + n)).exists():
+            n += 1
+        return n
+
+    def finish(self) -> bool:
+        """End the run: a folder this sink created is removed again if no frame went into it.
+
+        Returns
+        -------
+        bool
+            Whether any frame was written (the frames are kept either way; each file is
+            complete as soon as :meth:`write` returns).
+        """
+        if self.count == 0 and self.created:
+            try:
+                self.path.rmdir()
+            except OSError:
+                pass
+            return False
+        return self.count > 0
+
+    abort = finish
+
+
+#: The sink that writes the frames of each kind of target (a still is one :func:`write_png`).
+SINKS = {"video": VideoSink, "frames": FrameSink}

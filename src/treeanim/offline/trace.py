@@ -1,0 +1,130 @@
+"""``treeanim trace``: pull one object's tip, let go, and record its free swing (the paper's
+Figs. 1 and 4) as CSV and, with matplotlib, a plot."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import InputError
+from ..files import atomic_path
+from ..validate import positive_float
+
+#: What to install for plots (``trace --plot`` and the examples), from the repository.
+PLOTS_HINT = "needs matplotlib: .venv/bin/pip install -e '.[plots]' (from the repository)"
+
+
+@dataclass
+class TraceResult:
+    """A tip trace after release: ``times`` (T,) from 0 at release, ``tips`` (T, 3) world."""
+
+    times: np.ndarray
+    tips: np.ndarray
+    rest: np.ndarray
+    held: np.ndarray
+    obj: int
+    kind: str
+    f: np.ndarray
+    zeta: np.ndarray
+
+
+def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float) -> TraceResult:
+    """Pull object ``obj``'s tip with ``force`` (N, world) for ``hold`` seconds (the held object
+    sits at its static deflection; the rest of the tree settles), let go, and record the tip
+    for ``seconds`` at ``rate`` samples per second.
+
+    Raises
+    ------
+    InputError
+        ``seconds`` or ``rate`` not finite and positive, or so small that fewer than 2 samples
+        would follow the release (checked before anything is simulated).
+    """
+    from ..physics.trace import trace_tips
+
+    try:
+        positive_float("--seconds", seconds), positive_float("--rate", rate)
+    except ValueError as e:
+        raise InputError(str(e)) from None
+    samples = int(round(seconds * rate)) + 1  # trace_tips records the release and every step after it
+    if samples < 2:
+        raise InputError(f"--seconds {seconds:g} at --rate {rate:g} Hz gives {samples} sample after release; "
+                         f"a trace needs at least 2 samples")
+    dt = 1.0 / rate
+    tree = sim.tree
+    tip = int(tree.object_start[obj] + tree.object_count[obj] - 1)
+    sim.pull(obj, np.asarray(force, float))
+    for _ in range(max(1, int(round(hold / dt)))):
+        sim.step(dt)
+    held = sim.tip_position(obj)
+    sim.release()
+    times, tips = trace_tips(sim, [obj], seconds, dt)
+    return TraceResult(times - times[0], tips[:, 0], np.asarray(tree.rest_positions[tip], float), held, obj,
+                       str(tree.kind[obj]), np.array(sim.modes.f[obj], float), np.array(sim.modes.zeta[obj], float))
+
+
+def write_trace_csv(path: Path, trace: TraceResult) -> None:
+    """``t,x,y,z`` (seconds after release, world metres), written beside ``path`` and renamed."""
+    data = np.column_stack([trace.times, trace.tips])
+    with atomic_path(path, ".csv") as tmp:
+        np.savetxt(tmp, data, delimiter=",", header="t,x,y,z", comments="", fmt=["%.6f", "%.9f", "%.9f", "%.9f"])
+
+
+def plot_trace(path: Path, trace: TraceResult, title: str = "") -> None:
+    """The horizontal trace of the tip (x–z displacement from rest, equal aspect), coloured by
+    time after release, in the manner of the paper's Figs. 1 and 4."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.collections import LineCollection
+
+    d = trace.tips - trace.rest
+    x, z = d[:, 0] * 100, d[:, 2] * 100  # cm
+    pts = np.column_stack([x, z])
+    segs = np.stack([pts[:-1], pts[1:]], axis=1)
+    t = trace.times
+    fig, ax = plt.subplots(figsize=(6.4, 6.0), dpi=150)
+    age = t[:-1] / max(t[-1], 1e-9)
+    cmap = plt.get_cmap("viridis")
+    colors = cmap(age)
+    colors[:, 3] = 1.0 - 0.65 * age  # fade as it dies away
+    lc = LineCollection(segs, colors=colors, linewidths=1.1, capstyle="round")
+    ax.add_collection(lc)
+    ax.plot([0], [0], "+", color="0.2", ms=12, mew=1.5, label="rest")
+    ax.plot([x[0]], [z[0]], "o", color=cmap(0.0), ms=6, label="release")
+    span = max(np.ptp(x), np.ptp(z), 1e-6)
+    cx, cz = 0.5 * (x.max() + x.min()), 0.5 * (z.max() + z.min())
+    half = 0.55 * span
+    ax.set_xlim(cx - half, cx + half)
+    ax.set_ylim(cz - half, cz + half)
+    ax.set_aspect("equal")
+    ax.set_xlabel("tip displacement x (cm)")
+    ax.set_ylabel("tip displacement z (cm)")
+    ax.grid(True, color="0.9", lw=0.6)
+    ax.legend(loc="upper right", frameon=False, fontsize=8)
+    sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(0, t[-1]))
+    fig.colorbar(sm, ax=ax, fraction=0.046, pad=0.04, label="time after release (s)")
+    f, z_ = trace.f, trace.zeta
+    sub = (f"object {trace.obj} ({trace.kind}): f u,v,w = {f[0]:.3f}, {f[1]:.3f}, {f[2]:.3f} Hz; "
+           f"ζ = {z_[0]:.3f}, {z_[1]:.3f}, {z_[2]:.3f}")
+    ax.set_title((title + "\n" if title else "") + sub, fontsize=9)
+    fig.tight_layout()
+    suffix = Path(path).suffix.lower()
+    try:
+        with atomic_path(path, suffix) as tmp:
+            fig.savefig(tmp, format=suffix[1:])
+    finally:
+        plt.close(fig)
+
+
+def zero_crossing_frequency(t: np.ndarray, x: np.ndarray) -> float:
+    """Frequency (Hz) of an oscillating signal from its mean zero-crossing interval."""
+    x = np.asarray(x, float)
+    s = np.signbit(x)
+    i = np.flatnonzero(s[1:] != s[:-1])
+    if len(i) < 3:
+        return float("nan")
+    tz = t[i] - x[i] * (t[i + 1] - t[i]) / (x[i + 1] - x[i])
+    return float(1.0 / (2.0 * np.mean(np.diff(tz))))

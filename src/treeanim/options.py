@@ -1,0 +1,196 @@
+"""The command line's option types (argparse ``type=`` callables that refuse bad input with
+one clear line) and the option groups several commands share (wind, season, scene, timing)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .errors import UsageError
+
+#: Upper bound of times, rates and counts on the command line: large enough for any real use,
+#: small enough that products of them stay finite and allocations sane.
+LIMIT = 1e6
+#: Most frames (or samples) one command may produce.
+MAX_FRAMES = 1_000_000
+#: Most simulation steps one command may take (hours of work at a few ms a step).
+MAX_STEPS = 2_000_000
+
+
+def number(kind, lo: float, hi: float, lo_open: bool):
+    """An argparse type: a ``kind`` (int or float) in (lo, hi] or [lo, hi]."""
+    fmt = (lambda x: f"{int(x):,}") if kind is int else (lambda x: f"{x:g}")
+    noun = "integer" if kind is int else "number"
+    if lo_open and lo == 0:
+        what = f"a positive {noun} up to {fmt(hi)}"
+    else:
+        what = f"{'an' if kind is int else 'a'} {noun} in [{fmt(lo)}, {fmt(hi)}]"
+
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            value = float("nan")
+        if not ((value > lo) if lo_open else (value >= lo)) or not value <= hi:
+            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
+        return value
+
+    return parse
+
+
+def positive(kind, hi: float = LIMIT):
+    """An argparse type: a ``kind`` (int or float) in (0, ``hi``]."""
+    return number(kind, 0, hi, lo_open=True)
+
+
+non_negative = number(float, 0, LIMIT, lo_open=False)
+
+
+def checked(parse):
+    """An argparse type from a parser that raises ValueError with a clear message."""
+
+    def typed(text: str):
+        try:
+            return parse(text)
+        except ValueError as e:
+            raise argparse.ArgumentTypeError(str(e)) from None
+
+    typed.__name__ = parse.__name__
+    return typed
+
+
+def size(text: str) -> tuple[int, int]:
+    """An argparse type: ``WxH`` pixels (:func:`treeanim.offline.target.parse_size`)."""
+    from treeanim.offline.target import parse_size
+
+    return checked(parse_size)(text)
+
+
+def vector(what: str, force: bool = False):
+    """An argparse type: X,Y,Z (a force: of at most the simulation's largest pull)."""
+    from treeanim.scripted import parse_force, parse_vector
+
+    parse = parse_force if force else parse_vector
+    return checked(lambda text: parse(text, what))
+
+
+def pull(text: str):
+    """An argparse type: ``OBJECT:FX,FY,FZ@T0-T1`` (:func:`treeanim.scripted.parse_pull`)."""
+    from treeanim.scripted import parse_pull
+
+    return checked(parse_pull)(text)
+
+
+def wind_speed(text: str) -> float:
+    """An argparse type: a wind speed from 0 to the wind field's largest, m/s."""
+    from treeanim.physics.wind import MAX_SPEED
+
+    return number(float, 0, MAX_SPEED, lo_open=False)(text)
+
+
+def add_season_option(p: argparse.ArgumentParser) -> None:
+    """--season, for every command that builds a tree."""
+    p.add_argument("--season", type=number(float, 0, 1, lo_open=False), default=0.0, help="0 = summer … 1 = winter (default 0)")
+
+
+def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
+    """--wind and --wind-preset (the viewer's and the offline commands' wind)."""
+    from treeanim.physics.wind import WIND_PRESETS
+
+    names = ", ".join(f"{k} (Beaufort {v['beaufort']}, {v['speed']:g} m/s)" for k, v in WIND_PRESETS.items())
+    p.add_argument("--wind", type=wind_speed, default=None, metavar="SPEED",
+                   help=f"mean wind speed at the canopy top, m/s (default {wind:g}, or the preset's; 0 = calm)")
+    p.add_argument("--wind-preset", choices=list(WIND_PRESETS), default=None, metavar="NAME",
+                   help=f"a named wind: {names}; --wind (and --turbulence where it exists) override its values")
+
+
+def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
+    """Wind, season and seed options (the scene around the tree)."""
+    from treeanim.physics.wind import MODELS
+
+    add_wind_speed_options(p, wind)
+    p.add_argument("--wind-model", choices=list(MODELS), default=None,
+                   help="physical (default: turbulence in metres carried downwind, gusts, canopy profile) "
+                   "or paper (Hu, Chiba & He 2012, Eqs. 13-18; the default with --paper)")
+    p.add_argument("--wind-dir", type=vector("direction"), default=(1.0, 0.0, 0.0), metavar="X,Y,Z",
+                   help="wind direction; needs a horizontal part (default 1,0,0)")
+    p.add_argument("--turbulence", type=number(float, 0, 2, lo_open=False), default=None, metavar="T",
+                   help="physical: turbulence intensity at the canopy top in [0, 1] (default 0.3); "
+                   "paper: lambda of Eq. 17 in [1, 2] (default 1.5)")
+    add_season_option(p)
+    p.add_argument("--seed", type=number(int, 0, 2**32 - 1, lo_open=False), default=0,
+                   help="seed of the wind and the modal noise (default 0)")
+    p.set_defaults(wind_default=wind)
+
+
+def wind_settings(args) -> dict:
+    """WindField keyword arguments from :func:`add_wind_options` (speed 0 means calm: no field)."""
+    from treeanim.physics.wind import wind_preset
+
+    model = getattr(args, "wind_model", None)
+    kw = dict(model=model or ("paper" if getattr(args, "paper", False) else "physical"))
+    if getattr(args, "wind_preset", None):
+        if kw["model"] == "paper":
+            raise UsageError("--wind-preset: the named winds are for --wind-model physical")
+        kw.update(wind_preset(args.wind_preset))
+    kw.setdefault("speed", args.wind_default)
+    if args.wind is not None:
+        kw["speed"] = args.wind
+    if getattr(args, "turbulence", None) is not None:
+        kw["turbulence"] = args.turbulence
+    kw.update(direction=args.wind_dir, seed=args.seed)
+    return kw
+
+
+def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, fps: float = 30.0,
+                      seconds_help: str | None = None) -> None:
+    """Options shared by the offline commands: the preset, timing, wind, season and pulls."""
+    p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
+    p.add_argument("--seconds", type=positive(float), default=seconds,
+                   help=seconds_help or f"duration in seconds (default {seconds:g})")
+    p.add_argument("--fps", type=positive(float), default=fps, help=f"frames per second (default {fps:g})")
+    add_wind_options(p)
+    p.add_argument("--pull", type=pull, action="append", default=[], metavar="OBJECT:FX,FY,FZ@T0-T1",
+                   help="pull OBJECT's tip with a world force in newtons from T0 to T1 s, then let go; repeatable")
+    p.add_argument("--paper", action="store_true",
+                   help="the paper's model: every object on its own, linear drag, the paper's wind field "
+                   "(default: the load path in the physical wind)")
+
+
+def check_frames(seconds: float, fps: float, step_rate: float = 60.0) -> int:
+    """The number of frames ``seconds`` at ``fps`` give; UsageError beyond :data:`MAX_FRAMES`,
+    or beyond :data:`MAX_STEPS` simulation steps (one a frame, and at least ``step_rate`` a
+    second: scripted frames step at most 1/60 s at a time)."""
+    n = seconds * fps
+    if n > MAX_FRAMES:
+        raise UsageError(f"--seconds {seconds:g} at --fps {fps:g} is {n:.3g} frames; at most {MAX_FRAMES:,}")
+    steps = seconds * max(fps, step_rate)
+    if steps > MAX_STEPS:
+        raise UsageError(f"--seconds {seconds:g} takes {steps:.3g} simulation steps; at most {MAX_STEPS:,} "
+                         f"(about {MAX_STEPS / 3600 / 60:.0f} hours of simulated time at 60 steps a second)")
+    return int(round(n))
+
+
+def finite(text: str) -> float:
+    """An argparse type: any finite number."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if value != value or value in (float("inf"), float("-inf")):
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+    return value
+
+
+#: MSAA sample counts a GL implementation may offer (more are clamped to what it has).
+SAMPLES = (0, 1, 2, 4, 8, 16)
+
+
+def samples(text: str) -> int:
+    """An argparse type: an MSAA sample count of :data:`SAMPLES`."""
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if value not in SAMPLES:
+        raise argparse.ArgumentTypeError(f"expected one of {', '.join(map(str, SAMPLES))}, got {text!r}")
+    return value

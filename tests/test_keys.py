@@ -1,0 +1,29 @@
+"""The key table (app/keys.py) drives the viewer's handler and the panel's help: every binding
+names a Viewer action, no key is bound twice, and the help lists every binding."""
+
+from __future__ import annotations
+
+import glfw
+
+from treeanim.app.keys import BINDINGS, MOUSE, binding_for, help_lines
+from treeanim.app.viewer import Viewer
+
+
+def test_every_binding_is_an_action_of_the_viewer_and_in_the_help():
+    seen = set()
+    text = "\n".join(help_lines())
+    for b in BINDINGS:
+        assert callable(getattr(Viewer, b.action, None)), b.action
+        for key in b.keys:
+            assert (key, b.ctrl) not in seen, b
+            seen.add((key, b.ctrl))
+        assert f"{b.label} {b.does}" in text
+    assert all(f"{what}: {does}" in text for what, does in MOUSE)
+
+
+def test_ctrl_picks_its_own_bindings():
+    assert binding_for(glfw.KEY_S, 0).action == "request_screenshot"
+    assert binding_for(glfw.KEY_S, glfw.MOD_CONTROL).action == "save_preset"
+    assert binding_for(glfw.KEY_F, glfw.MOD_CONTROL) is None  # Ctrl with an unbound key does nothing
+    assert binding_for(glfw.KEY_F12, glfw.MOD_SHIFT).action == "request_screenshot"
+    assert binding_for(glfw.KEY_A, 0) is None
