@@ -9,7 +9,8 @@ from scipy.optimize import brentq
 from conftest import rot
 from treeanim.model.build import ObjectSpec, assemble
 from treeanim.model.params import PhysicsParams
-from treeanim.physics.bending import rest_frames, solve_bend_angle
+from treeanim.physics.bend_angle import solve_bend_angle
+from treeanim.physics.bending import rest_frames
 from treeanim.physics.simulation import Simulation
 
 

@@ -35,7 +35,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import sparse
 
-from .bending import saturating_twist
+from .bend_angle import saturating_twist
 from .rotation import Workspace
 
 __all__ = ["LoadPath", "TWIST_RATIO"]

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from .bending import saturating_twist
+from .bend_angle import saturating_twist
 from .oscillator import euler_step, exact_coefficients, exact_step
 from .rotation import qrot
 
