@@ -284,6 +284,8 @@ class BendingPlan:
         h0, H = self.hinge_start, self.n_hinges
         ta = 0  # start of block i among the solved segments (``gamma`` per segment)
         for i, K in enumerate(self.solved):
+            if K == 0:  # the rest are hinged segments (their counts never grow with i)
+                break
             a, b = self.offsets[i], self.offsets[i + 1]
             tw = slice(ta, ta + K) if per_segment else slice(0, K)
             ta += K
