@@ -13,6 +13,8 @@ from typing import Iterator
 
 import numpy as np
 
+from .clock import STEP, StepClock
+
 _PULL = re.compile(r"^\s*(\d+)\s*:\s*([^@]+?)\s*@\s*([^-]+?)\s*-\s*(.+?)\s*$")
 
 
@@ -78,19 +80,20 @@ def check_pulls(pulls: list[Pull], n_objects: int) -> None:
             raise ValueError(f"--pull on object {p.obj}: the tree has objects 0 to {n_objects - 1}")
 
 
-def frames(sim, seconds: float, fps: float, pulls: list[Pull] = (), max_step: float = 1 / 60) -> Iterator[int]:
+def frames(sim, seconds: float, fps: float, pulls: list[Pull] = (), step: float = STEP) -> Iterator[int]:
     """Advance ``sim`` to each frame time k / fps for k = 0 .. round(seconds * fps) - 1.
 
-    Yields the frame index after the simulation reached that frame's time. Steps are at most
-    ``max_step`` long. Before every step, exactly the pulls whose interval [T0, T1) holds the
-    step's start time are held (pulls on different objects may overlap); the others are let go.
+    Yields the frame index once the simulation is within half a ``step`` of that frame's time:
+    it steps by ``step`` on the viewer's clock (:class:`~treeanim.clock.StepClock`).
+    Before every step, exactly the pulls whose interval [T0, T1) holds the step's start time
+    are held (pulls on different objects may overlap); the others are let go.
     """
     n = int(round(seconds * fps))
+    clock = StepClock(step)
     held: dict[int, tuple[float, float, float]] = {}
     t = 0.0
     for k in range(n):
-        target = k / fps
-        while t < target - 1e-12:
+        for _ in range(clock.advance(1.0 / fps if k else 0.0)):
             want = {p.obj: p.force for p in pulls if p.start <= t < p.end}
             for obj in held.keys() - want.keys():
                 sim.release(obj)
@@ -98,9 +101,8 @@ def frames(sim, seconds: float, fps: float, pulls: list[Pull] = (), max_step: fl
                 if held.get(obj) != force:
                     sim.pull(obj, np.asarray(force, float))
             held = want
-            dt = min(max_step, target - t)
-            sim.step(dt)
-            t += dt
+            sim.step(step)
+            t += step
         yield k
     for obj in held:
         sim.release(obj)

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..clock import STEP, StepClock
 from ..model.tree import Tree
 from ..physics.pull import SpringPull
 from ..physics.simulation import Simulation
@@ -35,8 +36,6 @@ from .window import Window
 #: renderer at a few frames a second) still keep real time, in sub-steps; a stall (a dragged or
 #: hidden window) never makes a jump.
 MAX_FRAME_DT = 0.5
-#: Longest simulation sub-step (s of simulated time).
-MAX_SUBSTEP = 1.0 / 60.0
 
 
 def _clone_wind(w: WindField | None, **changes) -> WindField:
@@ -123,7 +122,7 @@ class Viewer(ViewerInput):
         self.sim_ms, self.render_ms, self.frame_s = _Ema(), _Ema(), _Ema(0.05)
         self.real_time = _Ema(0.05)  # simulated seconds per real second (the time scale, if kept up)
         self.last_sim_s = self.last_draw_s = 0.0  # the last frame's advance() and draw(), s
-        self._acc = 0.0
+        self.step_clock = StepClock()
         self._last_time: float | None = None
         self._screenshot_pending: list[Path | None] = []
         self._uploaded = None
@@ -182,7 +181,7 @@ class Viewer(ViewerInput):
         self.picker = Picker(tree)
         self.trace.clear()
         self.traced = None
-        self._acc = 0.0
+        self.step_clock.reset()
         lo, hi = renderer.bounds()
         self.local_frames = LocalFrames(scale=0.25)
         size = float(np.max(hi - lo))
@@ -228,19 +227,16 @@ class Viewer(ViewerInput):
 
         At 60 frames a second this is one step a frame at any slow-motion scale, and the exact
         integrator's coefficients stay cached while the scale is unchanged."""
-        return MAX_SUBSTEP * min(1.0, self.time_scale)
+        return STEP * min(1.0, self.time_scale)
 
     def advance(self, real_dt: float) -> int:
         """Advance the simulation by ``real_dt`` seconds of real time × the time scale, in
         fixed sub-steps; ``real_dt`` is clamped to :data:`MAX_FRAME_DT`. Returns the steps taken."""
         if self.paused:
             return 0
+        h = self.step_clock.step = self.substep
         dt = min(max(float(real_dt), 0.0), MAX_FRAME_DT) * self.time_scale
-        self._acc += dt
-        h = self.substep
-        n = int(math.floor(self._acc / h + 0.25))  # a step within a quarter of due is taken now
-        n = min(n, int(math.ceil(MAX_FRAME_DT * self.time_scale / h)) + 1)
-        self._acc = min(max(self._acc - n * h, -0.25 * h), h)
+        n = self.step_clock.advance(dt, most=int(math.ceil(MAX_FRAME_DT * self.time_scale / h)) + 1)
         sim = self.sim
         for j in range(n):
             if self.grab is not None:
@@ -438,7 +434,7 @@ class Viewer(ViewerInput):
         self.sim.reset()
         self.trace.clear()
         self.traced = None
-        self._acc = 0.0
+        self.step_clock.reset()
 
     def release(self) -> None:
         """Free the GL resources (the window stays open)."""
