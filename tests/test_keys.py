@@ -27,3 +27,17 @@ def test_ctrl_picks_its_own_bindings():
     assert binding_for(glfw.KEY_F, glfw.MOD_CONTROL) is None  # Ctrl with an unbound key does nothing
     assert binding_for(glfw.KEY_F12, glfw.MOD_SHIFT).action == "request_screenshot"
     assert binding_for(glfw.KEY_A, 0) is None
+
+
+def test_the_readme_lists_every_shortcut():
+    """The README's viewer table is written by hand: it names every key of the table."""
+    import re
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text(encoding="utf-8")
+    table = readme[readme.index("| input | does |"):]
+    rows = table[: table.index("\n\n")].splitlines()[2:]
+    keys = {k for row in rows for k in re.split(r"\s+(?:·|or)\s+", row.split("|")[1].strip())}
+    for b in BINDINGS:
+        for key in b.label.split("/"):
+            assert key in keys, (b.label, sorted(keys))
