@@ -56,10 +56,7 @@ def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
 
 def cmd_export(args) -> int:
     """Bake the simulated motion into a glTF 2.0 file."""
-    import numpy as np
-    from tqdm import tqdm
-
-    from treeanim import export, scripted
+    from treeanim import export
 
     out = output_path(args.out, (".glb", ".gltf"))
     tree, sim = make_simulation(args)
@@ -70,16 +67,10 @@ def cmd_export(args) -> int:
         raise UsageError(f"--seconds {args.seconds:g} at --fps {args.fps:g} gives fewer than 2 frames")
     if fade >= n:
         raise UsageError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
-    size = (n + fade) * skel.count * 16
-    if size > 8e9:
-        raise UsageError(f"{n + fade:,} frames of {skel.count:,} joints would need {size / 1e9:.0f} GB of keys; "
-                         "export fewer seconds or frames per second")
-    keys = np.empty((n + fade, skel.count, 4), np.float32)
-    bar = tqdm(total=n + fade, desc=f"baking {tree.name}", unit="frame", disable=args.quiet, leave=False)
-    for k in scripted.frames(sim, (n + fade) / args.fps, args.fps, args.pull):
-        keys[k] = export.local_rotations(skel, sim.rotations)
-        bar.update()
-    bar.close()
+    try:
+        keys = export.bake(sim, skel, n + fade, args.fps, args.pull, quiet=args.quiet)
+    except ValueError as e:
+        raise UsageError(str(e)) from None
     doc, data = export.build_gltf(tree, export.crossfade_loop(keys, fade), args.fps, season=args.season,
                                   present=sim.present)
     files = export.write_gltf(out, doc, data)

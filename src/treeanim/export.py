@@ -109,6 +109,40 @@ def crossfade_loop(keys: np.ndarray, fade: int) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- mesh
+#: The most bytes of animation keys :func:`bake` allocates (float32 quaternions).
+MAX_KEY_BYTES = 8e9
+
+
+def bake(sim, skel: Skeleton, frames: int, fps: float, pulls=(), quiet: bool = True) -> np.ndarray:
+    """Run ``sim`` for ``frames`` frames at ``fps`` (the offline clock, with the scheduled
+    ``pulls``) and record every joint's local rotation at each frame.
+
+    Returns
+    -------
+    (frames, joints, 4) float32
+        Quaternions (x, y, z, w), as :func:`build_gltf` takes them.
+
+    Raises
+    ------
+    ValueError
+        More than :data:`MAX_KEY_BYTES` of keys.
+    """
+    from tqdm import tqdm
+
+    from . import scripted
+
+    size = frames * skel.count * 16
+    if size > MAX_KEY_BYTES:
+        raise ValueError(f"{frames:,} frames of {skel.count:,} joints would need {size / 1e9:.0f} GB of keys; "
+                         "export fewer seconds or frames per second")
+    keys = np.empty((frames, skel.count, 4), np.float32)
+    with tqdm(total=frames, desc=f"baking {sim.tree.name}", unit="frame", disable=quiet, leave=False) as bar:
+        for k in scripted.frames(sim, frames / fps, fps, pulls):
+            keys[k] = local_rotations(skel, sim.rotations)
+            bar.update()
+    return keys
+
+
 def _lin(*rgb) -> np.ndarray:
     return np.power(np.asarray(rgb, float), 2.2)
 
