@@ -16,7 +16,7 @@ from typing import Any, Callable
 
 from ..model.params import ModeRange
 from ..model.tree import KINDS
-from ..physics.simulation import INTEGRATORS
+from ..physics.oscillator import INTEGRATORS
 from ..render.renderer import sun_angles, sun_direction
 from .winddir import wind_angle
 

@@ -13,14 +13,12 @@ from ..model.tree import KINDS, Tree
 from ..validate import finite_float, finite_vector3
 from .derived import Derived
 from .modal import ModalDraws, ModalParameters
+from .oscillator import INTEGRATORS
 from .rotation import qrot
 from .stages import Stages
 from .wind import DEFAULT_BOUNDS
 
-__all__ = ["Simulation", "INTEGRATORS", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
-
-#: Oscillator integrators (see :mod:`treeanim.physics.oscillator`).
-INTEGRATORS = ("exact", "euler")
+__all__ = ["Simulation", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
 
 #: Largest pull force accepted (N): far beyond any hand on a tree (the bending stays finite
 #: and keeps lengths far above it; the cap keeps absurd inputs out).
@@ -157,7 +155,7 @@ class Simulation(Derived, Stages):
             raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
         self._tree = tree
         self._seed = int(seed)
-        self._integrator = self._check_integrator(integrator)
+        self.integrator = integrator
         self._coupling = bool(coupling)
         self._load_path = bool(load_path)
         season = self._check_season(season)
@@ -179,7 +177,6 @@ class Simulation(Derived, Stages):
 
         self._pulls: dict[int, np.ndarray] = {}
         self._pos_buf = self._rot_buf = None
-        self._coef_cache: dict[float, tuple] = {}
         self._wind = None
         self.wind = wind
         self.reset()
@@ -188,7 +185,7 @@ class Simulation(Derived, Stages):
     @staticmethod
     def _check_integrator(name) -> str:
         if name not in INTEGRATORS:
-            raise ValueError(f"integrator must be one of {INTEGRATORS}, got {name!r}")
+            raise ValueError(f"integrator must be one of {tuple(INTEGRATORS)}, got {name!r}")
         return str(name)
 
     @staticmethod
@@ -236,7 +233,7 @@ class Simulation(Derived, Stages):
             raise ValueError(f"modes.zeta must be in [0, {MAX_ZETA:g}]: object {j} mode {'uvw'[c]} is {za[j, c]!r}")
         f3, z3 = fa.T.copy(), za.T.copy()
         self._mode_snap = (f, z, fa.copy(), za.copy(), f3, z3)
-        self._coef_cache.clear()
+        self._osc.clear()
         w = 2.0 * np.pi * f3
         self._w2, self._two_zeta_w = w * w, 2.0 * z3 * w  # ω² and 2ζω of every mode
         if self._load_path:
@@ -332,6 +329,7 @@ class Simulation(Derived, Stages):
     @integrator.setter
     def integrator(self, name: str) -> None:
         self._integrator = self._check_integrator(name)
+        self._osc = INTEGRATORS[self._integrator]()
 
     @property
     def coupling(self) -> bool:

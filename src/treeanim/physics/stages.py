@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from .bend_angle import saturating_twist
-from .oscillator import euler_step, exact_coefficients, exact_step
+from .oscillator import exact_coefficients, exact_response
 from .rotation import qrot
 
 #: Time constant (s) of the low-pass filter on base accelerations (base excitation). It keeps
@@ -46,15 +46,6 @@ class Stages:
             return None
         return lambda pts: np.nan_to_num(np.asarray(self._wind.sample(pts, t), float), posinf=0.0, neginf=0.0)
 
-    def _oscillator_coefficients(self, f3: np.ndarray, z3: np.ndarray, dt: float) -> tuple:
-        """The exact integrator's coefficients for ``dt`` (cached while the modes are unchanged)."""
-        coef = self._coef_cache.get(dt)
-        if coef is None:
-            if len(self._coef_cache) > 8:
-                self._coef_cache.clear()
-            coef = self._coef_cache[dt] = exact_coefficients(f3, z3, dt)
-        return coef
-
     def _step_paper(self, U, f3: np.ndarray, z3: np.ndarray, dt: float) -> None:
         """The paper's step (docs/design.md §6): linear loads on each object's own area, Eqs. 2–12."""
         M = self._M
@@ -81,10 +72,7 @@ class Stages:
         g[0] = L[2]  # g_u = L_w
         mul(self._lever, L[2], out=g[1])  # g_v = r·L_w
         g[2] = L[0]  # g_w = L_u
-        if self._integrator == "exact":
-            exact_step(self._p, self._pd, g, self._oscillator_coefficients(f3, z3, dt))
-        else:
-            euler_step(self._p, self._pd, g, f3, z3, dt)
+        self._osc.step(self._p, self._pd, g, f3, z3, dt)
         if self._pulls:  # held objects sit at the static deflection of their load (§8)
             held = np.fromiter(self._pulls, dtype=np.int64)
             self._p[:, held] = g[:, held]
@@ -242,21 +230,12 @@ class Stages:
         input g: L′ = p_free + c·g, L̇′ = pd_free + c_d·g. The ``held`` objects are critically
         damped (§8). Returns (p_free, pd_free, c, c_d), each (3, M)."""
 
-        def exact(coef, p, pd):  # y(dt) = A·y + B·ẏ, ẏ(dt) = C·y + D·ẏ with y = p − g
-            A, B, C, D = coef
-            return A * p + B * pd, C * p + D * pd, 1.0 - A, -C
-
         p, pd = self._p, self._pd
-        if self._integrator == "exact":
-            out = exact(self._oscillator_coefficients(f3, z3, dt), p, pd)
-        else:  # the free response, then the response to a unit input from rest
-            out = p.copy(), pd.copy(), np.zeros_like(p), np.zeros_like(pd)
-            euler_step(out[0], out[1], np.zeros_like(p), f3, z3, dt)
-            euler_step(out[2], out[3], np.ones_like(p), f3, z3, dt)
+        out = self._osc.response(p, pd, f3, z3, dt)
         if len(held):
             zc = np.maximum(z3[:, held], 1.0)
             zc[1] = z3[1, held]
-            for arr, val in zip(out, exact(exact_coefficients(f3[:, held], zc, dt), p[:, held], pd[:, held])):
+            for arr, val in zip(out, exact_response(exact_coefficients(f3[:, held], zc, dt), p[:, held], pd[:, held])):
                 arr[:, held] = val
         return out
 
