@@ -20,7 +20,7 @@ from ..errors import PresetError
 from .generate import BeamSpec, CrownSpec, GrassSpec, LaminaSpec, LeafSpec, LevelSpec, TreeSpec, generate
 from .look import Bark
 from .params import SCALAR_KEYS, SCALAR_MAX, ModeRange, PhysicsParams, SeasonModes
-from .tree import BRANCH_SIDES, Tree, curve_bands
+from .tree import BRANCH_SIDES, PLURAL, Tree, curve_bands
 
 #: Allowed ranges of numeric keys (inclusive); keys not listed must be finite and >= 0.
 BOUNDS: dict[str, tuple[float, float]] = {
@@ -125,11 +125,10 @@ def load_tree(path: str | Path) -> Tree:
         tree = generate(spec)
     except ValueError as e:  # the generator names the key it could not use
         raise PresetError(f"{path}: {e}") from None
-    plural = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
     for kind in np.unique(tree.kind):
         for season in ("summer", "winter"):
             if getattr(tree.physics, season).of(kind) is None:
-                raise PresetError(f"{path}: key 'physics.{season}.{kind}': missing; the tree has {plural[kind]}, "
+                raise PresetError(f"{path}: key 'physics.{season}.{kind}': missing; the tree has {PLURAL[kind]}, "
                                   "so it needs their f and zeta ranges")
     return tree
 
