@@ -7,7 +7,7 @@ import threading
 
 import numpy as np
 
-from ...validate import finite_float, finite_vector3
+from ...validate import finite_float, finite_vector3, float_within
 from .paper import _cached_grid, _sample_chunk, _Workspace, _wrap_shift
 from .physical import _canopy_mean, _sample_physical
 from .settings import (
@@ -28,7 +28,6 @@ from .settings import (
     MODELS,
     _bounds,
     _check_extent,
-    _in_range,
     _integer,
     _optional_length,
     wind_preset,
@@ -148,10 +147,10 @@ class WindField:
             beta_u = 1.67 if paper else 5.0 / 3.0
         if beta_vw is None:
             beta_vw = 1.33 if paper else 5.0 / 3.0
-        self._beta_u = _in_range("beta_u", beta_u, -MAX_BETA, MAX_BETA)
-        self._beta_vw = _in_range("beta_vw", beta_vw, -MAX_BETA, MAX_BETA)
+        self._beta_u = float_within("beta_u", beta_u, -MAX_BETA, MAX_BETA)
+        self._beta_vw = float_within("beta_vw", beta_vw, -MAX_BETA, MAX_BETA)
         self._seed = _integer("seed", seed, 0)
-        self._c1 = None if c1 is None else _in_range("c1", c1, 0.0, MAX_COEFF)
+        self._c1 = None if c1 is None else float_within("c1", c1, 0.0, MAX_COEFF)
         self._c2 = None if c2 is None else self._check_c2(c2)
         b = _bounds(DEFAULT_BOUNDS if bounds is None else bounds)
         _check_extent(b)
@@ -160,10 +159,10 @@ class WindField:
         self._bounds = b
         self._length_scale = _optional_length("length_scale", length_scale)
         self._canopy_height = _optional_length("canopy_height", canopy_height)
-        self._gust_strength = _in_range("gust_strength", gust_strength, 0.0, MAX_GUST_STRENGTH)
-        self._gust_rate = _in_range("gust_rate", gust_rate, 0.0, MAX_GUST_RATE, " per minute")
+        self._gust_strength = float_within("gust_strength", gust_strength, 0.0, MAX_GUST_STRENGTH)
+        self._gust_rate = float_within("gust_rate", gust_rate, 0.0, MAX_GUST_RATE, " per minute")
         self.direction = direction
-        self._speed = _in_range("speed", speed, 0.0, MAX_SPEED, " m/s")
+        self._speed = float_within("speed", speed, 0.0, MAX_SPEED, " m/s")
         self.turbulence = (1.5 if paper else 0.3) if turbulence is None else turbulence
         self.c3 = c3
         self.c4 = c4
@@ -258,7 +257,7 @@ class WindField:
 
     @speed.setter
     def speed(self, value) -> None:
-        x = _in_range("speed", value, 0.0, MAX_SPEED, " m/s")
+        x = float_within("speed", value, 0.0, MAX_SPEED, " m/s")
         self._rebase()
         self._speed = x
 
@@ -276,9 +275,9 @@ class WindField:
     @turbulence.setter
     def turbulence(self, value) -> None:
         if self._model == "paper":
-            self._turbulence = _in_range("turbulence", value, 1.0, 2.0)
+            self._turbulence = float_within("turbulence", value, 1.0, 2.0)
         else:
-            self._turbulence = _in_range("turbulence", value, 0.0, 1.0, " (intensity)")
+            self._turbulence = float_within("turbulence", value, 0.0, 1.0, " (intensity)")
 
     @property
     def length_scale(self) -> float:
@@ -316,7 +315,7 @@ class WindField:
 
     @gust_strength.setter
     def gust_strength(self, value) -> None:
-        self._gust_strength = _in_range("gust_strength", value, 0.0, MAX_GUST_STRENGTH)
+        self._gust_strength = float_within("gust_strength", value, 0.0, MAX_GUST_STRENGTH)
 
     @property
     def gust_rate(self) -> float:
@@ -325,7 +324,7 @@ class WindField:
 
     @gust_rate.setter
     def gust_rate(self, value) -> None:
-        x = _in_range("gust_rate", value, 0.0, MAX_GUST_RATE, " per minute")
+        x = float_within("gust_rate", value, 0.0, MAX_GUST_RATE, " per minute")
         self._rebase()
         self._gust_rate = x
 
@@ -336,7 +335,7 @@ class WindField:
 
     @c1.setter
     def c1(self, value) -> None:
-        c1 = None if value is None else _in_range("c1", value, 0.0, MAX_COEFF)
+        c1 = None if value is None else float_within("c1", value, 0.0, MAX_COEFF)
         if self._model == "paper":
             self._constants(self._bounds, c1, self._c2)
         self._c1 = c1
@@ -360,7 +359,7 @@ class WindField:
 
     @c3.setter
     def c3(self, value) -> None:
-        self._c3 = _in_range("c3", value, 0.0, MAX_COEFF)
+        self._c3 = float_within("c3", value, 0.0, MAX_COEFF)
 
     @property
     def c4(self) -> float:
@@ -369,7 +368,7 @@ class WindField:
 
     @c4.setter
     def c4(self, value) -> None:
-        self._c4 = _in_range("c4", value, 0.0, MAX_COEFF)
+        self._c4 = float_within("c4", value, 0.0, MAX_COEFF)
 
     @property
     def c5(self) -> float:
@@ -516,7 +515,7 @@ class WindField:
 
     @beta_u.setter
     def beta_u(self, value) -> None:
-        self._beta_u = _in_range("beta_u", value, -MAX_BETA, MAX_BETA)
+        self._beta_u = float_within("beta_u", value, -MAX_BETA, MAX_BETA)
         self._tables = None
 
     @property
@@ -526,7 +525,7 @@ class WindField:
 
     @beta_vw.setter
     def beta_vw(self, value) -> None:
-        self._beta_vw = _in_range("beta_vw", value, -MAX_BETA, MAX_BETA)
+        self._beta_vw = float_within("beta_vw", value, -MAX_BETA, MAX_BETA)
         self._tables = None
 
     @property

@@ -8,7 +8,8 @@ from functools import lru_cache
 import numpy as np
 import scipy.fft
 
-from .settings import _COORD_CLIP, _GRID_CLIP, MAX_BETA, MAX_GRID, _in_range, _integer
+from ...validate import float_within
+from .settings import _COORD_CLIP, _GRID_CLIP, MAX_BETA, MAX_GRID, _integer
 
 
 def fbm_noise(n: int, beta: float, seed=0) -> np.ndarray:
@@ -47,7 +48,7 @@ def fbm_noise(n: int, beta: float, seed=0) -> np.ndarray:
         or ``seed`` is not a seed.
     """
     n = _integer("n", n, 2, MAX_GRID)
-    beta = _in_range("beta", beta, -MAX_BETA, MAX_BETA)
+    beta = float_within("beta", beta, -MAX_BETA, MAX_BETA)
     try:
         rng = np.random.default_rng(seed)
     except (TypeError, ValueError) as exc:

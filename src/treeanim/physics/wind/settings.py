@@ -6,7 +6,7 @@ import operator
 
 import numpy as np
 
-from ...validate import finite_float
+from ...validate import float_within
 
 MODELS = ("physical", "paper")
 #: Default bounds ((x0, y0, z0), (x1, y1, z1)) in metres, until a Simulation fits the field.
@@ -85,14 +85,7 @@ def wind_preset(name: str) -> dict:
 def _optional_length(name: str, value) -> float | None:
     if value is None:
         return None
-    return _in_range(name, value, _MIN_LENGTH, _MAX_LENGTH, " m")
-
-
-def _in_range(name: str, value, lo: float, hi: float, what: str = "") -> float:
-    x = finite_float(name, value)
-    if not lo <= x <= hi:
-        raise ValueError(f"{name} must be in [{lo:g}, {hi:g}]{what}, got {value!r}")
-    return x
+    return float_within(name, value, _MIN_LENGTH, _MAX_LENGTH, " m")
 
 
 def _integer(name: str, value, lo: int, hi: int | None = None) -> int:
