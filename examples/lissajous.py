@@ -23,7 +23,8 @@ import numpy as np
 
 import treeanim as ta
 from treeanim.model.build import ObjectSpec, assemble
-from treeanim.physics.simulation import Simulation, trace_tips
+from treeanim.physics.simulation import Simulation
+from treeanim.physics.trace import trace_tips
 
 CASES = {
     "fig4a": dict(f_u=0.75, f_w=0.8, zeta_u=0.045, zeta_w=0.04),
