@@ -108,8 +108,15 @@ def _wind_speed(text: str) -> float:
 
 
 def add_season_option(p: argparse.ArgumentParser) -> None:
-    """--season, for every command that builds a tree."""
+    """--season, --leaves and --modes, for every command that builds a tree."""
+    from treeanim.model.qsm import SPECIES
+
     p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
+    p.add_argument("--leaves", choices=["none", *SPECIES], default=None,
+                   help="a TreeQSM model's leaves: none (default) or a species, along its twigs")
+    p.add_argument("--modes", choices=["paper", "physical"], default=None,
+                   help="modal f and zeta: paper (Eqs. 20-22; the presets' default) or physical (beam theory; "
+                   "TreeQSM models' default)")
 
 
 def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
@@ -195,7 +202,7 @@ def make_simulation(args):
     import treeanim as ta
     from treeanim.scripted import check_pulls
 
-    tree = load_any(args.preset)
+    tree = load_any(args.preset, args)
     try:
         check_pulls(args.pull, tree.n_objects)
         wind = None
@@ -417,7 +424,7 @@ def cmd_view(args) -> int:
     """Open the interactive viewer (the default command)."""
     from treeanim.app.main import ViewerUnavailable, view
 
-    tree = load_any(args.preset)
+    tree = load_any(args.preset, args)
     try:
         view(tree, season=args.season, wind_speed=args.wind, wind_preset=args.wind_preset, size=args.size,
              frames=args.frames,
@@ -427,18 +434,27 @@ def cmd_view(args) -> int:
     return 0
 
 
-def load_any(name_or_path: str):
-    """A preset by name, or a preset TOML file by path."""
+def load_any(name_or_path: str, args=None):
+    """A preset by name, a preset TOML file or a TreeQSM model (.txt, .csv, .mat) by path, with
+    ``args``' --leaves (QSM only) and --modes."""
     import treeanim as ta
+    from treeanim.model.qsm import QSM_SUFFIXES, load_qsm
 
-    if name_or_path.endswith(".toml"):
-        return ta.load_tree(name_or_path)
-    return ta.load_preset(name_or_path)
+    leaves, modes = getattr(args, "leaves", None), getattr(args, "modes", None)
+    if name_or_path.lower().endswith(QSM_SUFFIXES):
+        tree = load_qsm(name_or_path, leaves=leaves)
+    elif leaves is not None:
+        raise UsageError("--leaves is for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves")
+    else:
+        tree = ta.load_tree(name_or_path) if name_or_path.endswith(".toml") else ta.load_preset(name_or_path)
+    if modes is not None:
+        tree.modes = modes
+    return tree
 
 
 def cmd_info(args) -> int:
     """Print a preset's statistics beside the paper's Table 1 row."""
-    tree = load_any(args.preset)
+    tree = load_any(args.preset, args)
     stats = tree.stats(args.season)
     key = tree.name + ("@winter" if args.season >= 1.0 and tree.name == "large_cherry" else "")
     paper = {row[0]: row for row in TABLE1.get(key, [])}

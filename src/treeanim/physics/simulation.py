@@ -21,6 +21,7 @@ from .leaves import LeafTwist
 from .loadpath import LoadPath
 from .modal import ModalDraws, ModalParameters, derive_modes, mean_diameters
 from .oscillator import euler_step, exact_coefficients, exact_step
+from .physical import MODAL_MODELS, physical_modes
 from .rotation import Workspace, matrix_to_quat, qrot
 from .wind import DEFAULT_BOUNDS
 
@@ -62,7 +63,8 @@ def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
     if not isinstance(p, PhysicsParams):
         raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
     positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness",
-                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density", "reconfiguration_speed")
+                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density", "reconfiguration_speed",
+                "wood_youngs_modulus")
     for name in SCALAR_KEYS:
         x = finite_float(f"physics.{name}", getattr(p, name))
         if not (x > 0 if name in positive else x >= 0) or x > SCALAR_MAX[name]:
@@ -113,6 +115,12 @@ class Simulation:
         are as stiff as a tapered cantilever of the preset's Young's modulus, and pulls build
         up critically damped. False: the paper's model exactly (each object feels only the
         linear load on its own area), as the notes below describe.
+    modes : {'paper', 'physical'} or None
+        Where the modal f and ζ come from: 'paper' maps the preset's ranges (Eqs. 20–22);
+        'physical' gives every branch its first bending frequency as a tapered cantilever
+        carrying what grows on it, and damping from its wood and the drag of what it moves
+        (:mod:`~treeanim.physics.physical`; leaves and blades keep the paper's). None: the
+        tree's own ``modes`` ('paper' for the presets). Settable as ``modal``.
 
     Attributes
     ----------
@@ -173,7 +181,8 @@ class Simulation:
     """
 
     def __init__(self, tree: Tree, wind=None, season: float = 0.0, seed: int = 0,
-                 integrator: str = "exact", coupling: bool = True, load_path: bool = True):
+                 integrator: str = "exact", coupling: bool = True, load_path: bool = True,
+                 modes: str | None = None):
         if not isinstance(tree, Tree):
             raise ValueError(f"tree must be a treeanim Tree, got {type(tree).__name__}")
         if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
@@ -183,6 +192,7 @@ class Simulation:
         self._integrator = self._check_integrator(integrator)
         self._coupling = bool(coupling)
         self._load_path = bool(load_path)
+        self._modal = self._check_modal(tree.modes if modes is None else modes)
         season = self._check_season(season)
         kinds = [k for k in KINDS if np.any(tree.kind == k)]
         self._kinds = kinds
@@ -321,6 +331,9 @@ class Simulation:
     def _derive_modes(self) -> None:
         present = self._present if self._load_path else None  # Eq. 21 with the leaves still on
         m = derive_modes(self._tree, self._physics, self._season, self._draws, present)
+        if self._modal == "physical":
+            self._drag.derive(self._physics, self._present)
+            m = physical_modes(self._tree, self._physics, m, self._mass * self._present, self._drag.half_rho_cda)
         if hasattr(self, "_modes"):
             # Keep the user's references valid: overwrite in place when possible.
             cur = self._modes
@@ -341,6 +354,12 @@ class Simulation:
     def _check_integrator(name) -> str:
         if name not in INTEGRATORS:
             raise ValueError(f"integrator must be one of {INTEGRATORS}, got {name!r}")
+        return str(name)
+
+    @staticmethod
+    def _check_modal(name) -> str:
+        if name not in MODAL_MODELS:
+            raise ValueError(f"modes must be one of {MODAL_MODELS}, got {name!r}")
         return str(name)
 
     @staticmethod
@@ -475,6 +494,16 @@ class Simulation:
             self._physics = old
             self._derive_physics()
             raise
+
+    @property
+    def modal(self) -> str:
+        """Where the modes come from: 'paper' or 'physical' (settable; re-derives them)."""
+        return self._modal
+
+    @modal.setter
+    def modal(self, name: str) -> None:
+        self._modal = self._check_modal(name)
+        self._derive_modes()
 
     @property
     def integrator(self) -> str:
