@@ -279,11 +279,11 @@ def _check(table: np.ndarray, path, lines) -> tuple[np.ndarray, ...]:
     bad[:, 9] = False  # extension is not used
     if bad.any():
         k, c = np.argwhere(bad)[0]
-        raise _problem(path, k, f"{COLUMNS[c]} is {table[k, c]!r}; expected a finite number", lines)
+        raise _problem(path, k, f"{COLUMNS[c]} is {float(table[k, c])!r}; expected a finite number", lines)
     for c, what in ((0, "radius"), (1, "length")):
         k = np.flatnonzero(table[:, c] <= 0)
         if len(k):
-            raise _problem(path, k[0], f"{what} is {table[k[0], c]!r}; expected a positive number of metres", lines)
+            raise _problem(path, k[0], f"{what} is {float(table[k[0], c])!r}; expected a positive number of metres", lines)
     axis = table[:, 5:8]
     norm = np.linalg.norm(axis, axis=1)
     k = np.flatnonzero(norm < 1e-9)
@@ -312,7 +312,7 @@ def _check(table: np.ndarray, path, lines) -> tuple[np.ndarray, ...]:
     branch = table[:, 10]
     k = np.flatnonzero(branch != np.round(branch))
     if len(k):
-        raise _problem(path, k[0], f"branch {branch[k[0]]!r}; expected an integer", lines)
+        raise _problem(path, k[0], f"branch {float(branch[k[0]])!r}; expected an integer", lines)
     return table[:, 0], table[:, 1], table[:, 2:5], axis / norm[:, None], parent, branch.astype(np.int64)
 
 
