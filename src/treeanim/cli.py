@@ -112,8 +112,9 @@ def add_season_option(p: argparse.ArgumentParser) -> None:
     from treeanim.model.qsm import SPECIES
 
     p.add_argument("--season", type=_season, default=0.0, help="0 = summer … 1 = winter (default 0)")
-    p.add_argument("--leaves", choices=["none", *SPECIES], default=None,
-                   help="a TreeQSM model's leaves: none (default) or a species, along its twigs")
+    p.add_argument("--leaves", default=None, metavar="SPECIES[:PER_METRE]",
+                   help=f"a TreeQSM model's leaves along its twigs: none (default) or {', '.join(SPECIES)}, "
+                   "optionally with leaves per metre of twig (e.g. cherry:80)")
     p.add_argument("--modes", choices=["paper", "physical"], default=None,
                    help="modal f and zeta: paper (Eqs. 20-22; the presets' default) or physical (beam theory; "
                    "TreeQSM models' default)")
@@ -454,11 +455,15 @@ def load_any(name_or_path: str, args=None):
 
 def cmd_info(args) -> int:
     """Print a preset's statistics beside the paper's Table 1 row."""
+    import treeanim as ta
+    from treeanim.model.params import ModeRange
+
     tree = load_any(args.preset, args)
     stats = tree.stats(args.season)
     key = tree.name + ("@winter" if args.season >= 1.0 and tree.name == "large_cherry" else "")
     paper = {row[0]: row for row in TABLE1.get(key, [])}
     params = tree.physics
+    modal = ta.Simulation(tree, season=args.season).modes if tree.modes == "physical" else None
     print(f"{tree.name} (season {args.season:g}, seed {tree.seed}) — {tree.source}")
     print(f"{'object type':<12}{'objects':>16}{'nodes':>18}{'triangles':>22}   f range      ζ range")
     print(f"{'':<12}{'ours / paper':>16}{'ours / paper':>18}{'ours / paper':>22}")
@@ -469,6 +474,9 @@ def cmd_info(args) -> int:
         p = paper.get(kind)
         ref = (lambda i: f"{p[i]:,}") if p else (lambda i: "—")
         modes = params.modes(kind, args.season)
+        if modal is not None and kind == "branch":  # beam theory: the range it gives
+            f, z = modal.f[tree.kind == kind, 0], modal.zeta[tree.kind == kind, 0]
+            modes = ModeRange((f.min(), f.max()), (z.min(), z.max()))
         mr = f"{modes.f[0]:.2f}–{modes.f[1]:.2f}  {modes.zeta[0]:.2f}–{modes.zeta[1]:.2f}" if modes else ""
         print(
             f"{kind:<12}{n:>7,} / {ref(1):>6}{stats[kind + '_nodes']:>8,} / {ref(2):>7}"
@@ -477,6 +485,9 @@ def cmd_info(args) -> int:
     total_p = [f"{sum(r[i] for r in paper.values()):,}" if paper else "—" for i in (2, 3)]  # no paper row: —
     print(f"{'total':<12}{stats['objects']:>7,}{'':>9}{stats['nodes']:>8,} / {total_p[0]:>7}"
           f"{stats['triangles']:>11,} / {total_p[1]:>8}")
+    if modal is not None:
+        print(f"modes: physical (beam theory); the trunk sways at {modal.f[0, 0]:.3f} Hz, "
+              f"ζ {modal.zeta[0, 0]:.3f}")
     if key in TABLE1_FPS:
         print(f"paper's frame rate: {TABLE1_FPS[key]} FPS (2012, Core2 Duo 2.8 GHz, GeForce 9500 GT)")
     return 0

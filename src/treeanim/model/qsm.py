@@ -38,8 +38,8 @@ from .lamina import make_lamina
 from .params import WOOD_TYPES
 from .tree import Tree
 
-__all__ = ["SPECIES", "Species", "QSM_SUFFIXES", "read_table", "load_qsm", "build_tree", "synthetic_table",
-           "write_table"]
+__all__ = ["SPECIES", "Species", "QSM_SUFFIXES", "read_table", "load_qsm", "build_tree", "parse_leaves",
+           "synthetic_table", "write_table"]
 
 #: File suffixes read as TreeQSM models.
 QSM_SUFFIXES = (".txt", ".csv", ".mat")
@@ -354,7 +354,7 @@ def build_tree(table: np.ndarray, name: str = "qsm", source: str = "", leaves: s
     name, source : str
         The tree's name and the file it came from (for messages).
     leaves : str or None
-        None for a leafless tree, or a key of :data:`SPECIES`: leaves along the twigs.
+        None for a leafless tree, or a species (:func:`parse_leaves`): leaves along the twigs.
     seed : int
         Seed of the leaves' placement and of their fall order.
     lines : (N,) int, optional
@@ -381,7 +381,7 @@ def build_tree(table: np.ndarray, name: str = "qsm", source: str = "", leaves: s
     if table.shape[1] not in WIDTHS:
         raise QSMError(f"{path}: {table.shape[1]} columns; expected {_widths_text()}")
     radius, length, start, axis, parent, branch = _check(table, path, lines)
-    species = _species(leaves)
+    species = parse_leaves(leaves)
     preset = _preset_spec(species.preset if species else DEFAULT_PRESET)
 
     head, pos = _chains(parent, branch)
@@ -459,12 +459,36 @@ def _cyl_at(node: int, order: np.ndarray, first_node: np.ndarray, n_cyl: np.ndar
     return int(order[before + node - first_node[o] + 1])
 
 
-def _species(leaves: str | None) -> Species | None:
+#: Most leaves per metre of twig ``--leaves NAME:PER_METRE`` accepts.
+MAX_PER_METRE = 1000.0
+
+
+def parse_leaves(leaves: str | None) -> Species | None:
+    """The species of ``--leaves``: None or 'none' (leafless), ``NAME`` (a key of
+    :data:`SPECIES`) or ``NAME:PER_METRE`` (its leaves per metre of twig overridden).
+
+    Raises
+    ------
+    QSMError
+        An unknown species or a count that is not a number in (0, :data:`MAX_PER_METRE`].
+    """
     if leaves is None or leaves == "none":
         return None
-    if leaves not in SPECIES:
-        raise QSMError(f"--leaves {leaves!r}: unknown species; expected none or one of {', '.join(SPECIES)}")
-    return SPECIES[leaves]
+    name, _, count = str(leaves).partition(":")
+    if name not in SPECIES:
+        raise QSMError(f"--leaves {leaves!r}: unknown species; expected none or one of {', '.join(SPECIES)} "
+                       "(optionally NAME:LEAVES_PER_METRE)")
+    species = SPECIES[name]
+    if count:
+        try:
+            per_metre = float(count)
+        except ValueError:
+            per_metre = float("nan")
+        if not 0 < per_metre <= MAX_PER_METRE:
+            raise QSMError(f"--leaves {leaves!r}: expected leaves per metre of twig in (0, {MAX_PER_METRE:g}] "
+                           f"after the colon, got {count!r}")
+        species = dataclasses.replace(species, per_metre=per_metre)
+    return species
 
 
 def _preset_spec(name: str):
@@ -511,7 +535,7 @@ def load_qsm(path: str | Path, leaves: str | None = None, seed: int = 0) -> Tree
     path : str or Path
         ``.txt``, ``.csv`` (text) or ``.mat``.
     leaves : str or None
-        None (leafless) or a species of :data:`SPECIES`.
+        None (leafless) or a species (:func:`parse_leaves`).
     seed : int
         Seed of the leaves.
 
