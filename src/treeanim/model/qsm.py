@@ -437,7 +437,7 @@ def build_tree(table: np.ndarray, name: str = "qsm", source: str = "", leaves: s
     lamina, winter = None, 0
     if species is not None:
         rng = np.random.default_rng([int(seed), 0x716D73])  # "qms": the leaves' own stream
-        lf, slots = _leaf_rule(species, preset.leaves, specs)
+        specs, lf, slots = _leaf_rule(species, preset.leaves, specs)
         specs += place_leaves(lf, specs, slots, rng)
         la = preset.lamina
         lamina = make_lamina(la.shape, la.outline, la.samples, la.teeth, la.tooth_depth, la.curl)
@@ -505,26 +505,43 @@ def _scaled_ei_max(preset, d_max: float) -> float:
     return float(min(preset.physics.ei_max * (d_max / preset.levels[0].diameter) ** 4, 1e12))
 
 
-def _leaf_rule(species: Species, leaf: LeafSpec, branches: list[ObjectSpec]) -> tuple[LeafSpec, tuple]:
-    """The leaf-bearing nodes (segments at most ``twig_diameter`` thick, and free tips) and the
-    species' leaves with a count of ``per_metre`` × the twig length they serve."""
+#: Longest stretch of twig (m) between leaf-bearing nodes: leaf-bearing cylinders are cut into
+#: segments this long at most (straight, the same wood), so leaves spread along a twig instead
+#: of bunching at cylinder joints half a metre apart.
+LEAF_SPACING = 0.1
+
+
+def _leaf_rule(species: Species, leaf: LeafSpec, branches: list[ObjectSpec]) -> tuple[list, LeafSpec, tuple]:
+    """The branches with their leaf-bearing segments cut to :data:`LEAF_SPACING`, the leaf-bearing
+    nodes (ends of segments at most ``twig_diameter`` thick, and free tips) and the species'
+    leaves with a count of ``per_metre`` × the twig length they serve."""
     grown_on = {(s.parent, s.attach) for s in branches}
-    b, j, served, free = [], [], [], []
-    for i, s in enumerate(branches):
+    cut, node_map = [], []
+    for i, s in enumerate(branches):  # cut the leaf-bearing segments
         seg = np.linalg.norm(np.diff(s.points, axis=0), axis=1)
-        d_seg = 0.5 * (s.diameters[1:] + s.diameters[:-1])
-        nodes = np.arange(1, len(s.points))
-        tip_free = (i, len(seg)) not in grown_on
-        bear = d_seg <= species.twig_diameter
-        bear[-1] |= tip_free
-        b.append(np.full(int(bear.sum()), i))
-        j.append(nodes[bear])
-        served.append(seg[bear])
-        free.append((nodes[bear] == len(seg)) & tip_free)
-    slots = tuple(np.concatenate(a) for a in (b, j, served, free))
-    slots = (slots[0].astype(np.int64), slots[1].astype(np.int64), slots[2].astype(float), slots[3].astype(bool))
+        bear = 0.5 * (s.diameters[1:] + s.diameters[:-1]) <= species.twig_diameter
+        bear[-1] |= (i, len(seg)) not in grown_on
+        k = np.where(bear, np.maximum(1, np.ceil(seg / LEAF_SPACING - 1e-9)).astype(int), 1)
+        t = np.concatenate([np.arange(n) / n for n in k] + [[0.0]])
+        a = np.append(np.repeat(np.arange(len(seg)), k), len(seg) - 1)
+        t[-1] = 1.0
+        pts = s.points[a] + t[:, None] * (s.points[np.minimum(a + 1, len(seg))] - s.points[a])
+        dia = s.diameters[a] + t * (s.diameters[np.minimum(a + 1, len(seg))] - s.diameters[a])
+        node_map.append(np.concatenate([[0], np.cumsum(k)]))
+        cut.append((pts, dia, np.repeat(bear, k), np.repeat(np.arange(len(seg)) == len(seg) - 1, k)))
+    out, b, j, served, free = [], [], [], [], []
+    for i, (s, (pts, dia, bear, last)) in enumerate(zip(branches, cut)):
+        attach = int(node_map[s.parent][s.attach]) if s.parent >= 0 else s.attach
+        out.append(dataclasses.replace(s, points=pts, diameters=dia, attach=attach))
+        nodes = np.flatnonzero(bear) + 1
+        b.append(np.full(len(nodes), i))
+        j.append(nodes)
+        served.append(np.linalg.norm(pts[nodes] - pts[nodes - 1], axis=1))
+        free.append((nodes == len(pts) - 1) & ((i, len(s.points) - 1) not in grown_on))
+    slots = (np.concatenate(b).astype(np.int64), np.concatenate(j).astype(np.int64),
+             np.concatenate(served).astype(float), np.concatenate(free).astype(bool))
     count = int(round(species.per_metre * float(slots[2].sum()) / max(1.0 - leaf.tip_share, 1e-9)))
-    return dataclasses.replace(leaf, count=max(count, 1), levels=()), slots
+    return out, dataclasses.replace(leaf, count=max(count, 1), levels=()), slots
 
 
 def load_qsm(path: str | Path, leaves: str | None = None, seed: int = 0) -> Tree:

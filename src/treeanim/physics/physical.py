@@ -17,6 +17,12 @@ with y the mode shape over the branch's own elements and its children's bases. L
 mass (the frequency falls) and a large drag area for their mass (ζ rises). The simulation's
 own air damping, which grows with the wind (:mod:`.aero`), comes on top, as on real trees.
 
+Modes above :data:`QUASI_STATIC_F` are critically damped (ζ = 1): they keep their frequency,
+so their stiffness and lean are the beam's, but do not ring. A short stout twig rings at tens of
+hertz, invisible at any frame rate, and the load path couples objects once a step: stepped at
+60 Hz, lightly damped modes that fast feed energy into what they carry (the presets' stub twigs,
+5–150 Hz, made the cherries explode).
+
 Leaves and grass blades keep the paper's mapping: a petiole modelled as a cantilever would ring
 at tens of hertz, while a leaf's visible motion comes from its twig and its flutter.
 """
@@ -30,7 +36,7 @@ from ..model.params import PhysicsParams
 from ..model.tree import Tree
 from .modal import ModalParameters
 
-__all__ = ["MODAL_MODELS", "MIN_ELEMENTS", "U_REF", "branch_modes", "physical_modes", "subtree_sums"]
+__all__ = ["MODAL_MODELS", "MIN_ELEMENTS", "QUASI_STATIC_F", "U_REF", "branch_modes", "physical_modes", "subtree_sums"]
 
 #: The sources of modal parameters a Simulation accepts.
 MODAL_MODELS = ("paper", "physical")
@@ -39,6 +45,8 @@ MODAL_MODELS = ("paper", "physical")
 MIN_ELEMENTS = 32
 #: Air speed (m/s) about which drag is linearised into modal damping.
 U_REF = 1.0
+#: Frequency (Hz) above which a branch's mode is critically damped (see the module notes).
+QUASI_STATIC_F = 5.0
 #: Stodola iterations (from the static deflection under the beam's own weight).
 ITERATIONS = 6
 
@@ -267,12 +275,13 @@ def physical_modes(tree: Tree, params: PhysicsParams, paper: ModalParameters, ma
     Returns
     -------
     ModalParameters
-        New arrays: branches' three modes all at their beam frequency and damping.
+        New arrays: branches' three modes all at their beam frequency and damping (1 above
+        :data:`QUASI_STATIC_F`).
     """
     F, Z = paper.f.copy(), paper.zeta.copy()
     branches = np.flatnonzero(tree.kind == "branch")
     f, zeta_air = branch_modes(tree, params.wood_youngs_modulus, np.asarray(mass, float),
                                np.asarray(air, float), branches)
     F[branches] = f[:, None]
-    Z[branches] = (params.wood_damping + zeta_air)[:, None]
+    Z[branches] = np.where(f > QUASI_STATIC_F, 1.0, params.wood_damping + zeta_air)[:, None]
     return ModalParameters(F, Z)
