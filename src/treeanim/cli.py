@@ -439,15 +439,15 @@ def load_any(name_or_path: str, args=None):
     """A preset by name, a preset TOML file or a TreeQSM model (.txt, .csv, .mat) by path, with
     ``args``' --leaves (QSM only) and --modes."""
     import treeanim as ta
-    from treeanim.model.qsm import QSM_SUFFIXES, load_qsm
+    from treeanim.model.qsm import QSM_SUFFIXES, load_file
 
     leaves, modes = getattr(args, "leaves", None), getattr(args, "modes", None)
-    if name_or_path.lower().endswith(QSM_SUFFIXES):
-        tree = load_qsm(name_or_path, leaves=leaves)
+    if name_or_path.lower().endswith((*QSM_SUFFIXES, ".toml")):
+        tree = load_file(name_or_path, leaves=leaves)
     elif leaves is not None:
         raise UsageError("--leaves is for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves")
     else:
-        tree = ta.load_tree(name_or_path) if name_or_path.endswith(".toml") else ta.load_preset(name_or_path)
+        tree = ta.load_preset(name_or_path)
     if modes is not None:
         tree.modes = modes
     return tree

@@ -58,7 +58,7 @@ class Panel:
     Attributes
     ----------
     path : str
-        The preset file the Save and Load buttons use.
+        The file the Save and Open buttons use (Open also reads TreeQSM models).
     edit_season : {'summer', 'winter'}
         Which season's f and ζ ranges the range widgets edit.
     record_rects : bool
@@ -210,7 +210,8 @@ class Panel:
         return out
 
     def load(self, path: str | None = None) -> bool:
-        """Load a preset file (default :attr:`path`) and show its tree.
+        """Open a preset or TreeQSM model file (default :attr:`path`; .toml, .txt, .csv or .mat)
+        and show its tree (a model's counts in Statistics).
 
         Returns
         -------
@@ -219,12 +220,12 @@ class Panel:
             tree the simulation refuses (ValueError, e.g. no f/ζ range for a kind the tree
             has), is reported in the panel's status line; the current tree stays.
         """
-        import treeanim as ta
+        from ..model.qsm import load_file
 
         v = self.viewer
         target = path or self.path
         try:
-            v.load_tree(ta.load_tree(target))
+            v.load_tree(load_file(target))
         except (ValueError, OSError) as e:  # PresetError is a ValueError
             v.say(f"error: {' '.join(str(e).split())}")
             return False
@@ -421,7 +422,7 @@ class Panel:
                 self.save()
             self._rect("save")
             imgui.same_line()
-            if imgui.button("Load"):
+            if imgui.button("Open"):  # a preset .toml or a TreeQSM model (.txt, .csv, .mat)
                 self.load()
             self._rect("load")
             imgui.same_line()

@@ -38,7 +38,7 @@ from .lamina import make_lamina
 from .params import WOOD_TYPES
 from .tree import Tree
 
-__all__ = ["SPECIES", "Species", "QSM_SUFFIXES", "read_table", "load_qsm", "build_tree", "parse_leaves",
+__all__ = ["SPECIES", "Species", "QSM_SUFFIXES", "read_table", "load_qsm", "load_file", "build_tree", "parse_leaves",
            "synthetic_table", "write_table"]
 
 #: File suffixes read as TreeQSM models.
@@ -577,6 +577,24 @@ def load_qsm(path: str | Path, leaves: str | None = None, seed: int = 0) -> Tree
         raise
     except PresetError as e:  # pragma: no cover - a shipped preset that does not read
         raise QSMError(f"{path}: {e}") from None
+
+
+def load_file(path: str | Path, leaves: str | None = None) -> Tree:
+    """A tree from a file: a TreeQSM model by its suffix (:data:`QSM_SUFFIXES`), else a preset
+    TOML file (:func:`~treeanim.model.presets.load_tree`).
+
+    Raises
+    ------
+    PresetError
+        The file's one-line problem (a :class:`QSMError` for a model); ``leaves`` for a preset.
+    """
+    if str(path).lower().endswith(QSM_SUFFIXES):
+        return load_qsm(path, leaves=leaves)
+    if leaves not in (None, "none"):
+        raise PresetError(f"{path}: --leaves is for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves")
+    from .presets import load_tree
+
+    return load_tree(path)
 
 
 # ---------------------------------------------------------------------------- writing, synthetic trees
