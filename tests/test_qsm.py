@@ -328,3 +328,20 @@ def test_physical_parameters_are_checked():
     sim = ta.Simulation(tree, modes="physical")
     with pytest.raises(ValueError, match="wood_youngs_modulus must be > 0"):
         sim.physics = bad
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_a_mutated_table_builds_a_valid_tree_or_says_why_in_one_line(seed):
+    rng = np.random.default_rng(seed)
+    table = synthetic_table(limbs=4, twigs=2, seed=seed)
+    for _ in range(rng.integers(1, 4)):
+        r, c = rng.integers(len(table)), rng.integers(14)
+        table[r, c] = rng.choice([0.0, -1.0, np.nan, np.inf, 1e-12, 1e6, table[rng.integers(len(table)), c],
+                                  float(rng.integers(-2, len(table) + 3))])
+    try:
+        tree = build_tree(table, name="mutated", leaves=rng.choice([None, "cherry"]))
+    except QSMError as e:
+        assert "\n" not in str(e) and str(e).startswith("mutated:")
+    else:
+        tree.validate()
+        assert np.all(np.isfinite(tree.rest_positions)) and np.all(tree.node_diameter > 0)

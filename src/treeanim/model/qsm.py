@@ -117,18 +117,19 @@ def _read_text(path: Path) -> tuple[np.ndarray, np.ndarray]:
         text = _read_bytes(path).decode("utf-8-sig")
     except UnicodeDecodeError:
         raise QSMError(f"{path}: not a UTF-8 text file") from None
-    rows, numbers = [], []
+    rows, numbers, header = [], [], True
     for n, line in enumerate(text.splitlines(), 1):
         line = line.strip()
         if not line or line[0] in "#%":
             continue
         fields = _SPLIT.split(line.strip(" ,;"))
-        if not rows and not numbers and not _numeric(fields[0]):
-            numbers.append(-n)  # a header line: skipped
+        if header and not _numeric(fields[0]):  # the first line of words: a header, skipped
+            header = False
             continue
+        header = False
         rows.append(fields)
         numbers.append(n)
-    lines = np.array([n for n in numbers if n > 0], np.int64)
+    lines = np.array(numbers, np.int64)
     if not rows:
         raise QSMError(f"{path}: empty table: no cylinder rows")
     widths = np.array([len(r) for r in rows])
@@ -194,25 +195,23 @@ def _read_mat(path: Path) -> np.ndarray:
 def _from_struct(path: Path, cyl: dict) -> np.ndarray:
     need = {"radius": 1, "length": 1, "start": 3, "axis": 3, "parent": 1, "extension": 1, "branch": 1,
             "BranchOrder": 1, "PositionInBranch": 1}
-    cols = []
+    optional = ("extension", "BranchOrder", "PositionInBranch")  # not used to build the tree
     n = None
+    cols = {}
     for name, width in need.items():
         if name not in cyl:
-            if name in ("extension", "BranchOrder", "PositionInBranch"):  # not used to build the tree
-                cols.append(np.zeros((n or 0, 1)))
+            if name in optional:
                 continue
             raise QSMError(f"{path}: the cylinder struct has no field {name!r}; expected {', '.join(need)}")
         try:
             v = np.asarray(cyl[name], float).reshape(-1, width)
         except (TypeError, ValueError):
             raise QSMError(f"{path}: cylinder field {name!r} is not an array of {width} number(s) a row") from None
-        if n is None:
-            n = len(v)
-        elif len(v) != n:
+        n = len(v) if n is None else n
+        if len(v) != n:
             raise QSMError(f"{path}: cylinder field {name!r} has {len(v)} rows; 'radius' has {n}")
-        cols.append(v)
-    cols = [c if len(c) == n else np.zeros((n, 1)) for c in cols]
-    return np.hstack(cols + [np.zeros((n, 1))])  # + added
+        cols[name] = v
+    return np.hstack([cols.get(name, np.zeros((n, 1))) for name in need] + [np.zeros((n, 1))])  # + added
 
 
 def read_table(path: str | Path) -> np.ndarray:
