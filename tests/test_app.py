@@ -619,6 +619,9 @@ def test_the_panel_opens_a_treeqsm_model_and_shows_its_counts(viewer, tmp_path):
     assert v.stats()["branches"] == 228 and v.stats()["objects"] == 228
     v.show_panel = True
     assert v.frame(DT)
+    f = v.sim.modes.f[0, 0]
+    assert p.apply("physical_modes", False) and v.sim.modal == "paper" and v.sim.modes.f[0, 0] != f
+    assert p.apply("physical_modes", True) and v.sim.modes.f[0, 0] == pytest.approx(f)
     bad = tmp_path / "bad.csv"
     bad.write_text("0.1,1,0,0,0,0,0,1,2,0,1,0,1,0\n")  # its own parent
     assert not p.load(str(bad))

@@ -132,7 +132,7 @@ class Panel:
         (degrees about +y), ``wind_preset`` (calm, breeze, windy, gale, storm), ``turbulence``,
         ``gust_strength``, ``gust_rate``, ``length_scale``, ``beta_u``, ``beta_vw``, ``c3``, ``c4``, ``ei_max``,
         ``f:KIND`` and ``zeta:KIND`` ((min, max) of the edited season's table), ``time_scale``,
-        ``integrator``, ``coupling``, ``load_path``, ``paused``, ``show_trace``, ``show_frames``, ``show_wind``,
+        ``integrator``, ``coupling``, ``load_path``, ``physical_modes``, ``paused``, ``show_trace``, ``show_frames``, ``show_wind``,
         ``sun_azimuth`` and ``sun_elevation`` (degrees), ``shadows``, ``translucency``.
         """
         v = self.viewer
@@ -177,6 +177,8 @@ class Panel:
                 sim.coupling = bool(value)
             elif name == "load_path":
                 sim.load_path = bool(value)
+            elif name == "physical_modes":  # beam theory, or the preset's ranges (Eqs. 20–22)
+                sim.modal = v.tree.modes = "physical" if value else "paper"
             elif name in ("paused", "show_trace", "show_frames", "show_wind"):
                 setattr(v, name, bool(value))
             elif name in ("sun_azimuth", "sun_elevation"):
@@ -220,12 +222,14 @@ class Panel:
             tree the simulation refuses (ValueError, e.g. no f/ζ range for a kind the tree
             has), is reported in the panel's status line; the current tree stays.
         """
-        from ..model.qsm import load_file
+        import treeanim as ta
+
+        from ..model.qsm import QSM_SUFFIXES
 
         v = self.viewer
         target = path or self.path
         try:
-            v.load_tree(load_file(target))
+            v.load_tree(ta.load_qsm(target) if str(target).lower().endswith(QSM_SUFFIXES) else ta.load_tree(target))
         except (ValueError, OSError) as e:  # PresetError is a ValueError
             v.say(f"error: {' '.join(str(e).split())}")
             return False
@@ -357,6 +361,8 @@ class Panel:
             imgui.same_line()
             if imgui.radio_button("winter", self.edit_season == "winter"):
                 self.edit_season = "winter"
+            imgui.same_line()
+            self._check("physical", "physical_modes", sim.modal == "physical")  # branches: beam theory
             table = getattr(p, self.edit_season)
             for kind in self._kinds:
                 r = table.of(kind) or p.modes(kind, sim.season)
