@@ -345,3 +345,12 @@ def test_a_mutated_table_builds_a_valid_tree_or_says_why_in_one_line(seed):
     else:
         tree.validate()
         assert np.all(np.isfinite(tree.rest_positions)) and np.all(tree.node_diameter > 0)
+
+
+def test_saving_a_models_physics_as_a_preset_is_refused_clearly(tmp_path):
+    from treeanim.app.settings import save_preset
+
+    tree = load_qsm(ASSET)
+    with pytest.raises(ValueError, match="not a preset file; there is no preset shape"):
+        save_preset(tmp_path / "x.toml", tree, tree.physics)
+    assert not (tmp_path / "x.toml").exists()
