@@ -354,3 +354,15 @@ def test_saving_a_models_physics_as_a_preset_is_refused_clearly(tmp_path):
     with pytest.raises(ValueError, match="not a preset file; there is no preset shape"):
         save_preset(tmp_path / "x.toml", tree, tree.physics)
     assert not (tmp_path / "x.toml").exists()
+
+
+@pytest.mark.parametrize("where", ["next", "last"])
+def test_refuses_a_zero_length_segment(tmp_path, where):
+    t = small_table()
+    if where == "next":
+        t[1, 2:5] = t[0, 2:5]  # row 2 starts where row 1 starts
+        refuse(tmp_path, t, r"row 1 .*a zero-length segment")
+    else:
+        t[2, 1] = 1e-12  # the stem's last cylinder (too short for the text table's 6 decimals)
+        with pytest.raises(QSMError, match=r"^stem: row 3: a zero-length segment"):
+            build_tree(t, name="stem")

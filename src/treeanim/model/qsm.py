@@ -407,10 +407,11 @@ def build_tree(table: np.ndarray, name: str = "qsm", source: str = "", leaves: s
     within = np.ones(N - 1, bool)
     within[tip[:-1]] = False
     k = np.flatnonzero(within & (seg <= 1e-9))
-    if len(k):
-        cyl = _cyl_at(int(k[0]), order, first_node, n_cyl)
-        raise _problem(path, cyl, "starts where the cylinder before it in its branch starts (a zero-length "
-                                  "segment)", lines)
+    if len(k):  # node k to k + 1: the cylinder starting at k ends where it starts
+        o = int(np.searchsorted(first_node, k[0], side="right") - 1)
+        cyl = int(order[int(np.sum(n_cyl[:o])) + int(k[0] - first_node[o])])
+        raise _problem(path, cyl, "a zero-length segment: the next cylinder of its branch starts where it starts "
+                                  "(or it is shorter than a nanometre)", lines)
 
     # Parents: the node of the parent cylinder nearest the branch's start (its start or end).
     p_cyl = parent[heads]
@@ -435,7 +436,7 @@ def build_tree(table: np.ndarray, name: str = "qsm", source: str = "", leaves: s
              for a, c, lv, p, at in zip(first_node, count, level, par_obj, attach)]
     lamina, winter = None, 0
     if species is not None:
-        rng = np.random.default_rng([int(seed), 0x716D73])  # "qms": the leaves' own stream
+        rng = np.random.default_rng([int(seed), 0x71736D])  # "qsm": the leaves' own stream
         specs, lf, slots = _leaf_rule(species, preset.leaves, specs)
         specs += place_leaves(lf, specs, slots, rng)
         la = preset.lamina
@@ -449,13 +450,6 @@ def build_tree(table: np.ndarray, name: str = "qsm", source: str = "", leaves: s
                         modes="physical")
     except ValueError as e:  # pragma: no cover - the checks above leave nothing for validate to find
         raise QSMError(f"{path}: {e}") from None
-
-
-def _cyl_at(node: int, order: np.ndarray, first_node: np.ndarray, n_cyl: np.ndarray) -> int:
-    """The cylinder whose start node follows ``node`` (the second of a zero-length pair)."""
-    o = int(np.searchsorted(first_node, node, side="right") - 1)
-    before = int(np.sum(n_cyl[:o]))
-    return int(order[before + node - first_node[o] + 1])
 
 
 #: Most leaves per metre of twig ``--leaves NAME:PER_METRE`` accepts.
