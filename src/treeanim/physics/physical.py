@@ -3,8 +3,9 @@
 The paper maps d/h² onto a preset's frequency range (Eqs. 20–22, :mod:`.modal`). Here every
 branch is instead a tapered Euler–Bernoulli cantilever clamped at its base, of Young's modulus
 ``wood_youngs_modulus`` (EI = E π D⁴/64 along it), its own mass spread along it, and carrying
-what grows on it — each child's whole subtree (wood and the leaves present) as a rigid point
-mass at the node it sits on. Its first bending frequency comes from Stodola's iteration on
+what grows on it — each child's whole subtree (wood and the leaves present) as a rigid body at
+the node it sits on (its mass, and its first and second moments about that node, so a wide
+crown's rotary inertia counts). Its first bending frequency comes from Stodola's iteration on
 that beam: each segment is cut into elements (at least :data:`MIN_ELEMENTS` per object), the
 deflection under the inertial load of the last shape is integrated exactly for moments linear
 over an element of constant EI, and the Rayleigh quotient of successive shapes converges to
@@ -34,7 +35,7 @@ import numpy as np
 from ..model.geometry import segment_lengths
 from ..model.params import PhysicsParams
 from ..model.tree import Tree
-from .modal import ModalParameters
+from .modal import ModalParameters, subtree_sums
 
 __all__ = ["MODAL_MODELS", "MIN_ELEMENTS", "QUASI_STATIC_F", "U_REF", "branch_modes", "physical_modes", "subtree_sums"]
 
@@ -49,26 +50,6 @@ U_REF = 1.0
 QUASI_STATIC_F = 5.0
 #: Stodola iterations (from the static deflection under the beam's own weight).
 ITERATIONS = 6
-
-
-def subtree_sums(tree: Tree, values: np.ndarray) -> np.ndarray:
-    """Each object's value plus that of everything growing on it (all generations).
-
-    Parameters
-    ----------
-    tree : Tree
-    values : (M, ...) float
-
-    Returns
-    -------
-    numpy.ndarray, (M, ...) float
-    """
-    out = np.array(values, float)
-    for sl in reversed(tree.level_slices()):  # children come after parents, levels sorted
-        idx = np.arange(sl.start, sl.stop)
-        idx = idx[tree.parent[idx] >= 0]
-        np.add.at(out, tree.parent[idx], out[idx])
-    return out
 
 
 def _node_weights(tree: Tree, per_object: np.ndarray) -> np.ndarray:
