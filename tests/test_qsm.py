@@ -189,6 +189,12 @@ def test_the_command_line_reads_a_qsm_and_reports_a_bad_one_in_one_line(tmp_path
     assert err.count("\n") == 0 and "row 3" in err and "radius is -1.0" in err
     assert main(["info", "small_cherry", "--leaves", "cherry"]) == 2  # a preset has its own leaves
     assert "--leaves is for TreeQSM models" in capsys.readouterr().err
+    assert main(["info", str(ASSET), "--leaves", "cherry:many"]) == 2
+    assert "expected leaves per metre of twig in (0, 1000]" in capsys.readouterr().err
+    assert main(["info", "large_cherry", "--modes", "physical"]) == 0
+    assert "modes: physical (beam theory); the trunk sways at" in capsys.readouterr().out
+    assert main(["info", "large_cherry"]) == 0
+    assert "modes: physical" not in capsys.readouterr().out
 
 
 # ---------------------------------------------------------------------------- leaves
