@@ -674,6 +674,26 @@ def test_settings_round_trip_through_the_panel(viewer, tmp_path):
     assert v.messages[-1].startswith("error")
 
 
+def test_the_panel_opens_a_treeqsm_model_and_shows_its_counts(viewer, tmp_path):
+    from pathlib import Path
+
+    v, p = viewer, viewer.panel
+    qsm = Path(__file__).resolve().parents[1] / "assets" / "qsm" / "synthetic_broadleaf.txt"
+    assert p.load(str(qsm))
+    assert v.tree.name == "synthetic_broadleaf" and v.sim.modal == "physical"
+    assert v.stats()["branches"] == 228 and v.stats()["objects"] == 228
+    v.show_panel = True
+    assert v.frame(DT)
+    f = v.sim.modes.f[0, 0]
+    assert p.apply("physical_modes", False) and v.sim.modal == "paper" and v.sim.modes.f[0, 0] != f
+    assert p.apply("physical_modes", True) and v.sim.modes.f[0, 0] == pytest.approx(f)
+    bad = tmp_path / "bad.csv"
+    bad.write_text("0.1,1,0,0,0,0,0,1,2,0,1,0,1,0\n")  # its own parent
+    assert not p.load(str(bad))
+    assert v.messages[-1].startswith("error") and "row 1" in v.messages[-1]
+    assert v.tree.name == "synthetic_broadleaf"  # the current tree stays
+
+
 def test_preset_text_rewrites_unusual_layouts(tmp_path):
     tree = ta.load_preset("beam")
     physics = dataclasses.replace(tree.physics, ei_max=321.0)

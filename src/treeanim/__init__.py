@@ -22,6 +22,7 @@ _EXPORTS = {
     "list_presets": "model.presets",
     "load_preset": "model.presets",
     "load_tree": "model.presets",
+    "load_qsm": "model.qsm",
     "WindField": "physics.wind",
     "fbm_noise": "physics.wind",
     "Simulation": "physics.simulation",

@@ -24,7 +24,7 @@ def make_simulation(args):
     import treeanim as ta
     from treeanim.scripted import check_pulls
 
-    tree = load_any(args.preset)
+    tree = load_any(args.preset, args)
     try:
         check_pulls(args.pull, tree.n_objects)
         wind = None
@@ -210,7 +210,7 @@ def cmd_view(args) -> int:
     """Open the interactive viewer (the default command)."""
     from treeanim.app.main import ViewerUnavailable, view
 
-    tree = load_any(args.preset)
+    tree = load_any(args.preset, args)
     try:
         view(tree, season=args.season, wind_speed=args.wind, wind_preset=args.wind_preset, size=args.size,
              frames=args.frames,
@@ -220,24 +220,36 @@ def cmd_view(args) -> int:
     return 0
 
 
-def load_any(name_or_path: str):
-    """A preset by name, or a preset TOML file by path."""
+def load_any(name_or_path: str, args=None):
+    """A preset by name, a preset TOML file or a TreeQSM model (.txt, .csv, .mat) by path, with
+    ``args``' --leaves (QSM only) and --modes."""
     import treeanim as ta
+    from treeanim.model.qsm import QSM_SUFFIXES, load_file
 
-    if name_or_path.endswith(".toml"):
-        return ta.load_tree(name_or_path)
-    return ta.load_preset(name_or_path)
+    leaves, modes = getattr(args, "leaves", None), getattr(args, "modes", None)
+    if name_or_path.lower().endswith((*QSM_SUFFIXES, ".toml")):
+        tree = load_file(name_or_path, leaves=leaves)
+    elif leaves is not None:
+        raise UsageError("--leaves is for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves")
+    else:
+        tree = ta.load_preset(name_or_path)
+    if modes is not None:
+        tree.modes = modes
+    return tree
 
 
 def cmd_info(args) -> int:
     """Print a preset's statistics beside the paper's Table 1 row."""
+    import treeanim as ta
+    from treeanim.model.params import ModeRange
     from treeanim.model.tree import PLURAL
 
-    tree = load_any(args.preset)
+    tree = load_any(args.preset, args)
     stats = tree.stats(args.season)
     key = tree.name + ("@winter" if args.season >= 1.0 and tree.name == "large_cherry" else "")
     paper = {row[0]: row for row in TABLE1.get(key, [])}
     params = tree.physics
+    modal = ta.Simulation(tree, season=args.season).modes if tree.modes == "physical" else None
     print(f"{tree.name} (season {args.season:g}, seed {tree.seed}) — {tree.source}")
     print(f"{'object type':<12}{'objects':>16}{'nodes':>18}{'triangles':>22}   f range      ζ range")
     print(f"{'':<12}{'ours / paper':>16}{'ours / paper':>18}{'ours / paper':>22}")
@@ -248,6 +260,9 @@ def cmd_info(args) -> int:
         p = paper.get(kind)
         ref = (lambda i: f"{p[i]:,}") if p else (lambda i: "—")
         modes = params.modes(kind, args.season)
+        if modal is not None and kind == "branch":  # beam theory: the range it gives
+            f, z = modal.f[tree.kind == kind, 0], modal.zeta[tree.kind == kind, 0]
+            modes = ModeRange((f.min(), f.max()), (z.min(), z.max()))
         mr = f"{modes.f[0]:.2f}–{modes.f[1]:.2f}  {modes.zeta[0]:.2f}–{modes.zeta[1]:.2f}" if modes else ""
         print(
             f"{kind:<12}{n:>7,} / {ref(1):>6}{stats[kind + '_nodes']:>8,} / {ref(2):>7}"
@@ -256,6 +271,9 @@ def cmd_info(args) -> int:
     total_p = [f"{sum(r[i] for r in paper.values()):,}" if paper else "—" for i in (2, 3)]  # no paper row: —
     print(f"{'total':<12}{stats['objects']:>7,}{'':>9}{stats['nodes']:>8,} / {total_p[0]:>7}"
           f"{stats['triangles']:>11,} / {total_p[1]:>8}")
+    if modal is not None:
+        print(f"modes: physical (beam theory); the trunk sways at {modal.f[0, 0]:.3f} Hz, "
+              f"ζ {modal.zeta[0, 0]:.3f}")
     if key in TABLE1_FPS:
         print(f"paper's frame rate: {TABLE1_FPS[key]} FPS (2012, Core2 Duo 2.8 GHz, GeForce 9500 GT)")
     return 0

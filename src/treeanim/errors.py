@@ -8,7 +8,7 @@ what to install or use instead. This module imports nothing, so every layer may 
 
 from __future__ import annotations
 
-__all__ = ["InputError", "UsageError", "PresetError", "GLUnavailable", "ViewerUnavailable"]
+__all__ = ["InputError", "UsageError", "PresetError", "QSMError", "GLUnavailable", "ViewerUnavailable"]
 
 
 class InputError(ValueError):
@@ -23,6 +23,11 @@ class UsageError(InputError):
 class PresetError(InputError):
     """A preset file that cannot be used: the message names the file, the key and what was
     expected, on one line."""
+
+
+class QSMError(PresetError):
+    """A TreeQSM cylinder model that cannot be used: one line naming the file, the row (the
+    cylinder's number, 1-based as TreeQSM counts) and what was wrong."""
 
 
 class GLUnavailable(RuntimeError):

@@ -88,8 +88,16 @@ def wind_speed(text: str) -> float:
 
 
 def add_season_option(p: argparse.ArgumentParser) -> None:
-    """--season, for every command that builds a tree."""
+    """--season, --leaves and --modes, for every command that builds a tree."""
+    from treeanim.model.qsm import SPECIES
+
     p.add_argument("--season", type=number(float, 0, 1, lo_open=False), default=0.0, help="0 = summer … 1 = winter (default 0)")
+    p.add_argument("--leaves", default=None, metavar="SPECIES[:PER_METRE]",
+                   help=f"a TreeQSM model's leaves along its twigs: none (default) or {', '.join(SPECIES)}, "
+                   "optionally with leaves per metre of twig (e.g. cherry:80)")
+    p.add_argument("--modes", choices=["paper", "physical"], default=None,
+                   help="modal f and zeta: paper (Eqs. 20-22; the presets' default) or physical (beam theory; "
+                   "TreeQSM models' default)")
 
 
 def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:

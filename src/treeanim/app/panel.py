@@ -40,7 +40,7 @@ class Panel:
     Attributes
     ----------
     path : str
-        The preset file the Save and Load buttons use.
+        The file the Save and Open buttons use (Open also reads TreeQSM models).
     edit_season : {'summer', 'winter'}
         Which season's f and ζ ranges the range widgets edit.
     record_rects : bool
@@ -143,7 +143,8 @@ class Panel:
         return out
 
     def load(self, path: str | None = None) -> bool:
-        """Load a preset file (default :attr:`path`) and show its tree.
+        """Open a preset or TreeQSM model file (default :attr:`path`; .toml, .txt, .csv or .mat)
+        and show its tree (a model's counts in Statistics).
 
         Returns
         -------
@@ -154,10 +155,12 @@ class Panel:
         """
         import treeanim as ta
 
+        from ..model.qsm import QSM_SUFFIXES
+
         v = self.viewer
         target = path or self.path
         try:
-            v.load_tree(ta.load_tree(target))
+            v.load_tree(ta.load_qsm(target) if str(target).lower().endswith(QSM_SUFFIXES) else ta.load_tree(target))
         except (ValueError, OSError) as e:  # PresetError is a ValueError
             v.say(f"error: {' '.join(str(e).split())}")
             return False
@@ -308,6 +311,8 @@ class Panel:
             imgui.same_line()
             self.widget("load_path")
             imgui.same_line()
+            self.widget("physical_modes")
+            imgui.same_line()
             if imgui.button("Resume" if v.paused else "Pause"):
                 self.apply("paused", not v.paused)
             self._rect("pause")
@@ -341,7 +346,7 @@ class Panel:
                 self.save()
             self._rect("save")
             imgui.same_line()
-            if imgui.button("Load"):
+            if imgui.button("Open"):  # a preset .toml or a TreeQSM model (.txt, .csv, .mat)
                 self.load()
             self._rect("load")
             imgui.same_line()

@@ -64,6 +64,9 @@ def original_preset_text(tree: Tree) -> str:
     ValueError
         The tree has no readable source file (e.g. it was built in code).
     """
+    if tree.source and not tree.source.endswith(".toml"):
+        raise ValueError(f"tree {tree.name!r} was loaded from {tree.source}, not a preset file; there is no "
+                         "preset shape to save its physics with")
     if tree.source:
         try:
             return Path(tree.source).read_text(encoding="utf-8")

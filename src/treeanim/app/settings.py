@@ -98,6 +98,10 @@ def _flag(owner: Callable[[Any], Any], name: str, label: str) -> Setting:
                    kind="check")
 
 
+def _set_modal(v, physical) -> None:
+    v.sim.modal = v.tree.modes = "physical" if physical else "paper"
+
+
 def _load_preset(v, name) -> None:
     from ..model.presets import load_preset
 
@@ -171,6 +175,8 @@ SETTINGS: dict[str, Setting] = {
                           kind="choice", choices=tuple(INTEGRATORS)),
     "coupling": _flag(lambda v: v.sim, "coupling", "coupling"),
     "load_path": _flag(lambda v: v.sim, "load_path", "load path"),
+    # the branches' modes: beam theory, or the preset's ranges (Eqs. 20–22)
+    "physical_modes": Setting("physical", lambda v: v.sim.modal == "physical", _set_modal, kind="check"),
     "paused": _flag(lambda v: v, "paused", "paused"),
     # overlays
     "show_trace": _flag(lambda v: v, "show_trace", "pull trace"),

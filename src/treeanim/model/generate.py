@@ -309,7 +309,30 @@ def _leaves(spec: TreeSpec, branches: list[ObjectSpec], rng: np.random.Generator
     lf = spec.leaves
     if lf.count <= 0:
         return []
-    slot_b, slot_j, served, free = _leaf_slots(lf, branches)
+    return place_leaves(lf, branches, _leaf_slots(lf, branches), rng)
+
+
+def place_leaves(lf: LeafSpec, branches: list[ObjectSpec], slots: tuple[np.ndarray, ...],
+                 rng: np.random.Generator) -> list[ObjectSpec]:
+    """Leaves of ``lf`` (``lf.count`` of them) on the given branch nodes.
+
+    Parameters
+    ----------
+    lf : LeafSpec
+        Count, tufts, petiole and lamina sizes, angles.
+    branches : list of ObjectSpec
+        The tree's branches (leaves refer to them by index).
+    slots : tuple of arrays
+        ``(branch, node, length of the segment below, free tip?)`` per leaf-bearing node, ordered
+        by branch then node: leaves are spread over them in proportion to the length they serve.
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    list of ObjectSpec
+        One petiole object per leaf, one level below its branch.
+    """
+    slot_b, slot_j, served, free = slots
     # So many leaves per metre of twig, plus the tufts at the free tips.
     n_tuft = int(round(lf.tip_share * lf.count)) if free.any() else 0
     per_slot = _exact_split(lf.count - n_tuft, served, rng) + _exact_split(n_tuft, free.astype(float), rng)

@@ -90,6 +90,13 @@ class PhysicsParams:
     leaf_flutter : float
         Load path: the largest twist (rad) of a leaf's flutter about its petiole, reached by a
         lamina edge-on to a strong wind (:mod:`treeanim.physics.leaves`).
+    wood_youngs_modulus : float
+        ``modes="physical"`` only (:mod:`treeanim.physics.physical`): the effective Young's
+        modulus E (Pa) of the branches' wood in the beam-theory frequencies (see
+        :data:`WOOD_TYPES`).
+    wood_damping : float
+        ``modes="physical"`` only: the damping ratio of the wood and the stem's structure, to
+        which the drag of the crown adds.
 
     Notes
     -----
@@ -128,6 +135,8 @@ class PhysicsParams:
     reconfiguration: float = 0.7
     reconfiguration_speed: float = 4.0
     leaf_flutter: float = 0.35
+    wood_youngs_modulus: float = 6.0e9
+    wood_damping: float = 0.03
 
     def modes(self, kind: str, season: float) -> ModeRange | None:
         """f and ζ ranges for ``kind``, linearly interpolated at ``season`` in [0, 1]."""
@@ -151,6 +160,16 @@ SCALAR_MAX = {
     "wood_density": 1e4, "leaf_density": 1e4, "lamina_thickness": 0.05, "leaf_twist_c0": 100.0,
     "leaf_youngs_modulus": 1e12, "blade_youngs_modulus": 1e12, "air_density": 10.0, "drag_branch": 10.0,
     "drag_leaf": 10.0, "drag_blade": 10.0, "reconfiguration": 2.0, "reconfiguration_speed": 100.0,
-    "leaf_flutter": 1.5,
+    "leaf_flutter": 1.5, "wood_youngs_modulus": 1e12, "wood_damping": 10.0,
 }
 assert set(SCALAR_MAX) == set(SCALAR_KEYS)
+
+#: Wood per type, for ``modes="physical"``: green density (kg/m³), the effective Young's modulus
+#: of a standing tree (Pa) and the structure's damping ratio. Small clear green specimens give
+#: 9–11 GPa (Wood Handbook, FPL-GTR-190, Table 5-3a); a standing tree sways as if softer (its
+#: juvenile core, knots, the root plate's give): E ≈ 4 GPa fitted measured Douglas-fir sway
+#: best (docs/REALISM). Damping: de-branched stems 1–8 % (Moore & Maguire 2005).
+WOOD_TYPES = {
+    "hardwood": {"wood_density": 900.0, "wood_youngs_modulus": 6.0e9, "wood_damping": 0.03},
+    "softwood": {"wood_density": 800.0, "wood_youngs_modulus": 4.0e9, "wood_damping": 0.03},
+}

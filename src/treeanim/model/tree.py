@@ -110,6 +110,11 @@ class Tree:
         Seed the tree was generated with.
     source : str
         File the tree was loaded from.
+    bark : Bark
+        The bark's look.
+    modes : str
+        Where a :class:`~treeanim.physics.simulation.Simulation` takes the modal parameters
+        from unless told: ``'paper'`` (Eqs. 20–22) or ``'physical'`` (beam theory).
     """
 
     name: str
@@ -131,6 +136,7 @@ class Tree:
     seed: int = 0
     source: str = ""
     bark: Bark = field(default_factory=Bark)
+    modes: str = "paper"
 
     # ------------------------------------------------------------------ sizes
     @property

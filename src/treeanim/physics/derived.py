@@ -19,6 +19,7 @@ from .hierarchy import CompositionPlan
 from .leaves import LeafTwist
 from .loadpath import LoadPath
 from .modal import derive_modes, mean_diameters
+from .physical import physical_modes
 from .rotation import Workspace, matrix_to_quat
 
 #: E (Pa) that shapes a branch's stiffness along its length before :meth:`LoadPath.tune` sets
@@ -145,6 +146,9 @@ class Derived:
     def _derive_modes(self) -> None:
         present = self._present if self._load_path else None  # Eq. 21 with the leaves still on
         m = derive_modes(self._tree, self._physics, self._season, self._draws, present)
+        if self._modal == "physical":
+            self._drag.derive(self._physics, self._present)
+            m = physical_modes(self._tree, self._physics, m, self._mass * self._present, self._drag.half_rho_cda)
         if hasattr(self, "_modes"):
             # Keep the user's references valid: overwrite in place when possible.
             cur = self._modes

@@ -26,7 +26,7 @@ from ..model.params import PhysicsParams
 from ..model.tree import KINDS, Tree
 
 __all__ = ["ModalParameters", "ModalDraws", "object_lengths", "mean_diameters", "descendant_counts",
-           "derive_modes"]
+           "subtree_sums", "derive_modes"]
 
 
 @dataclass
@@ -107,6 +107,26 @@ def mean_diameters(tree: Tree) -> np.ndarray:
     return np.add.reduceat(tree.node_diameter, tree.object_start) / tree.object_count
 
 
+def subtree_sums(tree: Tree, values: np.ndarray) -> np.ndarray:
+    """Each object's value plus that of everything growing on it (all generations).
+
+    Parameters
+    ----------
+    tree : Tree
+    values : (M, ...) float
+
+    Returns
+    -------
+    numpy.ndarray, (M, ...) float
+    """
+    out = np.array(values, float)
+    for sl in reversed(tree.level_slices()):  # children come after parents, levels sorted
+        idx = np.arange(sl.start, sl.stop)
+        idx = idx[tree.parent[idx] >= 0]
+        np.add.at(out, tree.parent[idx], out[idx])
+    return out
+
+
 def descendant_counts(tree: Tree, present: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Descendant sub-branches and descendant leaves of every object (all generations).
 
@@ -121,22 +141,12 @@ def descendant_counts(tree: Tree, present: np.ndarray | None = None) -> tuple[np
     branches, leaves : (M,) int
         Number of objects of kind 'branch' (resp. 'leaf') below each object in the hierarchy.
     """
-    M = tree.n_objects
-    nb = np.zeros(M, np.int64)
-    nl = np.zeros(M, np.int64)
     is_b = (tree.kind == "branch").astype(np.int64)
     is_l = (tree.kind == "leaf").astype(np.int64)
     if present is not None:
         is_l *= np.asarray(present, bool)
-    # Children come after parents and levels are sorted: accumulate deepest level first.
-    for sl in reversed(tree.level_slices()):
-        idx = np.arange(sl.start, sl.stop)
-        idx = idx[tree.parent[idx] >= 0]
-        if len(idx) == 0:
-            continue
-        np.add.at(nb, tree.parent[idx], nb[idx] + is_b[idx])
-        np.add.at(nl, tree.parent[idx], nl[idx] + is_l[idx])
-    return nb, nl
+    sums = subtree_sums(tree, np.stack([is_b, is_l], axis=1)).astype(np.int64)
+    return sums[:, 0] - is_b, sums[:, 1] - is_l
 
 
 def _map_linear(x: np.ndarray, lo: float, hi: float, uniform: np.ndarray) -> np.ndarray:

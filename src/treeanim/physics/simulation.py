@@ -14,6 +14,7 @@ from ..validate import finite_float, finite_vector3
 from .derived import Derived
 from .modal import ModalDraws, ModalParameters
 from .oscillator import INTEGRATORS
+from .physical import MODAL_MODELS
 from .rotation import qrot
 from .stages import Stages
 from .wind import DEFAULT_BOUNDS
@@ -37,7 +38,8 @@ def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
     if not isinstance(p, PhysicsParams):
         raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
     positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness",
-                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density", "reconfiguration_speed")
+                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density", "reconfiguration_speed",
+                "wood_youngs_modulus")
     for name in SCALAR_KEYS:
         x = finite_float(f"physics.{name}", getattr(p, name))
         if not (x > 0 if name in positive else x >= 0) or x > SCALAR_MAX[name]:
@@ -88,6 +90,12 @@ class Simulation(Derived, Stages):
         are as stiff as a tapered cantilever of the preset's Young's modulus, and pulls build
         up critically damped. False: the paper's model exactly (each object feels only the
         linear load on its own area), as the notes below describe.
+    modes : {'paper', 'physical'} or None
+        Where the modal f and ζ come from: 'paper' maps the preset's ranges (Eqs. 20–22);
+        'physical' gives every branch its first bending frequency as a tapered cantilever
+        carrying what grows on it, and damping from its wood and the drag of what it moves
+        (:mod:`~treeanim.physics.physical`; leaves and blades keep the paper's). None: the
+        tree's own ``modes`` ('paper' for the presets). Settable as ``modal``.
 
     Attributes
     ----------
@@ -148,7 +156,8 @@ class Simulation(Derived, Stages):
     """
 
     def __init__(self, tree: Tree, wind=None, season: float = 0.0, seed: int = 0,
-                 integrator: str = "exact", coupling: bool = True, load_path: bool = True):
+                 integrator: str = "exact", coupling: bool = True, load_path: bool = True,
+                 modes: str | None = None):
         if not isinstance(tree, Tree):
             raise ValueError(f"tree must be a treeanim Tree, got {type(tree).__name__}")
         if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
@@ -158,6 +167,7 @@ class Simulation(Derived, Stages):
         self.integrator = integrator
         self._coupling = bool(coupling)
         self._load_path = bool(load_path)
+        self._modal = self._check_modal(tree.modes if modes is None else modes)
         season = self._check_season(season)
         kinds = [k for k in KINDS if np.any(tree.kind == k)]
         self._kinds = kinds
@@ -186,6 +196,12 @@ class Simulation(Derived, Stages):
     def _check_integrator(name) -> str:
         if name not in INTEGRATORS:
             raise ValueError(f"integrator must be one of {tuple(INTEGRATORS)}, got {name!r}")
+        return str(name)
+
+    @staticmethod
+    def _check_modal(name) -> str:
+        if name not in MODAL_MODELS:
+            raise ValueError(f"modes must be one of {MODAL_MODELS}, got {name!r}")
         return str(name)
 
     @staticmethod
@@ -320,6 +336,16 @@ class Simulation(Derived, Stages):
             self._physics = old
             self._derive_physics()
             raise
+
+    @property
+    def modal(self) -> str:
+        """Where the modes come from: 'paper' or 'physical' (settable; re-derives them)."""
+        return self._modal
+
+    @modal.setter
+    def modal(self, name: str) -> None:
+        self._modal = self._check_modal(name)
+        self._derive_modes()
 
     @property
     def integrator(self) -> str:
