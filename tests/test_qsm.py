@@ -1,4 +1,4 @@
-"""TreeQSM import (model/qsm.py) and physical modal parameters (physics/physical.py)."""
+"""TreeQSM import (model/qsm/) and physical modal parameters (physics/physical.py)."""
 
 from __future__ import annotations
 
