@@ -26,12 +26,18 @@ from .settings import (
     MAX_SPEED,
     MIN_AUTO_LENGTH,
     MODELS,
+    Setting,
     _bounds,
     _check_extent,
     _integer,
     _optional_length,
     wind_preset,
 )
+
+
+def _within(lo: float, hi: float, unit: str = ""):
+    """A :class:`Setting` check: a finite number in [lo, hi]."""
+    return lambda name, value: float_within(name, value, lo, hi, unit)
 
 
 class WindField:
@@ -115,6 +121,25 @@ class WindField:
     1.5
     """
 
+    # Checked settings (the others are properties below).
+    speed = Setting("Mean wind speed at the canopy top (paper: the tree top), m/s, in [0, 1000].",
+                    _within(0.0, MAX_SPEED, " m/s"), rebase=True)
+    gust_strength = Setting("Mean peak gust above the mean speed, as a fraction of it, in [0, 2] (physical).",
+                            _within(0.0, MAX_GUST_STRENGTH))
+    gust_rate = Setting("Gusts per minute passing a point, in [0, 30] (physical).",
+                        _within(0.0, MAX_GUST_RATE, " per minute"), rebase=True)
+    c3 = Setting("Vertical turbulence scale of Eq. 17.", _within(0.0, MAX_COEFF))
+    c4 = Setting("Lateral turbulence scale of Eq. 17.", _within(0.0, MAX_COEFF))
+    c5 = Setting("Downwind speed of the frozen turbulence, grid cells per second.", finite_float)
+    c6 = Setting("Lateral drift of the frozen turbulence, grid cells per second.", finite_float)
+    grid = Setting("Grid edge N (rebuilds the grids when changed).", lambda n, v: _integer(n, v, 4, MAX_GRID),
+                   regrid=True)
+    beta_u = Setting("Spectral exponent of the along-wind noise (rebuilds the grids when changed).",
+                     _within(-MAX_BETA, MAX_BETA), regrid=True)
+    beta_vw = Setting("Spectral exponent of the vertical and lateral noise (rebuilds the grids).",
+                      _within(-MAX_BETA, MAX_BETA), regrid=True)
+    seed = Setting("Noise seed (rebuilds the grids when changed).", lambda n, v: _integer(n, v, 0), regrid=True)
+
     def __init__(
         self,
         direction=(1, 0, 0),
@@ -142,14 +167,14 @@ class WindField:
             raise ValueError(f"model must be one of {', '.join(map(repr, MODELS))}, got {model!r}")
         self._model = model
         paper = model == "paper"
-        self._grid = _integer("grid", grid, 4, MAX_GRID)
+        self.grid = grid
         if beta_u is None:
             beta_u = 1.67 if paper else 5.0 / 3.0
         if beta_vw is None:
             beta_vw = 1.33 if paper else 5.0 / 3.0
-        self._beta_u = float_within("beta_u", beta_u, -MAX_BETA, MAX_BETA)
-        self._beta_vw = float_within("beta_vw", beta_vw, -MAX_BETA, MAX_BETA)
-        self._seed = _integer("seed", seed, 0)
+        self.beta_u = beta_u
+        self.beta_vw = beta_vw
+        self.seed = seed
         self._c1 = None if c1 is None else float_within("c1", c1, 0.0, MAX_COEFF)
         self._c2 = None if c2 is None else self._check_c2(c2)
         b = _bounds(DEFAULT_BOUNDS if bounds is None else bounds)
@@ -159,10 +184,10 @@ class WindField:
         self._bounds = b
         self._length_scale = _optional_length("length_scale", length_scale)
         self._canopy_height = _optional_length("canopy_height", canopy_height)
-        self._gust_strength = float_within("gust_strength", gust_strength, 0.0, MAX_GUST_STRENGTH)
-        self._gust_rate = float_within("gust_rate", gust_rate, 0.0, MAX_GUST_RATE, " per minute")
+        self.gust_strength = gust_strength
+        self.gust_rate = gust_rate
         self.direction = direction
-        self._speed = float_within("speed", speed, 0.0, MAX_SPEED, " m/s")
+        self.speed = speed
         self.turbulence = (1.5 if paper else 0.3) if turbulence is None else turbulence
         self.c3 = c3
         self.c4 = c4
@@ -251,17 +276,6 @@ class WindField:
         return self._frame.copy()
 
     @property
-    def speed(self) -> float:
-        """Mean wind speed at the canopy top (paper: the tree top), m/s, in [0, 1000]."""
-        return self._speed
-
-    @speed.setter
-    def speed(self, value) -> None:
-        x = float_within("speed", value, 0.0, MAX_SPEED, " m/s")
-        self._rebase()
-        self._speed = x
-
-    @property
     def calm(self) -> bool:
         """True when the speed is 0 or the direction is a zero vector."""
         return self._speed == 0.0 or not self._frame.any()
@@ -309,26 +323,6 @@ class WindField:
         self._canopy_height = x
 
     @property
-    def gust_strength(self) -> float:
-        """Mean peak gust above the mean speed, as a fraction of it, in [0, 2] (physical)."""
-        return self._gust_strength
-
-    @gust_strength.setter
-    def gust_strength(self, value) -> None:
-        self._gust_strength = float_within("gust_strength", value, 0.0, MAX_GUST_STRENGTH)
-
-    @property
-    def gust_rate(self) -> float:
-        """Gusts per minute passing a point, in [0, 30] (physical)."""
-        return self._gust_rate
-
-    @gust_rate.setter
-    def gust_rate(self, value) -> None:
-        x = float_within("gust_rate", value, 0.0, MAX_GUST_RATE, " per minute")
-        self._rebase()
-        self._gust_rate = x
-
-    @property
     def c1(self) -> float:
         """Effective c1 of Eq. 16 (set None for 1 / ln(c2·H))."""
         return self._profile_constants()[0]
@@ -351,42 +345,6 @@ class WindField:
         if self._model == "paper":
             self._constants(self._bounds, self._c1, c2)
         self._c2 = c2
-
-    @property
-    def c3(self) -> float:
-        """Vertical turbulence scale of Eq. 17."""
-        return self._c3
-
-    @c3.setter
-    def c3(self, value) -> None:
-        self._c3 = float_within("c3", value, 0.0, MAX_COEFF)
-
-    @property
-    def c4(self) -> float:
-        """Lateral turbulence scale of Eq. 17."""
-        return self._c4
-
-    @c4.setter
-    def c4(self, value) -> None:
-        self._c4 = float_within("c4", value, 0.0, MAX_COEFF)
-
-    @property
-    def c5(self) -> float:
-        """Downwind speed of the frozen turbulence, grid cells per second."""
-        return self._c5
-
-    @c5.setter
-    def c5(self, value) -> None:
-        self._c5 = finite_float("c5", value)
-
-    @property
-    def c6(self) -> float:
-        """Lateral drift of the frozen turbulence, grid cells per second."""
-        return self._c6
-
-    @c6.setter
-    def c6(self, value) -> None:
-        self._c6 = finite_float("c6", value)
 
     # -- bounds and the mean profile ---------------------------------------------------------
 
@@ -497,46 +455,6 @@ class WindField:
         return c1 * (np.log(np.maximum(h, math.exp(log_h0))) - log_h0)
 
     # -- the grids -----------------------------------------------------------------------------
-
-    @property
-    def grid(self) -> int:
-        """Grid edge N (rebuilds the grids when changed)."""
-        return self._grid
-
-    @grid.setter
-    def grid(self, value) -> None:
-        self._grid = _integer("grid", value, 4, MAX_GRID)
-        self._tables = None
-
-    @property
-    def beta_u(self) -> float:
-        """Spectral exponent of the along-wind noise (rebuilds the grids when changed)."""
-        return self._beta_u
-
-    @beta_u.setter
-    def beta_u(self, value) -> None:
-        self._beta_u = float_within("beta_u", value, -MAX_BETA, MAX_BETA)
-        self._tables = None
-
-    @property
-    def beta_vw(self) -> float:
-        """Spectral exponent of the vertical and lateral noise (rebuilds the grids)."""
-        return self._beta_vw
-
-    @beta_vw.setter
-    def beta_vw(self, value) -> None:
-        self._beta_vw = float_within("beta_vw", value, -MAX_BETA, MAX_BETA)
-        self._tables = None
-
-    @property
-    def seed(self) -> int:
-        """Noise seed (rebuilds the grids when changed)."""
-        return self._seed
-
-    @seed.setter
-    def seed(self, value) -> None:
-        self._seed = _integer("seed", value, 0)
-        self._tables = None
 
     @property
     def grids(self) -> np.ndarray:
