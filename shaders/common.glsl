@@ -14,6 +14,14 @@ uniform sampler2DShadow u_shadow_map;  // depth seen from the sun (render/shadow
 uniform mat4 u_light_view_proj;        // world -> the shadow map's clip space
 uniform int u_shadow_on;               // 0: everything in sunlight
 uniform float u_shadow_texel;          // one shadow-map texel, metres
+uniform mat4 u_inv_view_proj;          // clip -> world (sky and ground)
+uniform vec2 u_viewport;               // pixels
+
+// The view ray through this pixel's centre (unit, world; fragment shaders).
+vec3 pixel_ray() {
+    vec4 far = u_inv_view_proj * vec4(gl_FragCoord.xy / u_viewport * 2.0 - 1.0, 1.0, 1.0);
+    return normalize(far.xyz / far.w - u_camera_pos);
+}
 
 vec3 srgb_to_linear(vec3 c) { return pow(c, vec3(2.2)); }
 

@@ -1,4 +1,5 @@
 #version 330 core
+// One part of the tree (PART: see tree.vert).
 
 #include "common.glsl"
 #include "constants.glsl"
@@ -46,22 +47,22 @@ float tent_integral(float x) {
 }
 
 void main() {
-    if (v_half >= 0.0 && v_material == BARK && !gl_FrontFacing) discard;  // a thin twig, flat: its far half
+    if (PART == PART_BARK && v_half >= 0.0 && !gl_FrontFacing) discard;  // a thin twig, flat: its far half
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;                 // double-sided: laminas, blades
     vec3 V = normalize(u_camera_pos - v_world);
     float ndl = dot(n, u_sun_dir);
-    bool foliage = v_material != BARK;
+    bool foliage = PART != PART_BARK;
     vec3 albedo = v_albedo;
-    if (v_material == BARK) {
+    if (PART == PART_BARK) {
         albedo *= bark(v_uv);
-    } else if (v_material == LAMINA) {
+    } else if (PART == PART_LEAVES && v_material == LAMINA) {
         // Lamina: a lighter midrib and faint side veins; darker towards the base.
         float ax = abs(v_uv.x);
         float rib = (1.0 - smoothstep(0.008, 0.022, ax)) * step(0.02, v_uv.y) * (1.0 - smoothstep(0.85, 1.0, v_uv.y));
         float side = 1.0 - smoothstep(0.0, 0.07, abs(fract((v_uv.y - 0.9 * ax) * 7.0) - 0.5) - 0.43);
         albedo *= (0.88 + 0.16 * v_uv.y) * (1.0 + 0.45 * rib + 0.12 * side * (1.0 - rib));
-    } else if (v_material == BLADE) {
+    } else if (PART == PART_BLADES) {
         albedo *= 0.85 + 0.3 * (1.0 - abs(v_uv.x));
     }
     float sun = sun_visibility(v_world, n);
@@ -78,6 +79,6 @@ void main() {
     c = mix(c, vec3(1.0, 0.45, 0.05) * 1.5, 0.55 * v_highlight);
     // A thin twig or blade: its true width filtered by a tent one pixel either side (pixels
     // a column apart then sum to its width, wherever it falls between them).
-    float cover = v_half < 0.0 ? 1.0 : tent_integral(v_edge + v_half) - tent_integral(v_edge - v_half);
+    float cover = PART == PART_LEAVES || v_half < 0.0 ? 1.0 : tent_integral(v_edge + v_half) - tent_integral(v_edge - v_half);
     f_color = vec4(to_display(apply_haze(c, v_world)).rgb, cover);
 }

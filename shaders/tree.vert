@@ -1,5 +1,7 @@
 #version 330 core
-// Skinned tree: branch tubes, petioles, laminas and grass blades in one draw.
+// Skinned tree: one part of the mesh (PART, defined by the renderer: PART_LEAVES, petioles and
+// laminas; PART_BARK, branch tubes; PART_BLADES, grass blades). Each part has its own program
+// with only its own code: a software rasteriser runs both sides of every branch.
 
 #include "skin.glsl"
 
@@ -17,8 +19,6 @@ uniform vec3 u_bark_color;     // sRGB
 uniform float u_pixels_per_metre;  // at one metre from the eye: a length's size on screen
 uniform float u_thin_pixels;       // twigs and blades with a half width below this (px) get soft edges
 uniform vec3 u_camera_pos;
-
-const float THIN_DEPTH = 0.999999;  // where thin twigs are drawn in the depth range (NDC z)
 
 out vec3 v_world;
 out vec3 v_normal;
@@ -72,7 +72,7 @@ void main() {
     v_normal = R * in_normal;
     v_edge = 0.0;
     v_half = -1.0;
-    if (v_material == BARK || v_material == BLADE) {
+    if (PART != PART_LEAVES) {
         // Thinner than a few pixels, a twig or a blade would fall between pixel centres and
         // break into dots that crawl as it sways. It is drawn flat, facing the eye, a pixel
         // wider each side, and tree.frag gives each pixel the share of it the true width
@@ -85,8 +85,8 @@ void main() {
             vec3 axis = node_position(in_ids.x + 1) - node_position(in_ids.x);   // the segment's
             vec3 side = cross(axis, u_camera_pos - centre);
             float k = dot(across, side) / max(metres * length(side), 1e-30);  // -1 .. 1 across the axis
-            float half_px = v_material == BARK ? px : abs(k) * px;            // a blade: as seen
-            float edge = v_material == BARK ? k * (px + 1.0) : sign(k) * (half_px + 1.0);
+            float half_px = PART == PART_BARK ? px : abs(k) * px;            // a blade: as seen
+            float edge = PART == PART_BARK ? k * (px + 1.0) : sign(k) * (half_px + 1.0);
             if (px > 0.0 && length(side) > 0.0) {
                 v_world = centre + normalize(side) * (edge * metres / px);
                 v_edge = edge;
@@ -95,23 +95,22 @@ void main() {
         }
     }
     gl_Position = u_view_proj * vec4(v_world, 1.0);
-    if (v_half >= 0.0 && v_material == BARK) {
+    if (PART == PART_BARK && v_half >= 0.0) {
         // A faint twig writes depth like any surface, so a leaf drawn after it, behind it,
         // would be kept out and the sky show through the twig (streaks across a crown in a
         // gale). Drawn at the back of the depth range instead, it loses to every solid
         // surface, whatever the order: over sky, ground and its own wood it shows, blended;
         // among leaves it fades into them.
-        gl_Position.z = THIN_DEPTH * gl_Position.w;
+        gl_Position.z = DEPTH_THIN * gl_Position.w;
     }
 
     float jitter = in_extra.y;
     float key = in_extra.w;
-    if (v_material == BARK) {
+    if (PART == PART_BARK) {
         v_albedo = lin(u_bark_color) * (0.92 + 0.16 * jitter);
-    } else if (v_material == PETIOLE) {
-        v_albedo = mix(leaf_color(jitter, key), lin(C_PETIOLE), 0.4);
-    } else if (v_material == LAMINA) {
+    } else if (PART == PART_LEAVES) {
         v_albedo = leaf_color(jitter, key);
+        if (v_material == PETIOLE) v_albedo = mix(v_albedo, lin(C_PETIOLE), 0.4);
     } else {
         vec3 base = lin(C_BLADE_BASE);
         vec3 tip = mix(lin(C_BLADE_TIP), lin(C_BLADE_TIP_DRY), jitter);

@@ -371,10 +371,10 @@ def test_renderer_frees_what_it_made_when_construction_fails(tree, monkeypatch, 
         monkeypatch.setattr(ctx, name, recording(getattr(ctx, name)))
     load_program = renderer_module.load_program
 
-    def failing_load(c, vertex, *rest):
+    def failing_load(c, vertex, *rest, **kw):
         if fail_at == "line program" and vertex == "line.vert":
             raise RuntimeError("shader program line.vert + line.frag failed to build: (test)")
-        return load_program(c, vertex, *rest)
+        return load_program(c, vertex, *rest, **kw)
 
     def failing_ground(self):
         raise MemoryError("(test)")
