@@ -5,6 +5,7 @@
 // over the shadow's footprint only) also the tree's shadow from the sun's shadow map.
 
 #include "common.glsl"
+#include "pixel.glsl"
 
 uniform vec3 u_ground_centre;   // the trunk's foot
 uniform float u_earth_radius;   // bare earth around the trunk (0: none)

@@ -2,6 +2,7 @@
 // Sky gradient with the sun's disc and glow; below the horizon (where no ground is drawn) haze.
 
 #include "common.glsl"
+#include "pixel.glsl"
 
 uniform int u_show_sky;         // 0: flat horizon colour
 out vec4 f_color;

@@ -4,6 +4,7 @@
 // with only its own code: a software rasteriser runs both sides of every branch.
 
 #include "skin.glsl"
+#include "tree_light.glsl"
 
 in ivec4 in_ids;     // node, prev, object, material
 in vec3 in_offset;   // rest offset from the node
@@ -18,7 +19,6 @@ uniform float u_season;        // 0 summer .. 1 winter
 uniform vec3 u_bark_color;     // sRGB
 uniform float u_pixels_per_metre;  // at one metre from the eye: a length's size on screen
 uniform float u_thin_pixels;       // twigs and blades with a half width below this (px) get soft edges
-uniform vec3 u_camera_pos;
 
 out vec3 v_world;
 out vec3 v_normal;
@@ -29,6 +29,8 @@ flat out int v_material;
 flat out float v_highlight;
 noperspective out float v_edge;  // thin twigs and blades: distance from the axis on screen, px
 out float v_half;                // their true half width on screen, px (< 0: not thin)
+out vec3 v_light;                // blades: their light at the vertex, and ...
+out float v_haze;                // ... the haze over it (see below)
 
 #include "constants.glsl"
 
@@ -116,5 +118,19 @@ void main() {
         vec3 tip = mix(lin(C_BLADE_TIP), lin(C_BLADE_TIP_DRY), jitter);
         vec3 c = mix(base, tip, key);
         v_albedo = mix(c, lin(C_BLADE_WINTER) * (0.6 + 0.4 * key), 0.6 * u_season);
+    }
+    v_light = vec3(0.0);
+    v_haze = 0.0;
+    if (PART == PART_BLADES) {
+        // A blade is lit here, at its vertices (a few rows along it), its shadow looked up here
+        // too, and the light interpolated: a blade is a pixel or two wide, and lighting each of
+        // its pixels would cost a software rasteriser twice as much as all else it does for
+        // them. Its edges, darker than its midrib, are shaded in tree.frag. Leaves and bark are
+        // lit at each pixel.
+        vec3 V = normalize(u_camera_pos - v_world);
+        vec3 n = normalize(v_normal);
+        if (dot(n, V) < 0.0) n = -n;             // double-sided: the face the eye sees
+        v_light = tree_light(v_albedo, n, V, v_ao, sun_visibility(v_world, n), true, v_highlight);
+        v_haze = haze(v_world);
     }
 }

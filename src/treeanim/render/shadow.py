@@ -21,7 +21,9 @@ from .shaders import load_program
 
 #: Attributes the shadow pass reads; the rest of each vertex is skipped.
 SHADOW_ATTRIBUTES = ("in_ids", "in_offset", "in_extra", "in_curve")
-#: The box round the tree at rest grows by this fraction of its size each way (sway room).
+#: The box round the tree at rest grows by this fraction of its size each way (sway room), but
+#: by no more than its height (nothing sways further than it stands tall: a meadow's box grows
+#: by a blade's length, not by 15 % of the meadow's width).
 SWAY_MARGIN = 0.15
 #: The lowest sun elevation the map is fitted for (sin of it): lower suns cast the shadow of
 #: a sun at this height, not an endless one.
@@ -191,13 +193,14 @@ class ShadowMap:
         self.clear()
 
     def fit(self, sun, lo, hi) -> None:
-        """Fit the sun's view to the box ``lo`` .. ``hi`` grown by :data:`SWAY_MARGIN` (cached)."""
+        """Fit the sun's view to the box ``lo`` .. ``hi`` grown by :data:`SWAY_MARGIN` (cached),
+        and the ground's :attr:`footprint` to it."""
         key = (tuple(np.round(sun, 9)), tuple(lo), tuple(hi))
         if key == self._fitted:
             return
         self._fitted = key
         lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-        grow = SWAY_MARGIN * (hi - lo).max()
+        grow = min(SWAY_MARGIN * (hi - lo).max(), hi[1] - lo[1])
         self.matrix, extent = light_view_projection(sun, lo - grow, hi + grow)
         self.texel = extent / self.size
         grow += FOOTPRINT_TEXELS * self.texel / cast_direction(sun)[1]  # a texel's length on the ground
