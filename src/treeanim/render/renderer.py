@@ -277,12 +277,16 @@ class Renderer:
             if u is not None:
                 u.write(data)
 
+    @property
+    def pad(self) -> float:
+        """How far the tree's surface reaches beyond its nodes (metres): a lamina's length plus
+        half the thickest diameter."""
+        return float(np.max(self.tree.lamina_length, initial=0.0)) + 0.5 * float(np.max(self.tree.node_diameter))
+
     def bounds(self, positions: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Axis-aligned box of the tree (nodes, plus the leaves' laminas), world."""
         P = self.tree.rest_positions if positions is None else np.asarray(positions)
-        lo, hi = P.min(axis=0), P.max(axis=0)
-        pad = float(np.max(self.tree.lamina_length, initial=0.0)) + 0.5 * float(np.max(self.tree.node_diameter))
-        return lo - pad, hi + pad
+        return P.min(axis=0) - self.pad, P.max(axis=0) + self.pad
 
     def _place_ground(self) -> None:
         tree = self.tree
@@ -340,7 +344,7 @@ class Renderer:
             self._uniform(prog, "u_bark", (float(bark.furrows), float(bark.depth), float(bark.interlace),
                                            float(bark.lenticels)))
         if s.shadow:
-            self.shadow.fit(sun, *self.bounds())
+            self.shadow.fit(sun, *self.bounds(), self.tree.rest_positions, self.pad)
         else:
             self.shadow.clear()
         for prog in self.lit_progs:

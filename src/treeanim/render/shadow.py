@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import moderngl
 import numpy as np
-from scipy.spatial import ConvexHull
+from scipy.spatial import ConvexHull, QhullError
 
 from ..model.lamina import ear_clip
 from ..model.tree import Tree
@@ -90,27 +90,43 @@ def _box_and_shadow(sun: np.ndarray, lo, hi) -> tuple[np.ndarray, np.ndarray]:
     """The 8 corners of the box ``lo`` .. ``hi`` and their shadows on the ground y = 0 (corners
     below the ground stand for the ground under them)."""
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    return corners, corners - np.outer(np.maximum(corners[:, 1], 0.0) / sun[1], sun)
+    return corners, _shadow(sun, corners)
 
 
-def ground_footprint(sun, lo, hi) -> np.ndarray:
-    """Where on the ground y = 0 anything in the box ``lo`` .. ``hi`` can cast its shadow.
+def _shadow(sun: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Shadows on the ground y = 0 of ``points`` (points below the ground: the ground under them)."""
+    return points - np.outer(np.maximum(points[:, 1], 0.0) / sun[1], sun)
+
+
+def ground_footprint(sun, points, reach: float) -> np.ndarray:
+    """Where on the ground y = 0 anything within ``reach`` of ``points`` can cast its shadow.
 
     Parameters
     ----------
     sun : (3,) float
         Towards the sun (made :func:`cast_direction`).
-    lo, hi : (3,) float
-        Corners of the box.
+    points : (P, 3) float
+        The casters (a tree's nodes at rest).
+    reach : float
+        How far from a point its surface may be, or sway to (metres; each axis).
 
     Returns
     -------
     (K, 2) float
-        The convex polygon (x, z), in order round it: the hull of the shadows of the box's
-        corners (a shadow is a linear map of its caster, so the whole box's falls inside).
+        The convex polygon (x, z), in order round it: the hull of the shadows of the segments
+        from ``reach`` below each point to ``reach`` above it, widened by ``reach`` along x and z
+        (a shadow is a linear map of its caster, so the shadow of the box round each point falls
+        inside).
     """
-    _, ground = _box_and_shadow(cast_direction(sun), lo, hi)
-    xz = ground[:, [0, 2]]
+    sun = cast_direction(sun)
+    points = np.asarray(points, float)
+    ends = np.concatenate([points - [0.0, reach, 0.0], points + [0.0, reach, 0.0]])
+    xz = _shadow(sun, ends)[:, [0, 2]]
+    try:
+        xz = xz[ConvexHull(xz).vertices]
+    except QhullError:  # all in a line (one straight beam): the widening below makes it 2-D
+        pass
+    xz = (xz[:, None, :] + reach * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])).reshape(-1, 2)
     return xz[ConvexHull(xz).vertices]
 
 
@@ -192,9 +208,10 @@ class ShadowMap:
         self._fitted: tuple | None = None
         self.clear()
 
-    def fit(self, sun, lo, hi) -> None:
+    def fit(self, sun, lo, hi, points, pad: float) -> None:
         """Fit the sun's view to the box ``lo`` .. ``hi`` grown by :data:`SWAY_MARGIN` (cached),
-        and the ground's :attr:`footprint` to it."""
+        and the ground's :attr:`footprint` to the tree's ``points`` (its nodes at rest) grown by
+        the same and by ``pad`` (how far its surface reaches beyond them)."""
         key = (tuple(np.round(sun, 9)), tuple(lo), tuple(hi))
         if key == self._fitted:
             return
@@ -203,8 +220,8 @@ class ShadowMap:
         grow = min(SWAY_MARGIN * (hi - lo).max(), hi[1] - lo[1])
         self.matrix, extent = light_view_projection(sun, lo - grow, hi + grow)
         self.texel = extent / self.size
-        grow += FOOTPRINT_TEXELS * self.texel / cast_direction(sun)[1]  # a texel's length on the ground
-        self.footprint = ground_footprint(sun, lo - grow, hi + grow)
+        reach = grow + pad + FOOTPRINT_TEXELS * self.texel / cast_direction(sun)[1]  # texels long on the ground
+        self.footprint = ground_footprint(sun, points, reach)
         self.prog["u_light_view_proj"].write(self.matrix.tobytes())
 
     def clear(self) -> None:
