@@ -1,6 +1,6 @@
 #version 330 core
-// One full-screen triangle at the far plane: the sky, drawn after the ground and the tree's
-// leaves with depth test <=, so that only the pixels they left uncovered are shaded.
+// One full-screen triangle at the far plane: the sky into the background cache, and the copy
+// of the cache each frame, with depth test <=: only where nothing was drawn.
 void main() {
     vec2 p = vec2(gl_VertexID == 1 ? 3.0 : -1.0, gl_VertexID == 2 ? 3.0 : -1.0);
     gl_Position = vec4(p, 1.0, 1.0);

@@ -280,3 +280,22 @@ def test_a_blade_in_a_shadow_is_darker(offscreen):
     assert inside.sum() > 50 and outside.sum() > 300
     assert np.median(drop[inside]) > 4, np.median(drop[inside])  # 0 if blades ignored the shadow map
     assert np.median(drop[outside]) < 1.5, np.median(drop[outside])
+
+
+def test_the_background_cache_follows_the_camera_the_scene_and_the_size(offscreen, tree):
+    """Sky and ground without shadows are drawn into a cache only when the camera, the viewport
+    or the scene change: a renderer that drew another view, sun or size just before draws the
+    picture a fresh one draws."""
+    cams = [overhead(tree), OrbitCamera(target=(0.0, 1.0, 0.0), distance=5.0, azimuth=-40.0, elevation=15.0)]
+    suns = [(0.6, 0.75, 0.2), (-0.6, 0.75, -0.1)]
+    fresh = {(c, s): render(offscreen, tree, cams[c], sun_direction=suns[s]) for c in (0, 1) for s in (0, 1)}
+    r = offscreen.load(tree, scene=Scene(sun_direction=suns[0]))
+    offscreen.update(*rest_pose(tree))
+    for c, s in [(0, 0), (1, 0), (1, 0), (0, 0), (0, 1), (1, 1)]:
+        r.scene.sun_direction = suns[s]
+        np.testing.assert_array_equal(offscreen.render(cams[c]), fresh[c, s])
+    offscreen.resize(W // 2, H // 2)
+    small = offscreen.render(cams[1])
+    offscreen.load(tree, scene=Scene(sun_direction=suns[1]))
+    offscreen.update(*rest_pose(tree))
+    np.testing.assert_array_equal(small, offscreen.render(cams[1]))

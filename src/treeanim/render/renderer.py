@@ -14,12 +14,14 @@ texel i at (i mod width, i div width), read with texelFetch):
   the visibility or highlight changes.
 
 Each frame draws the sun's shadow map first (:mod:`treeanim.render.shadow`), then the leaves
-(opaque), the ground and the sky where the leaves left pixels uncovered, then the bark and the
-grass blades over them (blended: twigs and blades thinner than a pixel are soft lines of their
-true weight), then the overlays. Each part of the mesh (``mesh.PARTS``) has its own program, and
-the ground looks the shadow map up only over the shadow's footprint: a software rasteriser
-such as llvmpipe runs both sides of every branch, so code a pixel does not need costs it
-unless it is left out of that pixel's program.
+(opaque), the ground over the shadow's footprint and the background (sky and the rest of the
+ground, copied from a cache drawn again only when the camera, viewport or scene change) where
+the leaves left pixels uncovered, then the bark and the grass blades over them (blended: twigs
+and blades thinner than a pixel are soft lines of their true weight), then the overlays. Each
+part of the mesh (``mesh.PARTS``) has its own program, and the ground looks the shadow map up
+only over the shadow's footprint: a software rasteriser such as llvmpipe runs both sides of
+every branch, so code a pixel does not need costs it unless it is left out of that pixel's
+program.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ from ..model.tree import Tree
 from .camera import OrbitCamera
 from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh, build_mesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
-from .shaders import DEPTH_FOOTPRINT, DEPTH_GROUND, load_program
+from .shaders import DEPTH_GROUND, load_program
 from .shadow import ShadowMap, shadow_indices
 
 #: Width in texels of the node and object textures (GL 3.3 guarantees 1024).
@@ -193,6 +195,8 @@ class Renderer:
         self.ground_progs: list[moderngl.Program] = []
         self.parts: dict[str, _Part] = {}
         self.vbo = self.ibo = self.sky_vao = self.ground_vbo = None
+        self.background_prog = self.background_vao = self.background_texture = self.background_fbo = None
+        self._background_key: tuple | None = None
         self.ground_vaos: list[moderngl.VertexArray] = []
         self.node_texture = self.object_texture = None
         self.shadow: ShadowMap | None = None
@@ -201,6 +205,7 @@ class Renderer:
             self.sky_prog = load_program(ctx, "sky.vert", "sky.frag")
             for shadowed in (0, 1):  # off and over the shadow's footprint
                 self.ground_progs.append(load_program(ctx, "ground.vert", "ground.frag", defines={"SUN_SHADOW": shadowed}))
+            self.background_prog = load_program(ctx, "sky.vert", "background.frag")
             self.line_prog = load_program(ctx, "line.vert", "line.frag", "line_geom.glsl")
 
             # --- static mesh: one index buffer, part after part
@@ -238,8 +243,10 @@ class Renderer:
             for prog in (*self.tree_progs, *self.ground_progs):
                 self._uniform(prog, "u_shadow_map", 2)
 
-            # --- sky: one full-screen triangle; ground: polygons in clip space, made each frame
+            # --- sky and background: a full-screen triangle; ground: polygons in clip space
             self.sky_vao = ctx.vertex_array(self.sky_prog, [])
+            self.background_vao = ctx.vertex_array(self.background_prog, [])
+            self._uniform(self.background_prog, "u_background", 3)
             self.ground_vbo = ctx.buffer(reserve=4096, dynamic=True)
             for prog in self.ground_progs:
                 self.ground_vaos.append(ctx.vertex_array(prog, [(self.ground_vbo, "4f", "in_clip")]))
@@ -434,9 +441,6 @@ class Renderer:
         if self.scene.shadow:
             ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
             self.shadow.draw()
-        target.use()
-        ctx.viewport = (0, 0, width, height)
-
         vp = camera.view_projection(width, height)
         vp_bytes = vp.tobytes()
         eye = tuple(float(x) for x in camera.eye)
@@ -451,6 +455,9 @@ class Renderer:
             self._uniform(prog, "u_season", season)
             self._uniform(prog, "u_pixels_per_metre", 0.5 * height / math.tan(math.radians(camera.fov_y) / 2))
             self._uniform(prog, "u_thin_pixels", float(self.scene.thin_pixels))
+        self._update_background(camera, vp, width, height)
+        target.use()
+        ctx.viewport = (0, 0, width, height)
 
         s = self.scene
         hz = _lin(s.sky_horizon)
@@ -459,11 +466,15 @@ class Renderer:
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         self.shadow.texture.use(2)
-        # The leaves first: solid, so the ground and sky under them are never shaded.
+        # The leaves first: solid, so the ground and sky under them are never shaded. Then the
+        # ground over the shadow's footprint, with its shadow, and where neither was drawn the
+        # background: sky and ground as the cache holds them (a copy, at the far plane).
         self.parts["LEAVES"].render()
-        self._draw_ground(camera, vp)
-        ctx.depth_func = "<="  # the sky, at the far plane: only where nothing was drawn
-        self.sky_vao.render(moderngl.TRIANGLES, vertices=3)
+        if s.shadow and self._ground_shown(camera):
+            self._ground(self.ground_vaos[1], self.shadow.footprint, vp)
+        ctx.depth_func = "<="
+        self.background_texture.use(3)
+        self.background_vao.render(moderngl.TRIANGLES, vertices=3)
         ctx.depth_func = "<"
         # Blended: twigs and blades thinner than a pixel are drawn faint over what lies behind.
         ctx.enable(moderngl.BLEND)
@@ -476,27 +487,46 @@ class Renderer:
             self._draw_overlays(overlays, width, height)
         self._collect_lines({id(o) for o in overlays})
 
-    def _draw_ground(self, camera: OrbitCamera, vp: np.ndarray) -> None:
-        """The ground, as two polygons: the shadow's footprint (shadow-map lookups) first, then
-        a square out to the horizon round the eye (none), behind it in depth: kept out of the
-        pixels already drawn."""
-        eye = np.asarray(camera.eye, float)
-        if not self.scene.show_ground or eye[1] <= 0.0:
+    def _ground_shown(self, camera: OrbitCamera) -> bool:
+        return bool(self.scene.show_ground and camera.eye[1] > 0.0)
+
+    def _ground(self, vao: moderngl.VertexArray, polygon: np.ndarray, vp: np.ndarray) -> None:
+        """One convex polygon of the ground ((K, 2) corners x, z), drawn by ``vao``'s program at
+        ``DEPTH_GROUND``."""
+        tris = clip_ground(polygon, vp, DEPTH_GROUND)
+        if len(tris):
+            if self.ground_vbo.size < tris.nbytes:
+                self.ground_vbo.orphan(2 * tris.nbytes)
+            self.ground_vbo.write(tris.tobytes())
+            vao.render(moderngl.TRIANGLES, vertices=len(tris))
+
+    def _update_background(self, camera: OrbitCamera, vp: np.ndarray, width: int, height: int) -> None:
+        """Draw the background cache again if the viewport, the camera or the scene changed since
+        it was drawn: the sky, and over it the ground without shadows, as a square out to the
+        horizon round the eye. Neither moves with the tree, so a still camera reads them from
+        the cache each frame (a copy costs llvmpipe a fifth of shading them); only the ground
+        over the shadow's footprint is shaded every frame."""
+        key = (width, height, vp.tobytes(), tuple(camera.eye), self._applied_scene)
+        if key == self._background_key:
             return
-        reach = HORIZON_REACH * eye[1]
-        square = eye[[0, 2]] + reach * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
-        polygons = [(self.ground_vaos[0], clip_ground(square, vp, DEPTH_GROUND))]
-        if self.scene.shadow:
-            polygons.insert(0, (self.ground_vaos[1], clip_ground(self.shadow.footprint, vp, DEPTH_FOOTPRINT)))
-        data = np.concatenate([p for _, p in polygons])
-        if self.ground_vbo.size < data.nbytes:
-            self.ground_vbo.orphan(2 * data.nbytes)
-        self.ground_vbo.write(data.tobytes())
-        first = 0
-        for vao, p in polygons:
-            if len(p):
-                vao.render(moderngl.TRIANGLES, vertices=len(p), first=first)
-            first += len(p)
+        ctx = self.ctx
+        if self.background_texture is None or self.background_texture.size != (width, height):
+            for o in (self.background_fbo, self.background_texture):
+                if o is not None:
+                    o.release()
+            self.background_fbo = None  # made next: released again if making it fails
+            self.background_texture = ctx.texture((width, height), 4)
+            self.background_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.background_fbo = ctx.framebuffer(self.background_texture)
+        self.background_fbo.use()
+        ctx.viewport = (0, 0, width, height)
+        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
+        self.sky_vao.render(moderngl.TRIANGLES, vertices=3)
+        if self._ground_shown(camera):
+            eye = np.asarray(camera.eye, float)
+            square = eye[[0, 2]] + HORIZON_REACH * eye[1] * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+            self._ground(self.ground_vaos[0], square, vp)
+        self._background_key = key
 
     # ------------------------------------------------------------------ overlays
     def _draw_overlays(self, overlays, width: int, height: int) -> None:
@@ -549,6 +579,7 @@ class Renderer:
             self.shadow.release()
         for o in (*[p.vao for p in self.parts.values()], *self.tree_progs, self.vbo, self.ibo, self.sky_vao,
                   *self.ground_vaos, self.ground_vbo, self.node_texture, self.object_texture, self.sky_prog,
-                  *self.ground_progs, self.line_prog):
+                  *self.ground_progs, self.background_vao, self.background_fbo, self.background_texture,
+                  self.background_prog, self.line_prog):
             if o is not None:
                 o.release()
