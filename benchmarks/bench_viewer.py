@@ -14,8 +14,9 @@ the real main loop (advance by the elapsed time, draw, imgui, swap) and reports 
 * ``draw``: everything else the viewer does on the CPU in a frame: the pose upload
   (``Renderer.update``), the draw calls (``Renderer.draw``), the panel (``Panel.draw``) and
   imgui's rendering; ``driver``: the part of it spent inside the draw calls of the tree's
-  parts, the ground and the sky: a software rasteriser such as Mesa llvmpipe shades every vertex
-  inside the draw call, a GPU driver only queues it; ``ours`` = ``draw`` − ``driver``;
+  parts, the ground, the sky and the background's copy: a software rasteriser such as Mesa
+  llvmpipe shades every vertex inside the draw call, a GPU driver only queues it; ``ours`` =
+  ``draw`` − ``driver``;
 * ``cpu``: the thread's CPU time in ``draw`` (less disturbed by other processes than the wall
   clock; on llvmpipe it excludes the rasteriser's worker threads);
 * ``update``, ``panel``, ``imgui``: wall times of the pose upload, building the panel, and
@@ -93,6 +94,7 @@ def bench_row(win, row: str, frames: int, warmup: int, step: bool = False) -> di
             if part.vao is not None:
                 part.vao = _TimedVao(part.vao, t["driver"])
         r.sky_vao = _TimedVao(r.sky_vao, t["driver"])
+        r.background_vao = _TimedVao(r.background_vao, t["driver"])
         r.ground_vaos = [_TimedVao(v, t["driver"]) for v in r.ground_vaos]
         v.advance = t["sim"].wrap(v.advance)
         v.draw = t["draw"].wrap(v.draw)
