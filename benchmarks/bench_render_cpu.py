@@ -11,6 +11,8 @@ frame. The CPU time is the whole process's (``time.process_time``): with a softw
 such as Mesa's llvmpipe it counts the rasteriser's worker threads, and it hardly moves when
 other jobs share the cores, where the wall time can double. On an idle machine the wall time
 is roughly the vertex work (one thread) plus the rest shared among the worker threads.
+``--orbit`` moves the camera every frame, as a user dragging the view does (the renderer then
+draws its background cache again every frame).
 
 It runs any version of treeanim on the import path, so an older commit checked out in a git
 worktree can be measured against this one, alternately (``PYTHONPATH=that/src``; that
@@ -25,8 +27,9 @@ import statistics
 import time
 
 
-def measure(key: str, off, frames: int) -> tuple[float, float]:
-    """(median wall ms, median CPU ms) of ``frames`` frames of ``key``'s bench row."""
+def measure(key: str, off, frames: int, orbit: float = 0.0) -> tuple[float, float]:
+    """(median wall ms, median CPU ms) of ``frames`` frames of ``key``'s bench row, the camera
+    turned by ``orbit`` degrees about the tree before each frame."""
     import treeanim as ta
     from treeanim import offline
 
@@ -41,6 +44,7 @@ def measure(key: str, off, frames: int) -> tuple[float, float]:
     wall, cpu = [], []
     for k in range(frames + 2):
         sim.step(1 / 30)
+        cam.azimuth += orbit
         t0, c0 = time.perf_counter(), time.process_time()
         off.update(sim.positions, sim.rotations, sim.shown)
         off.render(cam, season=season)
@@ -56,6 +60,8 @@ def main(argv=None) -> int:
                                                    "tulip_poplar", "grassland"])
     ap.add_argument("--frames", type=int, default=12, help="frames timed per preset (default 12)")
     ap.add_argument("--samples", type=int, default=0, help="MSAA samples (default 0, as the viewer on llvmpipe)")
+    ap.add_argument("--orbit", type=float, default=0.0,
+                    help="turn the camera by this many degrees a frame (default 0: still, as the bench)")
     args = ap.parse_args(argv)
 
     from treeanim.render.offscreen import OffscreenRenderer
@@ -63,7 +69,7 @@ def main(argv=None) -> int:
     off = OffscreenRenderer(1280, 720, samples=args.samples)
     try:
         for key in args.presets:
-            wall, cpu = measure(key, off, args.frames)
+            wall, cpu = measure(key, off, args.frames, args.orbit)
             print(f"{key}: wall {wall:.1f} ms, cpu {cpu:.1f} ms", flush=True)
     finally:
         off.release()

@@ -423,9 +423,10 @@ def test_no_gl_errors_after_a_frame(scene):
 
 
 def test_the_depths_the_renderer_draws_at_keep_their_order():
-    """Thin twigs, then the ground over the shadow's footprint, then the background, each 25 or
-    more steps of a 24-bit depth buffer behind the one before (window depth = (NDC z + 1) / 2)."""
-    from treeanim.render.shaders import DEPTH_GROUND, DEPTH_THIN
+    """Thin twigs, then the ground over the shadow's footprint, then the rest of the ground, then
+    the sky, each 25 or more steps of a 24-bit depth buffer behind the one before (window depth
+    = (NDC z + 1) / 2)."""
+    from treeanim.render.shaders import DEPTH_FOOTPRINT, DEPTH_GROUND, DEPTH_THIN
 
-    steps = [(z + 1.0) / 2.0 * 2**24 for z in (DEPTH_THIN, DEPTH_GROUND, 1.0)]
+    steps = [(z + 1.0) / 2.0 * 2**24 for z in (DEPTH_THIN, DEPTH_FOOTPRINT, DEPTH_GROUND, 1.0)]
     assert all(b - a >= 25 for a, b in zip(steps, steps[1:])), np.diff(steps)

@@ -283,19 +283,27 @@ def test_a_blade_in_a_shadow_is_darker(offscreen):
 
 
 def test_the_background_cache_follows_the_camera_the_scene_and_the_size(offscreen, tree):
-    """Sky and ground without shadows are drawn into a cache only when the camera, the viewport
-    or the scene change: a renderer that drew another view, sun or size just before draws the
-    picture a fresh one draws."""
+    """Sky and ground without shadows are drawn into a cache once the camera, the viewport and
+    the scene hold still for a second frame, and copied from it after: a renderer that drew
+    another view, sun or size just before, or the same one (drawn, cached, copied), draws the
+    picture a fresh one draws (but for the horizon's multisampled edge, one grey level)."""
+
+    def same(a, b):
+        d = np.abs(a.astype(int) - b.astype(int))
+        assert d.max() <= 1 and np.mean(d.max(axis=2) > 0) < 0.01, (d.max(), np.mean(d.max(axis=2) > 0))
+
     cams = [overhead(tree), OrbitCamera(target=(0.0, 1.0, 0.0), distance=5.0, azimuth=-40.0, elevation=15.0)]
     suns = [(0.6, 0.75, 0.2), (-0.6, 0.75, -0.1)]
     fresh = {(c, s): render(offscreen, tree, cams[c], sun_direction=suns[s]) for c in (0, 1) for s in (0, 1)}
     r = offscreen.load(tree, scene=Scene(sun_direction=suns[0]))
     offscreen.update(*rest_pose(tree))
-    for c, s in [(0, 0), (1, 0), (1, 0), (0, 0), (0, 1), (1, 1)]:
+    for c, s in [(0, 0), (1, 0), (1, 0), (1, 0), (0, 0), (0, 0), (0, 1), (0, 1), (0, 1), (1, 1)]:
         r.scene.sun_direction = suns[s]
-        np.testing.assert_array_equal(offscreen.render(cams[c]), fresh[c, s])
+        same(offscreen.render(cams[c]), fresh[c, s])
     offscreen.resize(W // 2, H // 2)
-    small = offscreen.render(cams[1])
+    small = [offscreen.render(cams[1]) for _ in range(3)]  # drawn, cached, copied
     offscreen.load(tree, scene=Scene(sun_direction=suns[1]))
     offscreen.update(*rest_pose(tree))
-    np.testing.assert_array_equal(small, offscreen.render(cams[1]))
+    first = offscreen.render(cams[1])
+    for img in small:
+        same(img, first)

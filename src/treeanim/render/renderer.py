@@ -15,13 +15,12 @@ texel i at (i mod width, i div width), read with texelFetch):
 
 Each frame draws the sun's shadow map first (:mod:`treeanim.render.shadow`), then the leaves
 (opaque), the ground over the shadow's footprint and the background (sky and the rest of the
-ground, copied from a cache drawn again only when the camera, viewport or scene change) where
-the leaves left pixels uncovered, then the bark and the grass blades over them (blended: twigs
-and blades thinner than a pixel are soft lines of their true weight), then the overlays. Each
-part of the mesh (``mesh.PARTS``) has its own program, and the ground looks the shadow map up
-only over the shadow's footprint: a software rasteriser such as llvmpipe runs both sides of
-every branch, so code a pixel does not need costs it unless it is left out of that pixel's
-program.
+ground; while the camera is still, a copy of a cache) where the leaves left pixels uncovered,
+then the bark and the grass blades over them (blended: twigs and blades thinner than a pixel
+are soft lines of their true weight), then the overlays. Each part of the mesh
+(``mesh.PARTS``) has its own program, and the ground looks the shadow map up only over the
+shadow's footprint: a software rasteriser such as llvmpipe runs both sides of every branch,
+so code a pixel does not need costs it unless it is left out of that pixel's program.
 """
 
 from __future__ import annotations
@@ -37,7 +36,7 @@ from ..model.tree import Tree
 from .camera import OrbitCamera
 from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh, build_mesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
-from .shaders import DEPTH_GROUND, load_program
+from .shaders import DEPTH_FOOTPRINT, DEPTH_GROUND, load_program
 from .shadow import ShadowMap, shadow_indices
 
 #: Width in texels of the node and object textures (GL 3.3 guarantees 1024).
@@ -196,7 +195,9 @@ class Renderer:
         self.parts: dict[str, _Part] = {}
         self.vbo = self.ibo = self.sky_vao = self.ground_vbo = None
         self.background_prog = self.background_vao = self.background_texture = self.background_fbo = None
-        self._background_key: tuple | None = None
+        self.background_depth = None
+        self._background_key: tuple | None = None  # the view the cache holds
+        self._last_view: tuple | None = None        # the last frame's
         self.ground_vaos: list[moderngl.VertexArray] = []
         self.node_texture = self.object_texture = None
         self.shadow: ShadowMap | None = None
@@ -455,7 +456,7 @@ class Renderer:
             self._uniform(prog, "u_season", season)
             self._uniform(prog, "u_pixels_per_metre", 0.5 * height / math.tan(math.radians(camera.fov_y) / 2))
             self._uniform(prog, "u_thin_pixels", float(self.scene.thin_pixels))
-        self._update_background(camera, vp, width, height)
+        cached = self._cache_background(camera, vp, width, height)
         target.use()
         ctx.viewport = (0, 0, width, height)
 
@@ -468,14 +469,17 @@ class Renderer:
         self.shadow.texture.use(2)
         # The leaves first: solid, so the ground and sky under them are never shaded. Then the
         # ground over the shadow's footprint, with its shadow, and where neither was drawn the
-        # background: sky and ground as the cache holds them (a copy, at the far plane).
+        # background: sky and the rest of the ground (a copy of the cache, or drawn here).
         self.parts["LEAVES"].render()
         if s.shadow and self._ground_shown(camera):
-            self._ground(self.ground_vaos[1], self.shadow.footprint, vp)
-        ctx.depth_func = "<="
-        self.background_texture.use(3)
-        self.background_vao.render(moderngl.TRIANGLES, vertices=3)
-        ctx.depth_func = "<"
+            self._ground(self.ground_vaos[1], self.shadow.footprint, vp, DEPTH_FOOTPRINT)
+        if cached:
+            ctx.depth_func = "<="
+            self.background_texture.use(3)
+            self.background_vao.render(moderngl.TRIANGLES, vertices=3)
+            ctx.depth_func = "<"
+        else:
+            self._draw_background(camera, vp)
         # Blended: twigs and blades thinner than a pixel are drawn faint over what lies behind.
         ctx.enable(moderngl.BLEND)
         ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
@@ -490,43 +494,59 @@ class Renderer:
     def _ground_shown(self, camera: OrbitCamera) -> bool:
         return bool(self.scene.show_ground and camera.eye[1] > 0.0)
 
-    def _ground(self, vao: moderngl.VertexArray, polygon: np.ndarray, vp: np.ndarray) -> None:
+    def _ground(self, vao: moderngl.VertexArray, polygon: np.ndarray, vp: np.ndarray, depth: float) -> None:
         """One convex polygon of the ground ((K, 2) corners x, z), drawn by ``vao``'s program at
-        ``DEPTH_GROUND``."""
-        tris = clip_ground(polygon, vp, DEPTH_GROUND)
+        ``depth`` (NDC z)."""
+        tris = clip_ground(polygon, vp, depth)
         if len(tris):
             if self.ground_vbo.size < tris.nbytes:
                 self.ground_vbo.orphan(2 * tris.nbytes)
             self.ground_vbo.write(tris.tobytes())
             vao.render(moderngl.TRIANGLES, vertices=len(tris))
 
-    def _update_background(self, camera: OrbitCamera, vp: np.ndarray, width: int, height: int) -> None:
-        """Draw the background cache again if the viewport, the camera or the scene changed since
-        it was drawn: the sky, and over it the ground without shadows, as a square out to the
-        horizon round the eye. Neither moves with the tree, so a still camera reads them from
-        the cache each frame (a copy costs llvmpipe a fifth of shading them); only the ground
-        over the shadow's footprint is shaded every frame."""
-        key = (width, height, vp.tobytes(), tuple(camera.eye), self._applied_scene)
-        if key == self._background_key:
-            return
-        ctx = self.ctx
-        if self.background_texture is None or self.background_texture.size != (width, height):
-            for o in (self.background_fbo, self.background_texture):
-                if o is not None:
-                    o.release()
-            self.background_fbo = None  # made next: released again if making it fails
-            self.background_texture = ctx.texture((width, height), 4)
-            self.background_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            self.background_fbo = ctx.framebuffer(self.background_texture)
-        self.background_fbo.use()
-        ctx.viewport = (0, 0, width, height)
-        ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
-        self.sky_vao.render(moderngl.TRIANGLES, vertices=3)
+    def _draw_background(self, camera: OrbitCamera, vp: np.ndarray) -> None:
+        """The background, where nothing was drawn yet (depth test on): the ground without
+        shadows, a square out to the horizon round the eye, behind the footprint's, then the
+        sky at the far plane."""
         if self._ground_shown(camera):
             eye = np.asarray(camera.eye, float)
             square = eye[[0, 2]] + HORIZON_REACH * eye[1] * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
-            self._ground(self.ground_vaos[0], square, vp)
+            self._ground(self.ground_vaos[0], square, vp, DEPTH_GROUND)
+        self.ctx.depth_func = "<="
+        self.sky_vao.render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.depth_func = "<"
+
+    def _cache_background(self, camera: OrbitCamera, vp: np.ndarray, width: int, height: int) -> bool:
+        """Whether the background cache holds this frame's background; drawn into it on the
+        second frame in a row with the same viewport, camera and scene. Neither sky nor the
+        ground without shadows moves with the tree, so while the camera is still each frame
+        copies them (a copy costs llvmpipe a fifth of shading them); while it moves they are
+        drawn in the frame as before, so a moving camera pays nothing for the cache."""
+        key = (width, height, vp.tobytes(), tuple(camera.eye), self._applied_scene)
+        if key == self._background_key:
+            return True
+        if key != self._last_view:
+            self._last_view = key
+            return False
+        ctx = self.ctx
+        if self.background_texture is None or self.background_texture.size != (width, height):
+            for o in (self.background_fbo, self.background_depth, self.background_texture):
+                if o is not None:
+                    o.release()
+            self.background_fbo = self.background_depth = None  # made next: released again if that fails
+            self.background_texture = ctx.texture((width, height), 4)
+            self.background_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.background_depth = ctx.depth_renderbuffer((width, height))
+            self.background_fbo = ctx.framebuffer(self.background_texture, self.background_depth)
+        self.background_fbo.use()
+        ctx.viewport = (0, 0, width, height)
+        self.background_fbo.clear(depth=1.0)
+        ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<"
+        self._draw_background(camera, vp)
         self._background_key = key
+        return True
 
     # ------------------------------------------------------------------ overlays
     def _draw_overlays(self, overlays, width: int, height: int) -> None:
@@ -580,6 +600,7 @@ class Renderer:
         for o in (*[p.vao for p in self.parts.values()], *self.tree_progs, self.vbo, self.ibo, self.sky_vao,
                   *self.ground_vaos, self.ground_vbo, self.node_texture, self.object_texture, self.sky_prog,
                   *self.ground_progs, self.background_vao, self.background_fbo, self.background_texture,
+                  self.background_depth,
                   self.background_prog, self.line_prog):
             if o is not None:
                 o.release()
