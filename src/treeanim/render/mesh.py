@@ -142,7 +142,18 @@ class TreeMesh:
         return np.concatenate([[0], np.cumsum(self.object_triangles)[:-1]]).astype(np.int64)
 
     def part_indices(self, part: str) -> np.ndarray:
-        """(T', 3) uint32: the triangles of one of :data:`PARTS`, in their order here."""
+        """The triangles of one of the mesh's parts.
+
+        Parameters
+        ----------
+        part : str
+            A key of :data:`PARTS`.
+
+        Returns
+        -------
+        (T', 3) uint32
+            Rows of :attr:`indices` whose material is the part's, in their order there.
+        """
         return self.indices[np.isin(self.material[self.indices[:, 0]], PARTS[part])]
 
     @property

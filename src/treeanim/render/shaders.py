@@ -54,8 +54,20 @@ def constants_glsl() -> str:
 
 
 def with_defines(source: str, defines: dict | None) -> str:
-    """``source`` with a ``#define NAME value`` line for each item of ``defines`` after its
-    ``#version`` line (a shader's variants: constant conditions fold away when compiled)."""
+    """A shader's variant: ``source`` with a ``#define NAME value`` line for each item of
+    ``defines`` after its ``#version`` line (conditions on them fold away when compiled).
+
+    Parameters
+    ----------
+    source : str
+        GLSL, its first line ``#version ...`` (else the defines go first).
+    defines : dict or None
+        Name: value (written with ``str``).
+
+    Returns
+    -------
+    str
+    """
     if not defines:
         return source
     head, sep, rest = source.partition("\n")

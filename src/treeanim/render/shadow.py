@@ -73,9 +73,19 @@ def shadow_indices(mesh: TreeMesh, tree: Tree) -> np.ndarray:
 
 
 def cast_direction(sun) -> np.ndarray:
-    """Unit vector towards the sun the map is made for: ``sun``, or where it is lower than
-    :data:`MIN_SUN_HEIGHT`, a sun at that height in the same azimuth (its shadows stay on a
-    finite ground)."""
+    """The sun the map is made for: ``sun``, or where it is lower than :data:`MIN_SUN_HEIGHT`,
+    a sun at that height in the same azimuth (its shadows stay on a finite ground).
+
+    Parameters
+    ----------
+    sun : (3,) float
+        Towards the sun (any length).
+
+    Returns
+    -------
+    (3,) float
+        Unit vector towards the sun the shadows are cast from.
+    """
     sun = np.asarray(sun, float)
     sun = sun / np.linalg.norm(sun)
     if sun[1] < MIN_SUN_HEIGHT:
