@@ -13,9 +13,10 @@ the real main loop (advance by the elapsed time, draw, imgui, swap) and reports 
 * ``sim``: the simulation's sub-steps (``Viewer.advance``, building the pose included);
 * ``draw``: everything else the viewer does on the CPU in a frame: the pose upload
   (``Renderer.update``), the draw calls (``Renderer.draw``), the panel (``Panel.draw``) and
-  imgui's rendering; ``driver``: the part of it spent inside the two big draw calls (tree
-  mesh; sky and ground): a software rasteriser such as Mesa llvmpipe shades every vertex
-  inside the draw call, a GPU driver only queues it; ``ours`` = ``draw`` − ``driver``;
+  imgui's rendering; ``driver``: the part of it spent inside the draw calls of the tree's
+  parts, the ground, the sky and the background's copy: a software rasteriser such as Mesa
+  llvmpipe shades every vertex inside the draw call, a GPU driver only queues it; ``ours`` =
+  ``draw`` − ``driver``;
 * ``cpu``: the thread's CPU time in ``draw`` (less disturbed by other processes than the wall
   clock; on llvmpipe it excludes the rasteriser's worker threads);
 * ``update``, ``panel``, ``imgui``: wall times of the pose upload, building the panel, and
@@ -89,9 +90,12 @@ def bench_row(win, row: str, frames: int, warmup: int, step: bool = False) -> di
             win.swap()
         t = {k: _Timer() for k in ("sim", "draw", "driver", "update", "panel", "imgui")}
         r = v.renderer
-        if r.vao is not None:
-            r.vao = _TimedVao(r.vao, t["driver"])
-        r.bg_vao = _TimedVao(r.bg_vao, t["driver"])
+        for part in r.parts.values():
+            if part.vao is not None:
+                part.vao = _TimedVao(part.vao, t["driver"])
+        r.sky_vao = _TimedVao(r.sky_vao, t["driver"])
+        r.background_vao = _TimedVao(r.background_vao, t["driver"])
+        r.ground_vaos = [_TimedVao(v, t["driver"]) for v in r.ground_vaos]
         v.advance = t["sim"].wrap(v.advance)
         v.draw = t["draw"].wrap(v.draw)
         r.update = t["update"].wrap(r.update)

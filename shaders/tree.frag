@@ -1,6 +1,8 @@
 #version 330 core
+// One part of the tree (PART: see tree.vert).
 
-#include "common.glsl"
+#include "tree_light.glsl"
+#include "pixel.glsl"
 #include "constants.glsl"
 
 in vec3 v_world;
@@ -12,7 +14,8 @@ flat in int v_material;
 flat in float v_highlight;
 noperspective in float v_edge;
 in float v_half;
-uniform float u_translucency;   // 0: leaves pass no sunlight through
+in vec3 v_light;
+in float v_haze;
 uniform vec4 u_bark;            // furrows around a branch, furrow depth, interlacing, lenticels
 
 out vec4 f_color;
@@ -46,38 +49,27 @@ float tent_integral(float x) {
 }
 
 void main() {
-    if (v_half >= 0.0 && v_material == BARK && !gl_FrontFacing) discard;  // a thin twig, flat: its far half
+    if (PART == PART_BARK && v_half >= 0.0 && !gl_FrontFacing) discard;  // a thin twig, flat: its far half
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;                 // double-sided: laminas, blades
     vec3 V = normalize(u_camera_pos - v_world);
-    float ndl = dot(n, u_sun_dir);
-    bool foliage = v_material != BARK;
+    bool foliage = PART != PART_BARK;
     vec3 albedo = v_albedo;
-    if (v_material == BARK) {
+    if (PART == PART_BARK) {
         albedo *= bark(v_uv);
-    } else if (v_material == LAMINA) {
+    } else if (PART == PART_LEAVES && v_material == LAMINA) {
         // Lamina: a lighter midrib and faint side veins; darker towards the base.
         float ax = abs(v_uv.x);
         float rib = (1.0 - smoothstep(0.008, 0.022, ax)) * step(0.02, v_uv.y) * (1.0 - smoothstep(0.85, 1.0, v_uv.y));
         float side = 1.0 - smoothstep(0.0, 0.07, abs(fract((v_uv.y - 0.9 * ax) * 7.0) - 0.5) - 0.43);
         albedo *= (0.88 + 0.16 * v_uv.y) * (1.0 + 0.45 * rib + 0.12 * side * (1.0 - rib));
-    } else if (v_material == BLADE) {
-        albedo *= 0.85 + 0.3 * (1.0 - abs(v_uv.x));
     }
-    float sun = sun_visibility(v_world, n);
-    vec3 c = albedo * hemisphere(n) * v_ao;
-    c += albedo * u_sun_color * max(ndl, 0.0) * mix(0.55, 1.0, v_ao) * sun;
-    if (foliage) {
-        // Light through the leaf: its unlit face glows in the sun's colour, tinted by the leaf.
-        float back = max(-ndl, 0.0) * (0.55 + 0.45 * pow(max(dot(-V, u_sun_dir), 0.0), 2.0));
-        c += albedo * sqrt(albedo) * u_sun_color * 1.1 * back * v_ao * sun * u_translucency;
-        c += albedo * hemisphere(n) * v_ao * 0.25;   // sky light scattered through the crown
-        vec3 H = normalize(V + u_sun_dir);
-        c += u_sun_color * 0.06 * pow(max(dot(n, H), 0.0), 40.0) * step(0.0, ndl) * sun;
-    }
-    c = mix(c, vec3(1.0, 0.45, 0.05) * 1.5, 0.55 * v_highlight);
+    // A blade is lit at its vertices (tree.vert), and only shaded across here.
+    vec3 c = PART == PART_BLADES ? v_light * (0.85 + 0.3 * (1.0 - abs(v_uv.x)))
+                                 : tree_light(albedo, n, V, v_ao, sun_visibility(v_world, n), foliage, v_highlight);
     // A thin twig or blade: its true width filtered by a tent one pixel either side (pixels
     // a column apart then sum to its width, wherever it falls between them).
-    float cover = v_half < 0.0 ? 1.0 : tent_integral(v_edge + v_half) - tent_integral(v_edge - v_half);
-    f_color = vec4(to_display(apply_haze(c, v_world)).rgb, cover);
+    float cover = PART == PART_LEAVES || v_half < 0.0 ? 1.0 : tent_integral(v_edge + v_half) - tent_integral(v_edge - v_half);
+    float air = PART == PART_BLADES ? v_haze : haze(v_world);
+    f_color = vec4(to_display(mix(c, u_sky_horizon, air)).rgb, cover);
 }

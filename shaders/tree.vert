@@ -1,7 +1,10 @@
 #version 330 core
-// Skinned tree: branch tubes, petioles, laminas and grass blades in one draw.
+// Skinned tree: one part of the mesh (PART, defined by the renderer: PART_LEAVES, petioles and
+// laminas; PART_BARK, branch tubes; PART_BLADES, grass blades). Each part has its own program
+// with only its own code: a software rasteriser runs both sides of every branch.
 
 #include "skin.glsl"
+#include "tree_light.glsl"
 
 in ivec4 in_ids;     // node, prev, object, material
 in vec3 in_offset;   // rest offset from the node
@@ -16,9 +19,6 @@ uniform float u_season;        // 0 summer .. 1 winter
 uniform vec3 u_bark_color;     // sRGB
 uniform float u_pixels_per_metre;  // at one metre from the eye: a length's size on screen
 uniform float u_thin_pixels;       // twigs and blades with a half width below this (px) get soft edges
-uniform vec3 u_camera_pos;
-
-const float THIN_DEPTH = 0.999999;  // where thin twigs are drawn in the depth range (NDC z)
 
 out vec3 v_world;
 out vec3 v_normal;
@@ -29,6 +29,8 @@ flat out int v_material;
 flat out float v_highlight;
 noperspective out float v_edge;  // thin twigs and blades: distance from the axis on screen, px
 out float v_half;                // their true half width on screen, px (< 0: not thin)
+out vec3 v_light;                // blades: their light at the vertex, and ...
+out float v_haze;                // ... the haze over it (see below)
 
 #include "constants.glsl"
 
@@ -72,7 +74,7 @@ void main() {
     v_normal = R * in_normal;
     v_edge = 0.0;
     v_half = -1.0;
-    if (v_material == BARK || v_material == BLADE) {
+    if (PART != PART_LEAVES) {
         // Thinner than a few pixels, a twig or a blade would fall between pixel centres and
         // break into dots that crawl as it sways. It is drawn flat, facing the eye, a pixel
         // wider each side, and tree.frag gives each pixel the share of it the true width
@@ -85,8 +87,8 @@ void main() {
             vec3 axis = node_position(in_ids.x + 1) - node_position(in_ids.x);   // the segment's
             vec3 side = cross(axis, u_camera_pos - centre);
             float k = dot(across, side) / max(metres * length(side), 1e-30);  // -1 .. 1 across the axis
-            float half_px = v_material == BARK ? px : abs(k) * px;            // a blade: as seen
-            float edge = v_material == BARK ? k * (px + 1.0) : sign(k) * (half_px + 1.0);
+            float half_px = PART == PART_BARK ? px : abs(k) * px;            // a blade: as seen
+            float edge = PART == PART_BARK ? k * (px + 1.0) : sign(k) * (half_px + 1.0);
             if (px > 0.0 && length(side) > 0.0) {
                 v_world = centre + normalize(side) * (edge * metres / px);
                 v_edge = edge;
@@ -95,27 +97,40 @@ void main() {
         }
     }
     gl_Position = u_view_proj * vec4(v_world, 1.0);
-    if (v_half >= 0.0 && v_material == BARK) {
+    if (PART == PART_BARK && v_half >= 0.0) {
         // A faint twig writes depth like any surface, so a leaf drawn after it, behind it,
         // would be kept out and the sky show through the twig (streaks across a crown in a
         // gale). Drawn at the back of the depth range instead, it loses to every solid
         // surface, whatever the order: over sky, ground and its own wood it shows, blended;
         // among leaves it fades into them.
-        gl_Position.z = THIN_DEPTH * gl_Position.w;
+        gl_Position.z = DEPTH_THIN * gl_Position.w;
     }
 
     float jitter = in_extra.y;
     float key = in_extra.w;
-    if (v_material == BARK) {
+    if (PART == PART_BARK) {
         v_albedo = lin(u_bark_color) * (0.92 + 0.16 * jitter);
-    } else if (v_material == PETIOLE) {
-        v_albedo = mix(leaf_color(jitter, key), lin(C_PETIOLE), 0.4);
-    } else if (v_material == LAMINA) {
+    } else if (PART == PART_LEAVES) {
         v_albedo = leaf_color(jitter, key);
+        if (v_material == PETIOLE) v_albedo = mix(v_albedo, lin(C_PETIOLE), 0.4);
     } else {
         vec3 base = lin(C_BLADE_BASE);
         vec3 tip = mix(lin(C_BLADE_TIP), lin(C_BLADE_TIP_DRY), jitter);
         vec3 c = mix(base, tip, key);
         v_albedo = mix(c, lin(C_BLADE_WINTER) * (0.6 + 0.4 * key), 0.6 * u_season);
+    }
+    v_light = vec3(0.0);
+    v_haze = 0.0;
+    if (PART == PART_BLADES) {
+        // A blade is lit here, at its vertices (a few rows along it), its shadow looked up here
+        // too, and the light interpolated: a blade is a pixel or two wide, and lighting each of
+        // its pixels would cost a software rasteriser twice as much as all else it does for
+        // them. Its edges, darker than its midrib, are shaded in tree.frag. Leaves and bark are
+        // lit at each pixel.
+        vec3 V = normalize(u_camera_pos - v_world);
+        vec3 n = normalize(v_normal);
+        if (dot(n, V) < 0.0) n = -n;             // double-sided: the face the eye sees
+        v_light = tree_light(v_albedo, n, V, v_ao, sun_visibility(v_world, n), true, v_highlight);
+        v_haze = haze(v_world);
     }
 }

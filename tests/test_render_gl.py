@@ -371,10 +371,10 @@ def test_renderer_frees_what_it_made_when_construction_fails(tree, monkeypatch, 
         monkeypatch.setattr(ctx, name, recording(getattr(ctx, name)))
     load_program = renderer_module.load_program
 
-    def failing_load(c, vertex, *rest):
+    def failing_load(c, vertex, *rest, **kw):
         if fail_at == "line program" and vertex == "line.vert":
             raise RuntimeError("shader program line.vert + line.frag failed to build: (test)")
-        return load_program(c, vertex, *rest)
+        return load_program(c, vertex, *rest, **kw)
 
     def failing_ground(self):
         raise MemoryError("(test)")
@@ -420,3 +420,13 @@ def test_no_gl_errors_after_a_frame(scene):
     off.render(cam, overlays=list(_overlays(r.tree, r).values()))
     with off.ctx:
         assert off.ctx.error == "GL_NO_ERROR"
+
+
+def test_the_depths_the_renderer_draws_at_keep_their_order():
+    """Thin twigs, then the ground over the shadow's footprint, then the rest of the ground, then
+    the sky, each 25 or more steps of a 24-bit depth buffer behind the one before (window depth
+    = (NDC z + 1) / 2)."""
+    from treeanim.render.shaders import DEPTH_FOOTPRINT, DEPTH_GROUND, DEPTH_THIN
+
+    steps = [(z + 1.0) / 2.0 * 2**24 for z in (DEPTH_THIN, DEPTH_FOOTPRINT, DEPTH_GROUND, 1.0)]
+    assert all(b - a >= 25 for a, b in zip(steps, steps[1:])), np.diff(steps)

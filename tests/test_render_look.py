@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import treeanim as ta
-from conftest import rest_pose
+from conftest import _curve, grass_patch, rest_pose
+from treeanim.model.build import ObjectSpec, assemble
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.renderer import Scene
 
@@ -217,3 +218,92 @@ def test_a_thin_twig_in_front_never_opens_a_hole_in_what_is_behind_it(offscreen)
     # There the picture stays the trunk's, far nearer it than the sky.
     assert np.mean(np.abs(both - trunk_only)[where]) < 0.4 * np.mean(np.abs(sky_only - trunk_only)[where])
     assert np.all(np.abs(both - twig_only)[on_twig & ~over_trunk] < 3)  # and over the sky the twig shows
+
+
+# ----------------------------------------------------------------------------- the look's cost
+def inside_convex(polygon, points):
+    """Which ``points`` (P, 2) lie inside the convex ``polygon`` (K, 2), either winding."""
+    edges = np.roll(polygon, -1, axis=0) - polygon
+    rel = points[:, None, :] - polygon[None, :, :]
+    cross = edges[None, :, 0] * rel[..., 1] - edges[None, :, 1] * rel[..., 0]
+    return np.all(cross >= 0, axis=1) | np.all(cross <= 0, axis=1)
+
+
+def test_the_ground_looks_the_shadow_up_only_where_a_shadow_can_fall(offscreen):
+    """The ground reads the shadow map only over the shadow's footprint (issue #13's frame
+    budget), and the picture is the one a lookup everywhere makes, for a tree in a gale under a
+    low sun."""
+    tree = ta.load_preset("small_cherry")
+    sim = ta.Simulation(tree, wind=ta.WindField(speed=25.0, seed=0))
+    for _ in range(45):
+        sim.step(1 / 30)
+    cam = OrbitCamera(target=(-1.0, 0.0, -1.0), distance=9.0, azimuth=30.0, elevation=40.0)
+    offscreen.resize(W, H)
+    r = offscreen.load(tree, scene=Scene(sun_direction=(0.55, 0.4, 0.35)))
+    offscreen.update(sim.positions, sim.rotations, sim.shown)
+    fitted = offscreen.render(cam)
+    footprint = r.shadow.footprint.copy()
+    r.shadow.footprint = np.array([[-1e3, -1e3], [1e3, -1e3], [1e3, 1e3], [-1e3, 1e3]])
+    everywhere = offscreen.render(cam)
+    r.shadow.footprint = np.array([[50.0, 50.0], [51.0, 50.0], [51.0, 51.0]])
+    nowhere = offscreen.render(cam)
+    np.testing.assert_array_equal(fitted, everywhere)
+    assert (luminance(everywhere) < luminance(nowhere) - 12).sum() > 400  # there is a shadow to miss
+    # The footprint holds the tree's foot and its shadow, not the ground 4 m off.
+    xz = np.array([[0.0, 0.0], [-2.0, -1.5], [4.0, 4.0], [-4.0, 4.0], [4.0, -4.0]])
+    assert inside_convex(footprint, xz).tolist() == [True, True, False, False, False]
+
+
+def test_a_blade_in_a_shadow_is_darker(offscreen):
+    """Blades are lit at their vertices (tree.vert): a post's shadow still darkens the blades
+    it falls on, and only those."""
+    blades = grass_patch(n=80, seed=3)
+    post = ObjectSpec(_curve((0.0, 0.0, 0.0), (0.0, 1.0, 0.0), 1.2, 3), np.full(3, 0.35), "branch", 1)
+    specs = [post] + [ObjectSpec(blades.rest_positions[blades.object_nodes(i)], blades.node_diameter[blades.object_nodes(i)],
+                                 "blade", 1) for i in range(blades.n_objects)]
+    tree = assemble(specs, name="post_in_grass")
+    sun = np.array([-0.6, 0.45, 0.65])  # low, from the front left: the blades facing us take it
+    cam = OrbitCamera(target=(0.0, 0.1, 0.0), distance=2.2, azimuth=0.0, elevation=35.0)
+    look = dict(sun_direction=tuple(sun), show_ground=False)  # no ground: only the blades' own light changes
+    only_post = render(offscreen, tree, cam, present=np.asarray(tree.kind) == "branch", **look)
+    lit = render(offscreen, tree, cam, shadow=False, **look)
+    shaded = render(offscreen, tree, cam, shadow=True, **look)
+    blade_px = np.abs(lit.astype(int) - only_post.astype(int)).max(axis=2) > 20
+    # Where the post's shadow falls: within its radius (on screen) of its axis' cast, up to the blades' height.
+    axis = cast_on_ground(np.array([[0.0, y, 0.0] for y in np.linspace(0.0, 1.2, 25)]), sun)
+    cast = cam.project(np.concatenate([axis + [0.0, h, 0.0] for h in (0.0, 0.15, 0.3)]), W, H)[:, :2]
+    radius = np.ptp(cam.project([[-0.175, 0.0, 0.0], [0.175, 0.0, 0.0]], W, H)[:, 0]) / 2
+    gy, gx = np.mgrid[0:H, 0:W]
+    dist = np.min(np.hypot(gx[..., None] - cast[:, 0], gy[..., None] - cast[:, 1]), axis=2)
+    drop = luminance(lit) - luminance(shaded)
+    inside, outside = blade_px & (dist < 0.6 * radius), blade_px & (dist > 2.0 * radius)
+    assert inside.sum() > 50 and outside.sum() > 300
+    assert np.median(drop[inside]) > 4, np.median(drop[inside])  # 0 if blades ignored the shadow map
+    assert np.median(drop[outside]) < 1.5, np.median(drop[outside])
+
+
+def test_the_background_cache_follows_the_camera_the_scene_and_the_size(offscreen, tree):
+    """Sky and ground without shadows are drawn into a cache once the camera, the viewport and
+    the scene hold still for a second frame, and copied from it after: a renderer that drew
+    another view, sun or size just before, or the same one (drawn, cached, copied), draws the
+    picture a fresh one draws (but for the horizon's multisampled edge, one grey level)."""
+
+    def same(a, b):
+        d = np.abs(a.astype(int) - b.astype(int))
+        assert d.max() <= 1 and np.mean(d.max(axis=2) > 0) < 0.01, (d.max(), np.mean(d.max(axis=2) > 0))
+
+    cams = [overhead(tree), OrbitCamera(target=(0.0, 1.0, 0.0), distance=5.0, azimuth=-40.0, elevation=15.0)]
+    suns = [(0.6, 0.75, 0.2), (-0.6, 0.75, -0.1)]
+    fresh = {(c, s): render(offscreen, tree, cams[c], sun_direction=suns[s]) for c in (0, 1) for s in (0, 1)}
+    r = offscreen.load(tree, scene=Scene(sun_direction=suns[0]))
+    offscreen.update(*rest_pose(tree))
+    for c, s in [(0, 0), (1, 0), (1, 0), (1, 0), (0, 0), (0, 0), (0, 1), (0, 1), (0, 1), (1, 1)]:
+        r.scene.sun_direction = suns[s]
+        same(offscreen.render(cams[c]), fresh[c, s])
+    offscreen.resize(W // 2, H // 2)
+    small = [offscreen.render(cams[1]) for _ in range(3)]  # drawn, cached, copied
+    offscreen.load(tree, scene=Scene(sun_direction=suns[1]))
+    offscreen.update(*rest_pose(tree))
+    first = offscreen.render(cams[1])
+    for img in small:
+        same(img, first)

@@ -356,3 +356,17 @@ def test_render_package_exports_lazily():
 
     for name in render.__all__:
         assert getattr(render, name) is not None
+
+
+def test_the_mesh_parts_hold_every_triangle_once(any_tree):
+    """The renderer draws the mesh part by part (mesh.PARTS, a program each): every triangle is
+    in exactly one part, the part of its material."""
+    from treeanim.render.mesh import PARTS
+
+    mesh = build_mesh(any_tree)
+    parts = [mesh.part_indices(name) for name in PARTS]
+    assert sum(len(p) for p in parts) == mesh.triangle_count
+    together = np.concatenate(parts)
+    assert np.array_equal(np.unique(together, axis=0), np.unique(mesh.indices, axis=0))
+    for name, p in zip(PARTS, parts):
+        assert np.isin(mesh.material[p], PARTS[name]).all()

@@ -99,6 +99,10 @@ MATERIAL_PETIOLE = 1
 MATERIAL_LAMINA = 2
 MATERIAL_BLADE = 3
 
+#: The mesh's parts, each drawn by its own shader program (``PART`` in ``shaders/tree.*``), and
+#: the materials each holds: leaves (petioles and laminas), bark, grass blades.
+PARTS = {"LEAVES": (MATERIAL_PETIOLE, MATERIAL_LAMINA), "BARK": (MATERIAL_BARK,), "BLADES": (MATERIAL_BLADE,)}
+
 VERTEX_DTYPE = np.dtype(
     [("ids", "<i4", (4,)), ("offset", "<f4", (3,)), ("normal", "<f4", (3,)), ("extra", "<f4", (4,)),
      ("uv", "<f4", (2,)), ("curve", "<f4", (2,))]
@@ -136,6 +140,21 @@ class TreeMesh:
     def object_triangle_start(self) -> np.ndarray:
         """(M,) int: first row of each object's triangles in :attr:`indices`."""
         return np.concatenate([[0], np.cumsum(self.object_triangles)[:-1]]).astype(np.int64)
+
+    def part_indices(self, part: str) -> np.ndarray:
+        """The triangles of one of the mesh's parts.
+
+        Parameters
+        ----------
+        part : str
+            A key of :data:`PARTS`.
+
+        Returns
+        -------
+        (T', 3) uint32
+            Rows of :attr:`indices` whose material is the part's, in their order there.
+        """
+        return self.indices[np.isin(self.material[self.indices[:, 0]], PARTS[part])]
 
     @property
     def vertex_count(self) -> int:

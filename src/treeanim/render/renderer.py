@@ -13,9 +13,14 @@ texel i at (i mod width, i div width), read with texelFetch):
 - objects, RGBA32F, 1 texel an object: ``(visible, highlight, 0, 0)``; rewritten only when
   the visibility or highlight changes.
 
-Each frame draws the sun's shadow map first (:mod:`treeanim.render.shadow`), then sky and
-ground, then the tree over them (blended: twigs thinner than a pixel are soft lines of their
-true weight), then the overlays.
+Each frame draws the sun's shadow map first (:mod:`treeanim.render.shadow`), then the leaves
+(opaque), the ground over the shadow's footprint and the background (sky and the rest of the
+ground; while the camera is still, a copy of a cache) where the leaves left pixels uncovered,
+then the bark and the grass blades over them (blended: twigs and blades thinner than a pixel
+are soft lines of their true weight), then the overlays. Each part of the mesh
+(``mesh.PARTS``) has its own program, and the ground looks the shadow map up only over the
+shadow's footprint: a software rasteriser such as llvmpipe runs both sides of every branch,
+so code a pixel does not need costs it unless it is left out of that pixel's program.
 """
 
 from __future__ import annotations
@@ -29,13 +34,19 @@ import numpy as np
 
 from ..model.tree import Tree
 from .camera import OrbitCamera
-from .mesh import VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh, build_mesh
+from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh, build_mesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
-from .shaders import load_program
+from .shaders import DEPTH_FOOTPRINT, DEPTH_GROUND, load_program
 from .shadow import ShadowMap, shadow_indices
 
 #: Width in texels of the node and object textures (GL 3.3 guarantees 1024).
 TEXTURE_WIDTH = 1024
+#: The ground's square reaches this many times the eye's height from the eye: out to where a
+#: view ray falls 1e-5 per unit of its length, i.e. to the horizon (ground.frag's limit).
+HORIZON_REACH = 1e5
+#: The ground's polygons are clipped where they come nearer the eye than this (metres, along
+#: the view): they never reach its plane.
+GROUND_NEAR = 1e-4
 
 
 def _lin(rgb) -> tuple[float, float, float]:
@@ -54,6 +65,44 @@ def sun_angles(direction) -> tuple[float, float]:
     d = np.asarray(direction, float)
     d = d / np.linalg.norm(d)
     return math.degrees(math.atan2(d[0], d[2])) % 360.0, math.degrees(math.asin(np.clip(d[1], -1.0, 1.0)))
+
+
+def clip_ground(polygon: np.ndarray, view_proj: np.ndarray, depth: float) -> np.ndarray:
+    """Triangles of a convex polygon on the ground, in clip space, cut where it comes nearer the
+    eye than :data:`GROUND_NEAR` (GL would clip it only at the near plane), drawn at ``depth``.
+
+    Parameters
+    ----------
+    polygon : (K, 2) float
+        Corners (x, z) on the ground y = 0, in order round it.
+    view_proj : (4, 4) float
+        World → clip, as :meth:`OrbitCamera.view_projection` returns it (GLSL's column-major
+        bytes: a point p is ``p @ view_proj``).
+    depth : float
+        Where in the depth range (NDC z) the polygon lies, all of it.
+
+    Returns
+    -------
+    (3 (K' - 2), 4) float32
+        The clipped polygon as a fan of triangles (none if it lies behind the eye).
+    """
+    polygon = np.asarray(polygon, float)
+    world = np.column_stack([polygon[:, 0], np.zeros(len(polygon)), polygon[:, 1], np.ones(len(polygon))])
+    clip = world @ np.asarray(view_proj, float)
+    d = clip[:, 3] - GROUND_NEAR
+    kept = []
+    for i in range(len(clip)):  # Sutherland-Hodgman against w >= GROUND_NEAR
+        j = (i + 1) % len(clip)
+        if d[i] >= 0:
+            kept.append(clip[i])
+        if (d[i] >= 0) != (d[j] >= 0):
+            kept.append(clip[i] + (clip[j] - clip[i]) * (d[i] / (d[i] - d[j])))
+    if len(kept) < 3:
+        return np.zeros((0, 4), np.float32)
+    kept = np.array(kept)
+    kept[:, 2] = depth * kept[:, 3]
+    fan = [(0, k, k + 1) for k in range(1, len(kept) - 1)]
+    return kept.astype(np.float32)[np.ravel(fan)]
 
 
 def _bound_framebuffer(ctx: moderngl.Context) -> moderngl.Framebuffer:
@@ -81,6 +130,21 @@ class Scene:
     shadow_size: int = 1024             # shadow-map texels a side (read when the renderer is made)
     translucency: float = 1.0           # sunlight through the leaves (0: opaque leaves)
     thin_pixels: float = 1.5            # twigs and blades of a half width below this (px) get soft edges (0: none)
+
+
+@dataclass
+class _Part:
+    """One part of the mesh (``mesh.PARTS``): its program, and its triangles' range in the
+    renderer's index buffer."""
+
+    prog: moderngl.Program
+    vao: moderngl.VertexArray | None
+    first: int
+    count: int
+
+    def render(self) -> None:
+        if self.count:
+            self.vao.render(moderngl.TRIANGLES, vertices=self.count, first=self.first)
 
 
 class _Lines:
@@ -126,23 +190,38 @@ class Renderer:
         self._released = False
         # Every GL object starts as None, so that release() can free whatever was made before a
         # failure part-way through (a shader that does not compile, an out-of-memory buffer).
-        self.tree_prog = self.bg_prog = self.line_prog = None
-        self.vbo = self.ibo = self.vao = self.bg_vao = None
+        self.line_prog = self.sky_prog = None
+        self.ground_progs: list[moderngl.Program] = []
+        self.parts: dict[str, _Part] = {}
+        self.vbo = self.ibo = self.sky_vao = self.ground_vbo = None
+        self.background_prog = self.background_vao = self.background_texture = self.background_fbo = None
+        self.background_depth = None
+        self._background_key: tuple | None = None  # the view the cache holds
+        self._last_view: tuple | None = None        # the last frame's
+        self.ground_vaos: list[moderngl.VertexArray] = []
         self.node_texture = self.object_texture = None
         self.shadow: ShadowMap | None = None
         self._lines: dict[int, _Lines] = {}
         try:
-            self.tree_prog = load_program(ctx, "tree.vert", "tree.frag")
-            self.bg_prog = load_program(ctx, "background.vert", "background.frag")
+            self.sky_prog = load_program(ctx, "sky.vert", "sky.frag")
+            for shadowed in (0, 1):  # off and over the shadow's footprint
+                self.ground_progs.append(load_program(ctx, "ground.vert", "ground.frag", defines={"SUN_SHADOW": shadowed}))
+            self.background_prog = load_program(ctx, "sky.vert", "background.frag")
             self.line_prog = load_program(ctx, "line.vert", "line.frag", "line_geom.glsl")
 
-            # --- static mesh
+            # --- static mesh: one index buffer, part after part
+            tris = [self.mesh.part_indices(name) for name in PARTS]
             if self.mesh.triangle_count:
                 self.vbo = ctx.buffer(self.mesh.vertices.tobytes())
-                self.ibo = ctx.buffer(self.mesh.indices.tobytes())
-                self.vao = ctx.vertex_array(self.tree_prog, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRIBUTES)],
-                                            index_buffer=self.ibo, index_element_size=4)
-            self._n_indices = 3 * self.mesh.triangle_count
+                self.ibo = ctx.buffer(np.concatenate(tris).tobytes())
+            first = 0
+            for k, (name, t) in enumerate(zip(PARTS, tris)):
+                part = self.parts[name] = _Part(load_program(ctx, "tree.vert", "tree.frag", defines={"PART": k}),
+                                                None, first, 3 * len(t))
+                if part.count:
+                    part.vao = ctx.vertex_array(part.prog, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRIBUTES)],
+                                                index_buffer=self.ibo, index_element_size=4)
+                first += part.count
             bound = _bound_framebuffer(ctx)
             self.shadow = ShadowMap(ctx, self.vbo, shadow_indices(self.mesh, tree), self.scene.shadow_size)
             bound.use()  # making the map's framebuffer bound it
@@ -159,16 +238,19 @@ class Renderer:
             for tex in (self.node_texture, self.object_texture):
                 tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
                 tex.repeat_x = tex.repeat_y = False
-            for prog in (self.tree_prog, self.line_prog):
+            for prog in (*self.tree_progs, self.line_prog, self.shadow.prog):
                 self._uniform(prog, "u_nodes", 0)
-            self._uniform(self.tree_prog, "u_objects", 1)
-            self._uniform(self.shadow.prog, "u_objects", 1)
-            self._uniform(self.shadow.prog, "u_nodes", 0)
-            for prog in (self.tree_prog, self.bg_prog):
+                self._uniform(prog, "u_objects", 1)
+            for prog in (*self.tree_progs, *self.ground_progs):
                 self._uniform(prog, "u_shadow_map", 2)
 
-            # --- sky and ground: one full-screen triangle
-            self.bg_vao = ctx.vertex_array(self.bg_prog, [])
+            # --- sky and background: a full-screen triangle; ground: polygons in clip space
+            self.sky_vao = ctx.vertex_array(self.sky_prog, [])
+            self.background_vao = ctx.vertex_array(self.background_prog, [])
+            self._uniform(self.background_prog, "u_background", 3)
+            self.ground_vbo = ctx.buffer(reserve=4096, dynamic=True)
+            for prog in self.ground_progs:
+                self.ground_vaos.append(ctx.vertex_array(prog, [(self.ground_vbo, "4f", "in_clip")]))
             self._place_ground()
 
             self._present: np.ndarray | None = None  # None: derived from the season at draw time
@@ -181,6 +263,16 @@ class Renderer:
             raise
 
     # ------------------------------------------------------------------ helpers
+    @property
+    def tree_progs(self) -> list[moderngl.Program]:
+        """The programs of the mesh's parts."""
+        return [p.prog for p in self.parts.values()]
+
+    @property
+    def lit_progs(self) -> list[moderngl.Program]:
+        """Every program that lights a surface (``common.glsl``'s uniforms)."""
+        return [*self.tree_progs, *self.ground_progs, self.sky_prog]
+
     @staticmethod
     def _uniform(prog: moderngl.Program, name: str, value) -> None:
         u = prog.get(name, None)
@@ -193,12 +285,16 @@ class Renderer:
             if u is not None:
                 u.write(data)
 
+    @property
+    def pad(self) -> float:
+        """How far the tree's surface reaches beyond its nodes (metres): a lamina's length plus
+        half the thickest diameter."""
+        return float(np.max(self.tree.lamina_length, initial=0.0)) + 0.5 * float(np.max(self.tree.node_diameter))
+
     def bounds(self, positions: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
         """Axis-aligned box of the tree (nodes, plus the leaves' laminas), world."""
         P = self.tree.rest_positions if positions is None else np.asarray(positions)
-        lo, hi = P.min(axis=0), P.max(axis=0)
-        pad = float(np.max(self.tree.lamina_length, initial=0.0)) + 0.5 * float(np.max(self.tree.node_diameter))
-        return lo - pad, hi + pad
+        return P.min(axis=0) - self.pad, P.max(axis=0) + self.pad
 
     def _place_ground(self) -> None:
         tree = self.tree
@@ -237,29 +333,29 @@ class Renderer:
             "u_haze_distance": float(s.haze_distance or max(40.0 * self.size, 60.0)),
             "u_exposure": float(s.exposure),
         }
-        for prog in (self.tree_prog, self.bg_prog):
+        for prog in self.lit_progs:
             for k, v in lit.items():
                 self._uniform(prog, k, v)
-        g = self.bg_prog
-        self._uniform(g, "u_show_sky", int(s.show_sky))
-        self._uniform(g, "u_show_ground", int(s.show_ground))
-        self._uniform(g, "u_ground_centre", tuple(self.ground_centre))
-        self._uniform(g, "u_earth_radius", float(self.earth_radius))
+        self._uniform(self.sky_prog, "u_show_sky", int(s.show_sky))
         c = self.crown_centre  # the crown hides the sky straight above the ground under it
-        self._uniform(g, "u_occlusion_centre", (float(c[0]), 0.0, float(c[2])))
-        self._uniform(g, "u_occlusion_radius", float(self.occlusion_radius if s.shadow else 0.0))
-        self._uniform(g, "u_trunk_radius", float(self.trunk_radius if s.shadow else 0.0))
-        self._uniform(g, "u_grid", float(s.ground_grid))
-        self._uniform(self.tree_prog, "u_translucency", float(s.translucency))
+        for g in self.ground_progs:
+            self._uniform(g, "u_ground_centre", tuple(self.ground_centre))
+            self._uniform(g, "u_earth_radius", float(self.earth_radius))
+            self._uniform(g, "u_occlusion_centre", (float(c[0]), 0.0, float(c[2])))
+            self._uniform(g, "u_occlusion_radius", float(self.occlusion_radius if s.shadow else 0.0))
+            self._uniform(g, "u_trunk_radius", float(self.trunk_radius if s.shadow else 0.0))
+            self._uniform(g, "u_grid", float(s.ground_grid))
         bark = self.tree.bark
-        self._uniform(self.tree_prog, "u_bark_color", tuple(float(c) for c in bark.color))
-        self._uniform(self.tree_prog, "u_bark", (float(bark.furrows), float(bark.depth), float(bark.interlace),
-                                                 float(bark.lenticels)))
+        for prog in self.tree_progs:
+            self._uniform(prog, "u_translucency", float(s.translucency))
+            self._uniform(prog, "u_bark_color", tuple(float(c) for c in bark.color))
+            self._uniform(prog, "u_bark", (float(bark.furrows), float(bark.depth), float(bark.interlace),
+                                           float(bark.lenticels)))
         if s.shadow:
-            self.shadow.fit(sun, *self.bounds())
+            self.shadow.fit(sun, *self.bounds(), self.tree.rest_positions, self.pad)
         else:
             self.shadow.clear()
-        for prog in (self.tree_prog, self.bg_prog):
+        for prog in self.lit_progs:
             self._uniform(prog, "u_shadow_on", int(s.shadow))
             self._uniform(prog, "u_shadow_texel", float(self.shadow.texel))
             self._write((prog,), "u_light_view_proj", self.shadow.matrix.tobytes())
@@ -346,38 +442,111 @@ class Renderer:
         if self.scene.shadow:
             ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
             self.shadow.draw()
-        target.use()
-        ctx.viewport = (0, 0, width, height)
-
         vp = camera.view_projection(width, height)
         vp_bytes = vp.tobytes()
         eye = tuple(float(x) for x in camera.eye)
-        self._write((self.tree_prog, self.line_prog), "u_view_proj", vp_bytes)
-        for prog in (self.tree_prog, self.bg_prog):
+        inv_bytes = np.linalg.inv(vp.astype(np.float64)).astype(np.float32).tobytes()
+        self._write((*self.tree_progs, self.line_prog), "u_view_proj", vp_bytes)
+        for prog in self.lit_progs:
             self._uniform(prog, "u_camera_pos", eye)
-        self._uniform(self.tree_prog, "u_season", season)
-        self._uniform(self.tree_prog, "u_pixels_per_metre", 0.5 * height / math.tan(math.radians(camera.fov_y) / 2))
-        self._uniform(self.tree_prog, "u_thin_pixels", float(self.scene.thin_pixels))
+        for prog in (*self.ground_progs, self.sky_prog):
+            self._write((prog,), "u_inv_view_proj", inv_bytes)
+            self._uniform(prog, "u_viewport", (float(width), float(height)))
+        for prog in self.tree_progs:
+            self._uniform(prog, "u_season", season)
+            self._uniform(prog, "u_pixels_per_metre", 0.5 * height / math.tan(math.radians(camera.fov_y) / 2))
+            self._uniform(prog, "u_thin_pixels", float(self.scene.thin_pixels))
+        cached = self._cache_background(camera, vp, width, height)
+        target.use()
+        ctx.viewport = (0, 0, width, height)
 
         s = self.scene
         hz = _lin(s.sky_horizon)
         ctx.clear(hz[0] ** (1 / 2.2), hz[1] ** (1 / 2.2), hz[2] ** (1 / 2.2), 1.0, depth=1.0)
-        ctx.disable(moderngl.CULL_FACE | moderngl.BLEND | moderngl.DEPTH_TEST)
-        # Sky and ground first (no depth): the tree's faint thin twigs blend over them.
-        self.bg_prog["u_inv_view_proj"].write(np.linalg.inv(vp.astype(np.float64)).astype(np.float32).tobytes())
-        self.shadow.texture.use(2)
-        self.bg_vao.render(moderngl.TRIANGLES, vertices=3)
+        ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
-        if self.vao is not None:  # blended: twigs thinner than a pixel are drawn faint
-            ctx.enable(moderngl.BLEND)
-            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
-            self.vao.render(moderngl.TRIANGLES, vertices=self._n_indices)
-            ctx.disable(moderngl.BLEND)
+        self.shadow.texture.use(2)
+        # The leaves first: solid, so the ground and sky under them are never shaded. Then the
+        # ground over the shadow's footprint, with its shadow, and where neither was drawn the
+        # background: sky and the rest of the ground (a copy of the cache, or drawn here).
+        self.parts["LEAVES"].render()
+        if s.shadow and self._ground_shown(camera):
+            self._ground(self.ground_vaos[1], self.shadow.footprint, vp, DEPTH_FOOTPRINT)
+        if cached:
+            ctx.depth_func = "<="
+            self.background_texture.use(3)
+            self.background_vao.render(moderngl.TRIANGLES, vertices=3)
+            ctx.depth_func = "<"
+        else:
+            self._draw_background(camera, vp)
+        # Blended: twigs and blades thinner than a pixel are drawn faint over what lies behind.
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+        self.parts["BARK"].render()
+        self.parts["BLADES"].render()
+        ctx.disable(moderngl.BLEND)
         overlays = [o for o in overlays if o is not None]
         if overlays:
             self._draw_overlays(overlays, width, height)
         self._collect_lines({id(o) for o in overlays})
+
+    def _ground_shown(self, camera: OrbitCamera) -> bool:
+        return bool(self.scene.show_ground and camera.eye[1] > 0.0)
+
+    def _ground(self, vao: moderngl.VertexArray, polygon: np.ndarray, vp: np.ndarray, depth: float) -> None:
+        """One convex polygon of the ground ((K, 2) corners x, z), drawn by ``vao``'s program at
+        ``depth`` (NDC z)."""
+        tris = clip_ground(polygon, vp, depth)
+        if len(tris):
+            if self.ground_vbo.size < tris.nbytes:
+                self.ground_vbo.orphan(2 * tris.nbytes)
+            self.ground_vbo.write(tris.tobytes())
+            vao.render(moderngl.TRIANGLES, vertices=len(tris))
+
+    def _draw_background(self, camera: OrbitCamera, vp: np.ndarray) -> None:
+        """The background, where nothing was drawn yet (depth test on): the ground without
+        shadows, a square out to the horizon round the eye, behind the footprint's, then the
+        sky at the far plane."""
+        if self._ground_shown(camera):
+            eye = np.asarray(camera.eye, float)
+            square = eye[[0, 2]] + HORIZON_REACH * eye[1] * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
+            self._ground(self.ground_vaos[0], square, vp, DEPTH_GROUND)
+        self.ctx.depth_func = "<="
+        self.sky_vao.render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.depth_func = "<"
+
+    def _cache_background(self, camera: OrbitCamera, vp: np.ndarray, width: int, height: int) -> bool:
+        """Whether the background cache holds this frame's background; drawn into it on the
+        second frame in a row with the same viewport, camera and scene. Neither sky nor the
+        ground without shadows moves with the tree, so while the camera is still each frame
+        copies them (a copy costs llvmpipe a fifth of shading them); while it moves they are
+        drawn in the frame as before, so a moving camera pays nothing for the cache."""
+        key = (width, height, vp.tobytes(), tuple(camera.eye), self._applied_scene)
+        if key == self._background_key:
+            return True
+        if key != self._last_view:
+            self._last_view = key
+            return False
+        ctx = self.ctx
+        if self.background_texture is None or self.background_texture.size != (width, height):
+            for o in (self.background_fbo, self.background_depth, self.background_texture):
+                if o is not None:
+                    o.release()
+            self.background_fbo = self.background_depth = None  # made next: released again if that fails
+            self.background_texture = ctx.texture((width, height), 4)
+            self.background_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.background_depth = ctx.depth_renderbuffer((width, height))
+            self.background_fbo = ctx.framebuffer(self.background_texture, self.background_depth)
+        self.background_fbo.use()
+        ctx.viewport = (0, 0, width, height)
+        self.background_fbo.clear(depth=1.0)
+        ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<"
+        self._draw_background(camera, vp)
+        self._background_key = key
+        return True
 
     # ------------------------------------------------------------------ overlays
     def _draw_overlays(self, overlays, width: int, height: int) -> None:
@@ -428,7 +597,10 @@ class Renderer:
         self._lines.clear()
         if self.shadow is not None:
             self.shadow.release()
-        for o in (self.vao, self.vbo, self.ibo, self.bg_vao, self.node_texture, self.object_texture,
-                  self.tree_prog, self.bg_prog, self.line_prog):
+        for o in (*[p.vao for p in self.parts.values()], *self.tree_progs, self.vbo, self.ibo, self.sky_vao,
+                  *self.ground_vaos, self.ground_vbo, self.node_texture, self.object_texture, self.sky_prog,
+                  *self.ground_progs, self.background_vao, self.background_fbo, self.background_texture,
+                  self.background_depth,
+                  self.background_prog, self.line_prog):
             if o is not None:
                 o.release()

@@ -12,6 +12,14 @@ from importlib.resources import files
 
 import moderngl
 
+#: Where the renderer draws in the depth range (NDC z), behind every surface of the tree: twigs
+#: thinner than a few pixels (they lose to every solid surface, see shaders/tree.vert), then the
+#: ground over the shadow's footprint, then the rest of the ground (the sky: 1). Each 25 steps
+#: or more of a 24-bit depth buffer from the next, far above the rounding of their interpolation.
+DEPTH_THIN = 0.99999
+DEPTH_FOOTPRINT = 0.999994
+DEPTH_GROUND = 0.999997
+
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$', re.MULTILINE)
 
 
@@ -32,23 +40,52 @@ def shader_source(name: str) -> str:
 
 
 def constants_glsl() -> str:
-    """GLSL constants generated from Python: the materials of :mod:`treeanim.render.mesh` and
+    """GLSL constants generated from Python: the materials and parts of
+    :mod:`treeanim.render.mesh` (``PART_`` + name, numbered in order), ``DEPTH_THIN`` and
     the colours of :mod:`treeanim.render.palette` (sRGB, as ``C_`` + name)."""
     from . import mesh, palette
 
     names = ("BARK", "PETIOLE", "LAMINA", "BLADE")
     lines = [f"const int {n} = {getattr(mesh, 'MATERIAL_' + n)};" for n in names]
+    lines += [f"const int PART_{n} = {i};" for i, n in enumerate(mesh.PARTS)]
+    lines.append(f"const float DEPTH_THIN = {DEPTH_THIN!r};")
     lines += [f"const vec3 C_{n} = vec3({r!r}, {g!r}, {b!r});" for n, (r, g, b) in palette.COLOURS.items()]
     return "\n".join(lines) + "\n"
 
 
-def load_program(ctx: moderngl.Context, vertex: str, fragment: str, geometry: str | None = None) -> moderngl.Program:
-    """Compile and link a program from shader file names (e.g. ``"tree.vert"``)."""
+def with_defines(source: str, defines: dict | None) -> str:
+    """A shader's variant: ``source`` with a ``#define NAME value`` line for each item of
+    ``defines`` after its ``#version`` line (conditions on them fold away when compiled).
+
+    Parameters
+    ----------
+    source : str
+        GLSL, its first line ``#version ...`` (else the defines go first).
+    defines : dict or None
+        Name: value (written with ``str``).
+
+    Returns
+    -------
+    str
+    """
+    if not defines:
+        return source
+    head, sep, rest = source.partition("\n")
+    if not head.startswith("#version"):
+        head, sep, rest = "", "", source
+    lines = "".join(f"#define {k} {v}\n" for k, v in defines.items())
+    return head + sep + lines + rest
+
+
+def load_program(ctx: moderngl.Context, vertex: str, fragment: str, geometry: str | None = None,
+                 defines: dict | None = None) -> moderngl.Program:
+    """Compile and link a program from shader file names (e.g. ``"tree.vert"``), with
+    ``defines`` (name: value) set in every stage."""
     try:
         return ctx.program(
-            vertex_shader=shader_source(vertex),
-            fragment_shader=shader_source(fragment),
-            geometry_shader=shader_source(geometry) if geometry else None,
+            vertex_shader=with_defines(shader_source(vertex), defines),
+            fragment_shader=with_defines(shader_source(fragment), defines),
+            geometry_shader=with_defines(shader_source(geometry), defines) if geometry else None,
         )
     except moderngl.Error as exc:
         raise RuntimeError(f"shader program {vertex} + {fragment} failed to build: {exc}") from exc

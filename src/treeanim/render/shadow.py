@@ -4,13 +4,15 @@ scene, and sampled with percentage-closer filtering by the tree and the ground
 
 The sun's orthographic view is fitted once per sun direction to a box round the tree that
 leaves room for it to sway, and to that box's shadow on the ground: the map's texels stay
-fixed in the world while the tree moves (no swimming edges).
+fixed in the world while the tree moves (no swimming edges). The ground looks the map up only
+inside :attr:`ShadowMap.footprint`, the polygon that holds every shadow the box can cast.
 """
 
 from __future__ import annotations
 
 import moderngl
 import numpy as np
+from scipy.spatial import ConvexHull, QhullError
 
 from ..model.lamina import ear_clip
 from ..model.tree import Tree
@@ -19,13 +21,18 @@ from .shaders import load_program
 
 #: Attributes the shadow pass reads; the rest of each vertex is skipped.
 SHADOW_ATTRIBUTES = ("in_ids", "in_offset", "in_extra", "in_curve")
-#: The box round the tree at rest grows by this fraction of its size each way (sway room).
+#: The box round the tree at rest grows by this fraction of its size each way (sway room), but
+#: by no more than its height (nothing sways further than it stands tall: a meadow's box grows
+#: by a blade's length, not by 15 % of the meadow's width).
 SWAY_MARGIN = 0.15
 #: The lowest sun elevation the map is fitted for (sin of it): lower suns cast the shadow of
 #: a sun at this height, not an endless one.
 MIN_SUN_HEIGHT = 0.15
 #: Corners of a lamina's outline kept for its shadow (its teeth are far below a texel).
 SHADOW_LAMINA_CORNERS = 12
+#: The footprint reaches this many shadow-map texels beyond the box's shadow: the reach of a
+#: ground point's lookup (its offset off the ground and the filter's taps, ``shaders/common.glsl``).
+FOOTPRINT_TEXELS = 4.0
 
 
 def _skipping_format() -> str:
@@ -65,6 +72,74 @@ def shadow_indices(mesh: TreeMesh, tree: Tree) -> np.ndarray:
     return np.ascontiguousarray(np.concatenate(keep), dtype=np.uint32)
 
 
+def cast_direction(sun) -> np.ndarray:
+    """The sun the map is made for: ``sun``, or where it is lower than :data:`MIN_SUN_HEIGHT`,
+    a sun at that height in the same azimuth (its shadows stay on a finite ground).
+
+    Parameters
+    ----------
+    sun : (3,) float
+        Towards the sun (any length).
+
+    Returns
+    -------
+    (3,) float
+        Unit vector towards the sun the shadows are cast from.
+    """
+    sun = np.asarray(sun, float)
+    sun = sun / np.linalg.norm(sun)
+    if sun[1] < MIN_SUN_HEIGHT:
+        h = np.hypot(sun[0], sun[2])
+        flat = sun[[0, 2]] / h if h > 0 else np.array([1.0, 0.0])
+        c = np.sqrt(1.0 - MIN_SUN_HEIGHT**2)
+        sun = np.array([c * flat[0], MIN_SUN_HEIGHT, c * flat[1]])
+    return sun
+
+
+def _box_and_shadow(sun: np.ndarray, lo, hi) -> tuple[np.ndarray, np.ndarray]:
+    """The 8 corners of the box ``lo`` .. ``hi`` and their shadows on the ground y = 0 (corners
+    below the ground stand for the ground under them)."""
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    return corners, _shadow(sun, corners)
+
+
+def _shadow(sun: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Shadows on the ground y = 0 of ``points`` (points below the ground: the ground under them)."""
+    return points - np.outer(np.maximum(points[:, 1], 0.0) / sun[1], sun)
+
+
+def ground_footprint(sun, points, reach: float) -> np.ndarray:
+    """Where on the ground y = 0 anything within ``reach`` of ``points`` can cast its shadow.
+
+    Parameters
+    ----------
+    sun : (3,) float
+        Towards the sun (made :func:`cast_direction`).
+    points : (P, 3) float
+        The casters (a tree's nodes at rest).
+    reach : float
+        How far from a point its surface may be, or sway to (metres; each axis).
+
+    Returns
+    -------
+    (K, 2) float
+        The convex polygon (x, z), in order round it: the hull of the shadows of the segments
+        from ``reach`` below each point to ``reach`` above it, widened by ``reach`` along x and z
+        (a shadow is a linear map of its caster, so the shadow of the box round each point falls
+        inside).
+    """
+    sun = cast_direction(sun)
+    points = np.asarray(points, float)
+    ends = np.concatenate([points - [0.0, reach, 0.0], points + [0.0, reach, 0.0]])
+    xz = _shadow(sun, ends)[:, [0, 2]]
+    try:
+        xz = xz[ConvexHull(xz).vertices]
+    except QhullError:  # all in a line (one straight beam): the widening below makes it 2-D
+        pass
+    xz = (xz[:, None, :] + reach * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])).reshape(-1, 2)
+    return xz[ConvexHull(xz).vertices]
+
+
 def light_view_projection(sun: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, float]:
     """The sun's orthographic view-projection for a tree in the box ``lo`` .. ``hi``.
 
@@ -82,20 +157,13 @@ def light_view_projection(sun: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tu
     extent : float
         The larger side of the map's footprint (metres), for the texel size.
     """
-    sun = np.asarray(sun, float)
-    sun = sun / np.linalg.norm(sun)
-    if sun[1] < MIN_SUN_HEIGHT:  # keep the shadow on a finite ground
-        h = np.hypot(sun[0], sun[2])
-        flat = sun[[0, 2]] / h if h > 0 else np.array([1.0, 0.0])
-        c = np.sqrt(1.0 - MIN_SUN_HEIGHT**2)
-        sun = np.array([c * flat[0], MIN_SUN_HEIGHT, c * flat[1]])
+    sun = cast_direction(sun)
     forward = -sun  # the sun looks along -sun
     up = np.array([0.0, 1.0, 0.0]) if abs(sun[1]) < 0.99 else np.array([0.0, 0.0, 1.0])
     right = np.cross(forward, up)
     right /= np.linalg.norm(right)
     up = np.cross(right, forward)
-    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
-    ground = corners - np.outer(np.maximum(corners[:, 1], 0.0) / sun[1], sun)  # their shadows at y = 0
+    corners, ground = _box_and_shadow(sun, lo, hi)
     pts = np.vstack([corners, ground])
     x, y, d = pts @ right, pts @ up, pts @ forward  # d: distance along the sun's rays
     x0, x1, y0, y1 = x.min(), x.max(), y.min(), y.max()
@@ -146,19 +214,24 @@ class ShadowMap:
             raise
         self.matrix = np.eye(4, dtype=np.float32)
         self.texel = 1.0
+        self.footprint = np.zeros((0, 2))
         self._fitted: tuple | None = None
         self.clear()
 
-    def fit(self, sun, lo, hi) -> None:
-        """Fit the sun's view to the box ``lo`` .. ``hi`` grown by :data:`SWAY_MARGIN` (cached)."""
+    def fit(self, sun, lo, hi, points, pad: float) -> None:
+        """Fit the sun's view to the box ``lo`` .. ``hi`` grown by :data:`SWAY_MARGIN` (cached),
+        and the ground's :attr:`footprint` to the tree's ``points`` (its nodes at rest) grown by
+        the same and by ``pad`` (how far its surface reaches beyond them)."""
         key = (tuple(np.round(sun, 9)), tuple(lo), tuple(hi))
         if key == self._fitted:
             return
         self._fitted = key
         lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-        grow = SWAY_MARGIN * (hi - lo).max()
+        grow = min(SWAY_MARGIN * (hi - lo).max(), hi[1] - lo[1])
         self.matrix, extent = light_view_projection(sun, lo - grow, hi + grow)
         self.texel = extent / self.size
+        reach = grow + pad + FOOTPRINT_TEXELS * self.texel / cast_direction(sun)[1]  # texels long on the ground
+        self.footprint = ground_footprint(sun, points, reach)
         self.prog["u_light_view_proj"].write(self.matrix.tobytes())
 
     def clear(self) -> None:

@@ -1,0 +1,56 @@
+#version 330 core
+// The ground plane y = 0 found by casting each pixel's view ray: grass with soft variation, bare
+// earth round the trunk, the sky the crown hides and a contact shadow at the trunk's foot, an
+// optional 1 m grid, hazed into the horizon. With SUN_SHADOW 1 (the program the renderer draws
+// over the shadow's footprint only) also the tree's shadow from the sun's shadow map.
+
+#include "common.glsl"
+#include "pixel.glsl"
+
+uniform vec3 u_ground_centre;   // the trunk's foot
+uniform float u_earth_radius;   // bare earth around the trunk (0: none)
+uniform vec3 u_occlusion_centre;  // below the crown's centre: the sky is hidden there
+uniform float u_occlusion_radius; // 0: none
+uniform float u_trunk_radius;     // contact shadow round the trunk's foot (0: none)
+uniform float u_grid;           // 0: no grid; else grid line strength (1 m cells)
+out vec4 f_color;
+
+vec3 ground_color(vec2 xz, float fade) {
+    float n1 = vnoise(xz * 0.23);
+    float n2 = vnoise(xz * 1.9 + 17.0);
+    float fine = vnoise(xz * 9.0 + 3.0);
+    vec3 grass = mix(srgb_to_linear(vec3(0.25, 0.39, 0.12)), srgb_to_linear(vec3(0.33, 0.45, 0.15)), n1);
+    grass *= (0.9 + 0.2 * n2) * (1.0 + 0.18 * (fine - 0.5) * fade);
+    vec3 earth = srgb_to_linear(vec3(0.36, 0.28, 0.19)) * (0.85 + 0.3 * n2);
+    float r = length(xz - u_ground_centre.xz);
+    float bare = 1.0 - smoothstep(0.4 * u_earth_radius, u_earth_radius, r + 0.3 * u_earth_radius * (n2 - 0.5));
+    vec3 albedo = mix(grass, earth, bare * step(1e-6, u_earth_radius));
+
+    vec3 up = vec3(0.0, 1.0, 0.0);
+#if SUN_SHADOW
+    float sun = sun_visibility(vec3(xz.x, 0.0, xz.y), up);
+#else
+    float sun = 1.0;   // off the footprint: nothing casts a shadow here
+#endif
+    float ds = length(xz - u_occlusion_centre.xz) / max(u_occlusion_radius, 1e-6);
+    float sky = 1.0 - 0.45 * exp(-2.0 * ds * ds) * step(1e-6, u_occlusion_radius);
+    float dt = max(r - u_trunk_radius, 0.0) / max(1.5 * u_trunk_radius, 1e-6);
+    float contact = 1.0 - 0.6 * exp(-dt * dt) * step(1e-6, u_trunk_radius);
+    vec3 light = hemisphere(up) * sky + u_sun_color * max(u_sun_dir.y, 0.0) * sun;
+    return albedo * light * contact;
+}
+
+void main() {
+    vec3 dir = pixel_ray();
+    float t = u_camera_pos.y / max(-dir.y, 1e-5);
+    vec2 xz = u_camera_pos.xz + min(t, 1e5) * dir.xz;
+    vec2 fw = fwidth(xz);
+    float fade = 1.0 - smoothstep(0.05, 0.2, length(fw) * 0.9);   // no shimmer far away
+    vec3 c = ground_color(xz, fade);
+    if (u_grid > 0.0) {
+        vec2 g = abs(fract(xz - 0.5) - 0.5) / max(fw, vec2(1e-6));
+        float line = (1.0 - min(min(g.x, g.y), 1.0)) * fade;
+        c = mix(c, c * 1.6 + 0.02, u_grid * line);
+    }
+    f_color = to_display(apply_haze(c, vec3(xz.x, 0.0, xz.y)));
+}

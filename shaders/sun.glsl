@@ -1,0 +1,27 @@
+// The sun and its shadow map: how much of the sun reaches a point (any shader stage).
+
+uniform vec3 u_sun_dir;                // unit, towards the sun
+uniform sampler2DShadow u_shadow_map;  // depth seen from the sun (render/shadow.py)
+uniform mat4 u_light_view_proj;        // world -> the shadow map's clip space
+uniform int u_shadow_on;               // 0: everything in sunlight
+uniform float u_shadow_texel;          // one shadow-map texel, metres
+
+// Where `world` (normal `n`) falls in the shadow map: pushed off the surface towards the sun's
+// side by a texel and a half, so a surface never shadows itself (acne) and a leaf lit from
+// behind is looked up on its lit face.
+vec3 shadow_coord(vec3 world, vec3 n) {
+    vec3 towards = dot(n, u_sun_dir) < 0.0 ? -n : n;
+    vec4 p = u_light_view_proj * vec4(world + 1.5 * u_shadow_texel * towards + 0.5 * u_shadow_texel * u_sun_dir, 1.0);
+    return p.xyz / p.w * 0.5 + 0.5;
+}
+
+// How much of the sun reaches a surface (0 shadowed .. 1 lit): percentage-closer filtering,
+// four bilinear taps a texel apart (a soft edge about three texels wide). A software rasteriser
+// runs every branch, so there is no early exit for pixels off the map or with shadows off.
+float sun_visibility(vec3 world, vec3 n) {
+    vec3 s = shadow_coord(world, n);
+    vec2 d = 0.5 / vec2(textureSize(u_shadow_map, 0));
+    float lit = 0.25 * (texture(u_shadow_map, vec3(s.x - d.x, s.y - d.y, s.z)) + texture(u_shadow_map, vec3(s.x + d.x, s.y - d.y, s.z))
+                      + texture(u_shadow_map, vec3(s.x - d.x, s.y + d.y, s.z)) + texture(u_shadow_map, vec3(s.x + d.x, s.y + d.y, s.z)));
+    return u_shadow_on == 0 || s.z >= 1.0 ? 1.0 : lit;
+}
