@@ -27,20 +27,38 @@ import statistics
 import time
 
 
-def measure(key: str, off, frames: int, orbit: float = 0.0) -> tuple[float, float]:
-    """(median wall ms, median CPU ms) of ``frames`` frames of ``key``'s bench row, the camera
-    turned by ``orbit`` degrees about the tree before each frame."""
-    import treeanim as ta
-    from treeanim import offline
+def _this_version():
+    """(the bench's rows, framed_camera) wherever this version of treeanim keeps them."""
+    try:
+        from treeanim.render.camera import framed_camera
+        from treeanim.table1 import ROWS
+    except ImportError:  # before issue #15: both in offline.py
+        from treeanim import offline
 
-    rows = getattr(offline, "ROWS", None) or getattr(offline, "BENCH_ROWS", {})  # BENCH_ROWS before issue #15
+        return getattr(offline, "ROWS", None) or offline.BENCH_ROWS, offline.framed_camera
+    return ROWS, framed_camera
+
+
+def measure(key: str, off, frames: int, orbit: float = 0.0, elevation: float | None = None,
+            view=None) -> tuple[float, float]:
+    """(median wall ms, median CPU ms) of ``frames`` frames of ``key``'s bench row, the camera
+    ``elevation`` degrees up (None: this version's framing), at ``view`` = (distance, target
+    x, y, z) if given, and turned by ``orbit`` degrees about the tree before each frame."""
+    import treeanim as ta
+
+    rows, framed_camera = _this_version()
     preset, season = rows.get(key, (key, 0.0))
     tree = ta.load_preset(preset)
     sim = ta.Simulation(tree, wind=ta.WindField(speed=5.0, seed=0), season=season, seed=0)
     for _ in range(5):
         sim.step(1 / 30)
     off.load(tree)
-    cam = offline.framed_camera(tree, off.width, off.height, present=sim.present)
+    if view is None:
+        cam = framed_camera(tree, off.width, off.height, elevation=elevation, present=sim.present)
+    else:  # the same camera in any version: distance and target given
+        from treeanim.render.camera import OrbitCamera
+
+        cam = OrbitCamera(target=view[1:], distance=view[0], elevation=elevation or 0.0)
     wall, cpu = [], []
     for k in range(frames + 2):
         sim.step(1 / 30)
@@ -62,6 +80,11 @@ def main(argv=None) -> int:
     ap.add_argument("--samples", type=int, default=0, help="MSAA samples (default 0, as the viewer on llvmpipe)")
     ap.add_argument("--orbit", type=float, default=0.0,
                     help="turn the camera by this many degrees a frame (default 0: still, as the bench)")
+    ap.add_argument("--elevation", type=float, default=None,
+                    help="the camera's degrees above the horizon (default: the version's own framing; "
+                    "give one to compare versions whose framing differs)")
+    ap.add_argument("--view", default=None, metavar="D,TX,TY,TZ",
+                    help="the camera's distance and target (metres), the same in any version (one preset)")
     args = ap.parse_args(argv)
 
     from treeanim.render.offscreen import OffscreenRenderer
@@ -69,7 +92,8 @@ def main(argv=None) -> int:
     off = OffscreenRenderer(1280, 720, samples=args.samples)
     try:
         for key in args.presets:
-            wall, cpu = measure(key, off, args.frames, args.orbit)
+            view = None if args.view is None else [float(x) for x in args.view.split(",")]
+            wall, cpu = measure(key, off, args.frames, args.orbit, args.elevation, view)
             print(f"{key}: wall {wall:.1f} ms, cpu {cpu:.1f} ms", flush=True)
     finally:
         off.release()
