@@ -104,6 +104,22 @@ def _centre(rect):
 
 
 # ---------------------------------------------------------------------------- drawing
+def _tree_pixels(v, w, h, threshold):
+    """Pixels where the tree differs by more than ``threshold`` from the same view without it
+    (the renderer told that nothing is present; the panel not drawn), and the view with it."""
+    v.show_panel, shown = False, v.show_panel
+    v.frame(DT)
+    scene = v.read_pixels()
+    r = v.renderer
+    r.update(v.sim.positions, v.sim.rotations, present=np.zeros(v.tree.n_objects, bool))
+    v.ctx.screen.use()
+    r.draw(v.camera, w, h, season=v.sim.season)
+    empty = v.read_pixels()
+    v._uploaded = None  # the viewer uploads its pose again on its next frame
+    v.show_panel = shown
+    return np.abs(scene.astype(int) - empty.astype(int)).max(axis=2) > threshold, scene
+
+
 def test_window_draws_the_tree_and_the_panel(viewer):
     v = viewer
     v.show_panel = True
@@ -112,18 +128,8 @@ def test_window_draws_the_tree_and_the_panel(viewer):
     with_panel = v.read_pixels()
     assert with_panel.shape == (H, W, 3)
     assert v.window.samples in (0, 4)  # pytest-xvfb's 16-bit screen has no multisampled visual
-    v.show_panel = False
-    v.frame(DT)
-    scene = v.read_pixels()
-    # The same view without the tree (the renderer told that nothing is present).
-    r = v.renderer
-    r.update(v.sim.positions, v.sim.rotations, present=np.zeros(v.tree.n_objects, bool))
-    v.ctx.screen.use()
-    r.draw(v.camera, W, H, season=v.sim.season)
-    empty = v.read_pixels()
-    v._uploaded = None  # the viewer uploads its pose again on its next frame
+    tree_px, scene = _tree_pixels(v, W, H, 24)
     assert v.ctx.error == "GL_NO_ERROR"
-    tree_px = np.abs(scene.astype(int) - empty.astype(int)).max(axis=2) > 24
     assert tree_px.mean() > 0.03, "the tree covers too little of the window"
     ys, xs = np.nonzero(tree_px)
     assert 0.1 * W < xs.mean() < 0.9 * W and 0.1 * H < ys.mean() < 0.9 * H
@@ -263,21 +269,6 @@ def test_orbit_pan_zoom_on_empty_sky(viewer):
     assert v.frame(DT)
 
 
-def _scene_mask(v, w, h):
-    """Pixels where the tree differs from the same view without it (the panel not drawn)."""
-    v.show_panel, shown = False, v.show_panel
-    v.frame(DT)
-    scene = v.read_pixels()
-    r = v.renderer
-    r.update(v.sim.positions, v.sim.rotations, present=np.zeros(v.tree.n_objects, bool))
-    v.ctx.screen.use()
-    r.draw(v.camera, w, h, season=v.sim.season)
-    empty = v.read_pixels()
-    v._uploaded = None
-    v.show_panel = shown
-    return np.abs(scene.astype(int) - empty.astype(int)).max(axis=2) > 8  # blades are close to the ground's green
-
-
 def test_f_frames_the_grassland_beside_the_panel_and_the_orbit_pivots_on_it(viewer):
     """F frames the whole meadow in the part of the window the panel leaves free (it reached
     past the window's right edge), and orbiting turns about the framed centre."""
@@ -301,7 +292,7 @@ def test_f_frames_the_grassland_beside_the_panel_and_the_orbit_pivots_on_it(view
         P, pad = tree_extent(v.tree, v.sim.shown)
         x, y, _ = v.camera.project(P, w, h).T
         assert x.min() > left and x.max() < w and y.min() > 0 and y.max() < h
-        mask = _scene_mask(v, w, h)
+        mask, _ = _tree_pixels(v, w, h, 8)  # blades are close to the ground's green
         free = mask[:, int(np.ceil(left)):]
         assert free.mean() > 0.05, "the meadow covers too little of the free view"
         assert not free[0].any() and not free[-1].any() and not free[:, 0].any() and not free[:, -1].any()

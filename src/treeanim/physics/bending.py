@@ -205,7 +205,7 @@ class BendingPlan:
         self.rho = np.zeros(S)
         self.rho_old = np.zeros(S)
         self.rho_start = np.zeros(S)
-        self.turn = np.zeros(S)  # a hinged segment's turn from its rest direction, c₀φ + … + cᵢφ
+        self.turn = np.zeros(S)  # a hinged later segment's turn from its rest direction (see _hinge_turns)
         self._hinge = None  # the hinges' last solve, until :meth:`finish` lays out their segments
 
     def stiffness(self, ei_max: float, exponent: float) -> list[np.ndarray]:
@@ -353,7 +353,6 @@ class BendingPlan:
             beta = beta[:K] + left
             self.turn[a:b] = beta
             tip[:K] = beta
-        self.turn[self.offsets[0] + self.hinge_start:self.offsets[0] + self.hinge_start + self.n_hinges] = phi
         self.q[:, self.hinge_tip] = self._hinge_rotation(tip, np.empty((4, self.n_hinges)))
 
     def finish(self) -> None:
