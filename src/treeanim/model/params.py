@@ -5,7 +5,10 @@ These are plain data; the physics package interprets them (docs/design.md §4–
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
+
+from ..validate import finite_float
 
 
 @dataclass(frozen=True)
@@ -173,3 +176,39 @@ WOOD_TYPES = {
     "hardwood": {"wood_density": 900.0, "wood_youngs_modulus": 6.0e9, "wood_damping": 0.03},
     "softwood": {"wood_density": 800.0, "wood_youngs_modulus": 4.0e9, "wood_damping": 0.03},
 }
+
+
+def check_physics(p: PhysicsParams, kinds: Iterable[str]) -> None:
+    """Raise ValueError naming the field if ``p`` cannot drive a simulation of these kinds.
+
+    Parameters
+    ----------
+    p : PhysicsParams
+    kinds : iterable of str
+        The kinds of object the tree has ('branch', 'leaf', 'blade').
+    """
+    if not isinstance(p, PhysicsParams):
+        raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
+    positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness",
+                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density", "reconfiguration_speed",
+                "wood_youngs_modulus")
+    for name in SCALAR_KEYS:
+        x = finite_float(f"physics.{name}", getattr(p, name))
+        if not (x > 0 if name in positive else x >= 0) or x > SCALAR_MAX[name]:
+            raise ValueError(f"physics.{name} must be {'>' if name in positive else '>='} 0 and at most "
+                             f"{SCALAR_MAX[name]:g}, got {x!r}")
+    for season in ("summer", "winter"):
+        sm = getattr(p, season)
+        for kind in kinds:
+            r = sm.of(kind)
+            if r is None:
+                if getattr(p, "winter" if season == "summer" else "summer").of(kind) is None:
+                    raise ValueError(f"physics: no f/zeta range for kind {kind!r}, which the tree has")
+                continue
+            for i in (0, 1):
+                f = finite_float(f"physics.{season}.{kind}.f", r.f[i])
+                z = finite_float(f"physics.{season}.{kind}.zeta", r.zeta[i])
+                if f <= 0:
+                    raise ValueError(f"physics.{season}.{kind}.f must be > 0, got {r.f!r}")
+                if z < 0:
+                    raise ValueError(f"physics.{season}.{kind}.zeta must be >= 0, got {r.zeta!r}")

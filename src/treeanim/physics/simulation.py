@@ -3,19 +3,17 @@
 from __future__ import annotations
 
 import numbers
-import sys
-from collections.abc import Iterable
 
 import numpy as np
 
-from ..model.params import SCALAR_KEYS, SCALAR_MAX, PhysicsParams
+from ..model.params import PhysicsParams, check_physics
 from ..model.tree import KINDS, Tree
 from ..validate import finite_float, finite_vector3
 from .derived import Derived
 from .modal import ModalDraws, ModalParameters
 from .oscillator import INTEGRATORS
 from .physical import MODAL_MODELS
-from .rotation import qrot
+from .pose import Pose
 from .stages import Stages
 from .wind import DEFAULT_BOUNDS
 
@@ -33,36 +31,7 @@ MAX_FREQUENCY = 1e4
 MAX_ZETA = 1e3
 
 
-def _check_params(p: PhysicsParams, kinds: Iterable[str]) -> None:
-    """Raise ValueError naming the field if ``p`` cannot drive a simulation of these kinds."""
-    if not isinstance(p, PhysicsParams):
-        raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
-    positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness",
-                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density", "reconfiguration_speed",
-                "wood_youngs_modulus")
-    for name in SCALAR_KEYS:
-        x = finite_float(f"physics.{name}", getattr(p, name))
-        if not (x > 0 if name in positive else x >= 0) or x > SCALAR_MAX[name]:
-            raise ValueError(f"physics.{name} must be {'>' if name in positive else '>='} 0 and at most "
-                             f"{SCALAR_MAX[name]:g}, got {x!r}")
-    for season in ("summer", "winter"):
-        sm = getattr(p, season)
-        for kind in kinds:
-            r = sm.of(kind)
-            if r is None:
-                if getattr(p, "winter" if season == "summer" else "summer").of(kind) is None:
-                    raise ValueError(f"physics: no f/zeta range for kind {kind!r}, which the tree has")
-                continue
-            for i in (0, 1):
-                f = finite_float(f"physics.{season}.{kind}.f", r.f[i])
-                z = finite_float(f"physics.{season}.{kind}.zeta", r.zeta[i])
-                if f <= 0:
-                    raise ValueError(f"physics.{season}.{kind}.f must be > 0, got {r.f!r}")
-                if z < 0:
-                    raise ValueError(f"physics.{season}.{kind}.zeta must be >= 0, got {r.zeta!r}")
-
-
-class Simulation(Derived, Stages):
+class Simulation(Derived, Stages, Pose):
     """A tree animated by wind and by pulls (Hu, Chiba & He 2012; docs/design.md §5–§8).
 
     Parameters
@@ -171,7 +140,7 @@ class Simulation(Derived, Stages):
         season = self._check_season(season)
         kinds = [k for k in KINDS if np.any(tree.kind == k)]
         self._kinds = kinds
-        _check_params(tree.physics, kinds)
+        check_physics(tree.physics, kinds)
 
         M, N = tree.n_objects, tree.n_nodes
         self._M, self._N = M, N
@@ -326,7 +295,7 @@ class Simulation(Derived, Stages):
 
     @physics.setter
     def physics(self, params: PhysicsParams) -> None:
-        _check_params(params, self._kinds)
+        check_physics(params, self._kinds)
         old = self._physics
         self._physics = params
         try:
@@ -416,99 +385,6 @@ class Simulation(Derived, Stages):
             wind.fit(box)
         else:
             wind.bounds = box
-
-    @property
-    def rest_positions(self) -> np.ndarray:
-        """(N, 3) rest node positions (the tree's)."""
-        return self._tree.rest_positions
-
-    def _node_frames(self) -> np.ndarray:
-        if self._fn is None:
-            self._fn = self._cplan.node_frames(self._frame)
-        return self._fn
-
-    def _recycled(self, attr: str, shape: tuple[int, ...]) -> np.ndarray:
-        """The array in ``attr`` if nobody outside holds it any more (so overwriting it is
-        invisible), else a new one: outputs stay fresh arrays for whoever keeps them, without a
-        new allocation (and its page faults) every frame for whoever does not."""
-        old = getattr(self, attr)
-        setattr(self, attr, None)
-        if old is not None and old.shape == shape and sys.getrefcount(old) <= _UNSHARED_REFS:
-            old.setflags(write=True)
-            return old
-        return np.empty(shape)
-
-    @property
-    def positions(self) -> np.ndarray:
-        """(N, 3) deformed world node positions (read-only; built on first access after a step).
-
-        An array you keep is never changed by later steps.
-        """
-        if self._pos_out is None:
-            buf = self._recycled("_pos_buf", (self._N, 3))
-            self._bplan.finish()
-            pos = self._cplan.positions(self._bplan.o, self._node_frames(), self._base, out=buf)
-            self._fallen.pose(pos)
-            pos.setflags(write=False)
-            self._pos_out = self._pos_buf = pos
-        return self._pos_out
-
-    @property
-    def rotations(self) -> np.ndarray:
-        """(N, 3, 3) world rotations relative to rest of the segment leaving each node.
-
-        See the class notes for the convention. Read-only; built on first access after a step.
-        An array you keep is never changed by later steps.
-        """
-        if self._rot_out is None:
-            buf = self._recycled("_rot_buf", (self._N, 3, 3))
-            self._bplan.finish()
-            rot = self._cplan.rotations(self._bplan.q, self._node_frames(), out=buf)
-            self._fallen.pose(None, rot)
-            rot.setflags(write=False)
-            self._rot_out = self._rot_buf = rot
-        return self._rot_out
-
-    @property
-    def loads(self) -> np.ndarray:
-        """(M, 3) the local loads L = (L_u, L_v, L_w) of the last step (N), a copy."""
-        return self._L.T.copy()
-
-    @property
-    def modal_loads(self) -> np.ndarray:
-        """(M, 3) the oscillator outputs L′ = (L′_u, L′_v, L′_w) (N; N·m for v), a copy."""
-        return self._p.T.copy()
-
-    @property
-    def pulls(self) -> dict[int, np.ndarray]:
-        """Held objects and their world forces (a copy)."""
-        return {i: f.copy() for i, f in self._pulls.items()}
-
-    def tip_position(self, i: int) -> np.ndarray:
-        """Deformed world position of object ``i``'s tip node.
-
-        Parameters
-        ----------
-        i : int
-            Object index.
-
-        Returns
-        -------
-        numpy.ndarray, (3,) float
-
-        Raises
-        ------
-        ValueError
-            Unknown object index.
-        """
-        i = self._check_object(i)
-        return self._tip_positions(np.array([i]))[0]
-
-    def _tip_positions(self, objs: np.ndarray) -> np.ndarray:
-        """(K, 3) deformed tip positions of objects ``objs`` (no validation)."""
-        self._bplan.finish()
-        o = self._bplan.o[:, self._bplan.ofs_of_node[self._tip_node[objs]]]
-        return (self._base[:, objs] + qrot(self._frame[:, objs], o)).T
 
     def compliance(self, i: int, k: int, s: float, offset=(0.0, 0.0, 0.0)) -> float:
         """Metres a point of object ``i`` moves per newton of a force on it (small bends, rest
@@ -656,19 +532,3 @@ class Simulation(Derived, Stages):
         self._rot_out = None
         self._fn = None
 
-
-def _unshared_refs() -> int:
-    """sys.getrefcount of an array held only by an attribute, seen as in _recycled (measured,
-    since the count of a lone object differs between Python versions)."""
-
-    class Holder:
-        pass
-
-    h = Holder()
-    h.a = np.empty(1)
-    old = getattr(h, "a")
-    h.a = None
-    return sys.getrefcount(old)
-
-
-_UNSHARED_REFS = _unshared_refs()
