@@ -25,7 +25,7 @@ from treeanim.app.save import physics_toml, preset_text, save_preset
 from treeanim.app.viewer import MAX_FRAME_DT, Viewer, run
 from treeanim.app.window import Window
 from treeanim.model.params import ModeRange
-from treeanim.render.renderer import Scene, sun_angles
+from treeanim.render.scene import Scene, sun_angles
 
 W, H = 480, 360
 DT = 1.0 / 60.0

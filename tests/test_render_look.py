@@ -12,7 +12,7 @@ import treeanim as ta
 from conftest import _curve, grass_patch, rest_pose
 from treeanim.model.build import ObjectSpec, assemble
 from treeanim.render.camera import OrbitCamera
-from treeanim.render.renderer import Scene
+from treeanim.render.scene import Scene
 
 W, H = 200, 150
 

@@ -17,7 +17,7 @@ from typing import Any, Callable
 from ..model.params import ModeRange
 from ..model.tree import KINDS
 from ..physics.oscillator import INTEGRATORS
-from ..render.renderer import sun_angles, sun_direction
+from ..render.scene import sun_angles, sun_direction
 from .winddir import wind_angle
 
 __all__ = ["Setting", "SETTINGS", "EI_SPAN"]

@@ -26,7 +26,8 @@ from ..physics.wind import wind_preset as wind_preset_kwargs
 from ..render.camera import TREE_ELEVATION, OrbitCamera, frame_tree
 from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
 from ..render.picking import Picker
-from ..render.renderer import Renderer, Scene
+from ..render.renderer import Renderer
+from ..render.scene import Scene
 from .gui import Gui
 from .input import ViewerInput
 from .winddir import wind_direction

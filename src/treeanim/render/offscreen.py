@@ -9,7 +9,8 @@ import numpy as np
 
 from ..model.tree import Tree
 from .camera import OrbitCamera
-from .renderer import Renderer, Scene
+from .renderer import Renderer
+from .scene import Scene
 
 
 def create_egl_context() -> moderngl.Context:
