@@ -82,17 +82,7 @@ from ..model.geometry import arc_length, lamina_frames
 from ..model.geometry import perpendicular as _perpendicular
 from ..model.geometry import unit as _unit
 from ..model.tree import BRANCH_SIDES, Tree, curve_bands
-
-#: A child branch's collar rim is this many times its base radius, at least and at most...
-COLLAR_FLARE = (1.15, 1.5)
-#: ... and, along a parent, at most this fraction of the parent's radius (it fits inside).
-COLLAR_FIT = 0.95
-#: Where a child sits on its parent's tip, its collar's apex lies this many parent radii below
-#: the parent's end (at most half the parent's last segment).
-COLLAR_SINK = 2.0
-#: A child on its parent's tip forks from the parent's end ring, tilted towards the child by as
-#: much as the child turns from the parent's direction beyond this angle (degrees).
-COLLAR_FORK = 70.0
+from .collars import collars, outward
 
 MATERIAL_BARK = 0
 MATERIAL_PETIOLE = 1
@@ -280,77 +270,6 @@ class _Parts:
         self.tri_obj.append(np.broadcast_to(obj, tris.shape[:-1]).reshape(-1))
 
 
-def _outward(q: np.ndarray, axis: np.ndarray) -> np.ndarray:
-    """Unit directions of points ``q`` (C, K, 3) away from the lines through 0 along ``axis`` (C, 3)."""
-    m = axis[:, None, :]
-    return _unit(q - np.sum(q * m, axis=2, keepdims=True) * m, np.broadcast_to(m, q.shape))
-
-
-def _leave(d: np.ndarray, radial: np.ndarray, rho: np.ndarray, axis: np.ndarray, R: np.ndarray) -> np.ndarray:
-    """(C, K): the largest s at which s·d + ρ·radial meets the cylinder of radius R about
-    ``axis`` (C, 1 or K, 3) through 0 (d (C, 3), radial (C, K, 3), ρ and R (C,))."""
-    dm = d[:, None, :]
-    d_off = dm - np.sum(dm * axis, axis=2, keepdims=True) * axis
-    u_off = radial - np.sum(radial * axis, axis=2, keepdims=True) * axis
-    qa = np.sum(d_off * d_off, axis=2)
-    qb = rho[:, None] * np.sum(d_off * u_off, axis=2)
-    qc = (rho * rho)[:, None] * np.sum(u_off * u_off, axis=2) - (R * R)[:, None]
-    return (np.sqrt(np.maximum(qb * qb - qa * qc, 0.0)) - qb) / np.maximum(qa, 1e-12)
-
-
-def _collars(tree: Tree, child: np.ndarray, d: np.ndarray, radial: np.ndarray, room: np.ndarray):
-    """Rest geometry of the collars of child branches ``child`` (module notes).
-
-    Parameters
-    ----------
-    tree : Tree
-    child : (C,) int
-        Branch objects that have a parent.
-    d : (C, 3) float
-        Unit directions in which they leave their parents.
-    radial : (C, K, 3) float
-        Unit directions of the K sides of their tubes, square to ``d``.
-    room : (C,) float
-        Length of each child's first band: the rim stays within the first half of it.
-
-    Returns
-    -------
-    rim, normal : (C, K, 3) float
-        The rim's vertices, from the child's base node, and their normals (the parent's).
-    axis : (C, 3) float
-        The parent's unit direction at the joint.
-    apex : (C, 3) float
-        The apex sunk in the parent, from the child's base node.
-    """
-    P = tree.rest_positions
-    r = 0.5 * tree.node_diameter
-    att, par = tree.attach_node[child], tree.parent[child]
-    a, _, end, nxt, prv = _node_tangents(tree, att, att - tree.object_start[par], par)
-    R, rc = r[att], r[tree.object_start[child]]
-    cos = np.sum(a * d, axis=1)
-    am = a[:, None, :]
-    # Along a parent: each side of the child's tube, widened to ρ, runs out along the child to
-    # where it leaves the parent's tube (radius R about the segment behind or ahead of the
-    # joint, on whichever side of it that is), at most half the first band out.
-    rho = np.minimum(np.clip(0.5 * (R + rc), COLLAR_FLARE[0] * rc, COLLAR_FLARE[1] * rc), COLLAR_FIT * R)
-    s = _leave(d, radial, rho, am, R)
-    ahead = np.sum((s[..., None] * d[:, None, :] + rho[:, None, None] * radial) * am, axis=2) >= 0
-    segment = np.where(ahead[..., None], _unit(P[nxt] - P[att], a)[:, None], _unit(P[att] - P[prv], a)[:, None])
-    s = np.clip(_leave(d, radial, rho, segment, R), 0.0, 0.5 * room[:, None])
-    side = s[..., None] * d[:, None, :] + rho[:, None, None] * radial
-    # At a fork (on the parent's tip): the parent's end ring, widened at least to the flare
-    # and then raised as far as a cone from the apex sunk below the end rises through the end
-    # ring; turned towards a child more than COLLAR_FORK° off the parent's direction, by the excess.
-    sink = np.minimum(COLLAR_SINK * R, 0.5 * np.linalg.norm(P[att] - P[prv], axis=1))
-    top = np.maximum(R, COLLAR_FLARE[0] * rc)
-    tilt = np.maximum(np.arccos(np.clip(cos, -1.0, 1.0)) - np.radians(COLLAR_FORK), 0.0)
-    plane = np.cos(tilt)[:, None] * a + np.sin(tilt)[:, None] * _unit(d - cos[:, None] * a, _perpendicular(a))
-    end_ring = (sink * (top / R - 1.0))[:, None, None] * am + top[:, None, None] * _outward(radial, plane)
-    rim = np.where(end[:, None, None], end_ring, side)
-    apex = np.where(end[:, None], -sink[:, None] * a, 0.0)  # below a parent's end, else on its axis
-    return rim, _outward(rim, a), a, apex
-
-
 def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool, material: int,
            jitter: np.ndarray, key: np.ndarray) -> None:
     """Tapered tubes with ``sides`` sides over the segments of objects ``objs``.
@@ -415,8 +334,10 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     normal = _unit(radial - slope[:, None, None] * tan[:, None, :])
     along = arc_length(tree)[n0] + t * seg_len
     # A child's base ring is its collar's rim, on the parent's surface with its normals.
-    offset[ic], normal[ic], axis, apex = _collars(tree, ring_obj[ic], tan[ic], radial[ic],
-                                                  seg_len[ic] / bands[src[ic]])
+    child = ring_obj[ic]
+    att, par = tree.attach_node[child], tree.parent[child]
+    offset[ic], normal[ic], axis, apex = collars(tree, child, tan[ic], radial[ic], seg_len[ic] / bands[src[ic]],
+                                                 _node_tangents(tree, att, att - tree.object_start[par], par))
     along[ic] = np.mean(np.sum(offset[ic] * tan[ic, None], axis=2), axis=1)
     ring_prev, ring_weight = prev[src], weight[src]
 
@@ -447,7 +368,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
         peak = np.zeros((len(ib), 3))
         peak[kb] = apex
         face = np.repeat(-tan[ib, None], sides, axis=1)
-        face[kb] = _outward(0.5 * (offset[ic][:, s0] + offset[ic][:, s1]), axis)
+        face[kb] = outward(0.5 * (offset[ic][:, s0] + offset[ic][:, s1]), axis)
         cb = parts.add(rep(n0[ib]), rep(ring_prev[ib]), rep(ring_obj[ib]), material, rep(peak),
                        face.reshape(-1, 3), rep(ring_weight[ib]), rep(jitter[ring_obj[ib]]), rep(key[ring_obj[ib]]),
                        np.stack([np.tile((s0 + 0.5) / sides, len(ib)), rep(along[ib])], -1), rep(curve[ib]))
