@@ -8,10 +8,9 @@ import threading
 import numpy as np
 
 from ...validate import finite_float, finite_vector3, float_within
-from .paper import _cached_grid, _sample_chunk, _Workspace, _wrap_shift
+from .paper import _cached_grid, _sample_paper, _Workspace, check_c2, lookup_tables, profile_constants
 from .physical import _canopy_mean, _sample_physical
 from .settings import (
-    _CHUNK,
     _MAX_LENGTH,
     _MIN_LENGTH,
     _TIME_CLIP,
@@ -176,11 +175,11 @@ class WindField:
         self.beta_vw = beta_vw
         self.seed = seed
         self._c1 = None if c1 is None else float_within("c1", c1, 0.0, MAX_COEFF)
-        self._c2 = None if c2 is None else self._check_c2(c2)
+        self._c2 = None if c2 is None else check_c2(c2)
         b = _bounds(DEFAULT_BOUNDS if bounds is None else bounds)
         _check_extent(b)
         if paper:
-            self._constants(b, self._c1, self._c2)
+            profile_constants(b, self._c1, self._c2)
         self._bounds = b
         self._length_scale = _optional_length("length_scale", length_scale)
         self._canopy_height = _optional_length("canopy_height", canopy_height)
@@ -331,7 +330,7 @@ class WindField:
     def c1(self, value) -> None:
         c1 = None if value is None else float_within("c1", value, 0.0, MAX_COEFF)
         if self._model == "paper":
-            self._constants(self._bounds, c1, self._c2)
+            profile_constants(self._bounds, c1, self._c2)
         self._c1 = c1
 
     @property
@@ -341,9 +340,9 @@ class WindField:
 
     @c2.setter
     def c2(self, value) -> None:
-        c2 = None if value is None else self._check_c2(value)
+        c2 = None if value is None else check_c2(value)
         if self._model == "paper":
-            self._constants(self._bounds, self._c1, c2)
+            profile_constants(self._bounds, self._c1, c2)
         self._c2 = c2
 
     # -- bounds and the mean profile ---------------------------------------------------------
@@ -358,7 +357,7 @@ class WindField:
         b = _bounds(value)
         _check_extent(b)
         if self._model == "paper":
-            self._constants(b, self._c1, self._c2)
+            profile_constants(b, self._c1, self._c2)
         self._rebase()
         self._bounds = b
 
@@ -396,35 +395,8 @@ class WindField:
             b[1, thin] = mid[thin] + half
         self.bounds = b
 
-    @staticmethod
-    def _check_c2(value) -> float:
-        c2 = finite_float("c2", value)
-        if not 1e-12 <= c2 <= 1e12:
-            raise ValueError(f"c2 must be in [1e-12, 1e12] (1/m), got {value!r}")
-        return c2
-
-    @staticmethod
-    def _constants(b, c1, c2):
-        top = float(b[1, 1])
-        if c2 is None:
-            if not top > 0.0:
-                raise ValueError(
-                    "bounds top y1 must be above the ground (y1 > 0) for the default log "
-                    f"wind profile (c2 = 50 / y1), got y1 = {top}"
-                )
-            c2 = 50.0 / top
-        if c1 is None:
-            log_top = math.log(c2) + math.log(top) if top > 0.0 else -math.inf
-            if not log_top >= 1.0 / MAX_COEFF:
-                raise ValueError(
-                    "with c1 = None (W = 1 at the top of the bounds), c2·y1 must exceed "
-                    f"{math.exp(1.0 / MAX_COEFF):.4f}; got c2 = {c2}, y1 = {top}"
-                )
-            c1 = 1.0 / log_top
-        return c1, c2
-
     def _profile_constants(self) -> tuple[float, float]:
-        return self._constants(self._bounds, self._c1, self._c2)
+        return profile_constants(self._bounds, self._c1, self._c2)
 
     def profile(self, h) -> np.ndarray:
         """Mean wind profile: the mean speed at height h over ``speed``.
@@ -475,15 +447,7 @@ class WindField:
 
     def _lookup_tables(self) -> tuple[np.ndarray, np.ndarray]:
         if self._tables is None:
-            # One wrap layer on the high side of each axis, so the upper corner of a cell is
-            # always index + 1; raveled so one np.take gathers a corner for every point.
-            # FBM_u and FBM_v travel together as one complex64 (8-byte gathers), FBM_w alone.
-            g = np.pad(self.grids, ((0, 0), (0, 1), (0, 1), (0, 1)), mode="wrap")
-            uv = np.empty(g[0].size, dtype=np.complex64)
-            uv.real = g[0].ravel()
-            uv.imag = g[1].ravel()
-            w = g[2].astype(np.float32).ravel()
-            self._tables = (uv, w)
+            self._tables = lookup_tables(self.grids)
         return self._tables
 
     def _workspace(self, n: int) -> "_Workspace":
@@ -559,28 +523,7 @@ class WindField:
             _sample_physical(self, p, t, out)
             return out
 
-        n = self._grid
-        tables = self._lookup_tables()
-        lo = self._bounds[0]
-        scale = (n - 1) / (self._bounds[1] - self._bounds[0])
-        # Eq. 17: x(N−1) − c5 t, y(N−1), z(N−1) − c6 t, in the wind frame (see module doc):
-        # grid coordinates q = M (p − lo) − shift, M = frame · diag(scale). The shifts are
-        # reduced modulo the period N first, so no finite t overflows.
-        shift = np.array([_wrap_shift(self._c5, t, n), 0.0, _wrap_shift(self._c6, t, n)])
-        m = self._frame * scale[None, :]
-        offset = -(m @ lo) - shift
-        c1, c2 = self._profile_constants()
-        c3, c4 = self._c3, self._c4
-        consts = (
-            m, offset, n, tables,
-            c1, -math.log(c2), c3, c4,
-            1.0 / math.sqrt(1.0 + 0.25 * c3 * c3 + 0.25 * c4 * c4),  # 1 / s1
-            self._turbulence, self._speed, self._frame,
-        )
-        ws = self._workspace(min(k, _CHUNK))
-        for start in range(0, k, _CHUNK):
-            stop = min(start + _CHUNK, k)
-            _sample_chunk(p[start:stop], out[start:stop], ws, consts)
+        _sample_paper(self, p, t, out)
         return out
 
     def __repr__(self) -> str:

@@ -8,8 +8,8 @@ from functools import lru_cache
 import numpy as np
 import scipy.fft
 
-from ...validate import float_within
-from .settings import _COORD_CLIP, _GRID_CLIP, MAX_BETA, MAX_GRID, _integer
+from ...validate import finite_float, float_within
+from .settings import _CHUNK, _COORD_CLIP, _GRID_CLIP, MAX_BETA, MAX_COEFF, MAX_GRID, _integer
 
 
 def fbm_noise(n: int, beta: float, seed=0) -> np.ndarray:
@@ -207,3 +207,73 @@ def _corner_offsets(mp: int) -> np.ndarray:
     d = np.arange(2)
     off = (d[:, None, None] * mp + d[None, :, None]) * mp + d[None, None, :]
     return off.reshape(8)
+
+
+def check_c2(value) -> float:
+    """c2 of Eq. 16 (1/m), a finite number in [1e-12, 1e12], or ValueError."""
+    c2 = finite_float("c2", value)
+    if not 1e-12 <= c2 <= 1e12:
+        raise ValueError(f"c2 must be in [1e-12, 1e12] (1/m), got {value!r}")
+    return c2
+
+
+def profile_constants(b: np.ndarray, c1: float | None, c2: float | None) -> tuple[float, float]:
+    """(c1, c2) of Eq. 16 for the bounds ``b``: None gives the defaults, c2 = 50 / y1 (the
+    profile starts at 2 % of the top) and c1 = 1 / ln(c2·y1) (W = 1 at the top). ValueError
+    where the bounds cannot carry them."""
+    top = float(b[1, 1])
+    if c2 is None:
+        if not top > 0.0:
+            raise ValueError(
+                "bounds top y1 must be above the ground (y1 > 0) for the default log "
+                f"wind profile (c2 = 50 / y1), got y1 = {top}"
+            )
+        c2 = 50.0 / top
+    if c1 is None:
+        log_top = math.log(c2) + math.log(top) if top > 0.0 else -math.inf
+        if not log_top >= 1.0 / MAX_COEFF:
+            raise ValueError(
+                "with c1 = None (W = 1 at the top of the bounds), c2·y1 must exceed "
+                f"{math.exp(1.0 / MAX_COEFF):.4f}; got c2 = {c2}, y1 = {top}"
+            )
+        c1 = 1.0 / log_top
+    return c1, c2
+
+
+def lookup_tables(grids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The noise grids (3, N, N, N) as :func:`_sample_chunk` reads them: one wrap layer on the
+    high side of each axis, so the upper corner of a cell is always index + 1, and raveled so
+    one np.take gathers a corner for every point; FBM_u and FBM_v travel together as one
+    complex64 (8-byte gathers), FBM_w alone as float32."""
+    g = np.pad(grids, ((0, 0), (0, 1), (0, 1), (0, 1)), mode="wrap")
+    uv = np.empty(g[0].size, dtype=np.complex64)
+    uv.real = g[0].ravel()
+    uv.imag = g[1].ravel()
+    return uv, g[2].astype(np.float32).ravel()
+
+
+def _sample_paper(wind, p: np.ndarray, t: float, out: np.ndarray) -> None:
+    """Eqs. 13–18 at the points ``p`` (K, 3) and time ``t``, into ``out`` (K, 3), in chunks."""
+    k = p.shape[0]
+    n = wind._grid
+    tables = wind._lookup_tables()
+    lo = wind._bounds[0]
+    scale = (n - 1) / (wind._bounds[1] - wind._bounds[0])
+    # Eq. 17: x(N−1) − c5 t, y(N−1), z(N−1) − c6 t, in the wind frame (see module doc):
+    # grid coordinates q = M (p − lo) − shift, M = frame · diag(scale). The shifts are
+    # reduced modulo the period N first, so no finite t overflows.
+    shift = np.array([_wrap_shift(wind._c5, t, n), 0.0, _wrap_shift(wind._c6, t, n)])
+    m = wind._frame * scale[None, :]
+    offset = -(m @ lo) - shift
+    c1, c2 = wind._profile_constants()
+    c3, c4 = wind._c3, wind._c4
+    consts = (
+        m, offset, n, tables,
+        c1, -math.log(c2), c3, c4,
+        1.0 / math.sqrt(1.0 + 0.25 * c3 * c3 + 0.25 * c4 * c4),  # 1 / s1
+        wind._turbulence, wind._speed, wind._frame,
+    )
+    ws = wind._workspace(min(k, _CHUNK))
+    for start in range(0, k, _CHUNK):
+        stop = min(start + _CHUNK, k)
+        _sample_chunk(p[start:stop], out[start:stop], ws, consts)
