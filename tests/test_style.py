@@ -66,3 +66,10 @@ def test_the_package_has_no_import_cycles():
         if name not in state:
             visit(name, [name])
     assert not cycles, [" -> ".join(c) for c in cycles]
+
+
+def test_no_module_is_much_over_500_lines():
+    """Small modules whose names say what they hold (issue #15): none grows past 550 lines."""
+    long = {p.relative_to(ROOT).as_posix(): n for p in (ROOT / "src" / "treeanim").rglob("*.py")
+            if (n := len(p.read_text(encoding="utf-8").splitlines())) > 550}
+    assert not long, long
