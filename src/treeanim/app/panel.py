@@ -312,7 +312,6 @@ class Panel:
             self.widget("load_path")
             imgui.same_line()
             self.widget("physical_modes")
-            imgui.same_line()
             if imgui.button("Resume" if v.paused else "Pause"):
                 self.apply("paused", not v.paused)
             self._rect("pause")
