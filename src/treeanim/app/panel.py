@@ -302,6 +302,7 @@ class Panel:
                 self._range_pair(f"f:{kind}", 0.01, "%.2f")
                 self._range_pair(f"zeta:{kind}", 0.002, "%.3f")
             self.widget("ei_max")
+            self.widget("physical_modes")
 
         # --- time
         if self._header("Simulation", open_=True):
@@ -311,7 +312,6 @@ class Panel:
             imgui.same_line()
             self.widget("load_path")
             imgui.same_line()
-            self.widget("physical_modes")
             if imgui.button("Resume" if v.paused else "Pause"):
                 self.apply("paused", not v.paused)
             self._rect("pause")

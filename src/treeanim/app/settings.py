@@ -176,7 +176,8 @@ SETTINGS: dict[str, Setting] = {
     "coupling": _flag(lambda v: v.sim, "coupling", "coupling"),
     "load_path": _flag(lambda v: v.sim, "load_path", "load path"),
     # the branches' modes: beam theory, or the preset's ranges (Eqs. 20–22)
-    "physical_modes": Setting("physical", lambda v: v.sim.modal == "physical", _set_modal, kind="check"),
+    "physical_modes": Setting("physical modes (beam theory)", lambda v: v.sim.modal == "physical", _set_modal,
+                              kind="check"),
     "paused": _flag(lambda v: v, "paused", "paused"),
     # overlays
     "show_trace": _flag(lambda v: v, "show_trace", "pull trace"),
