@@ -99,9 +99,13 @@ class Derived:
         t = np.clip((half - arc[start + j]) / np.maximum(seg[start + j], 1e-300), 0.0, 1.0)
         hinge = self._bplan.hinge  # hinged: on its first segment (bent each step), extended to half the arc
         j[hinge], t[hinge] = 0, half[hinge] / np.maximum(seg[start[hinge]], 1e-300)
-        self._mid_a = self._bplan.ofs_of_node[start + j]
+        # The point is t·o[b] + (1 − t)·o[a] of the bent offsets; o[a] is the base (zero) on a
+        # first segment, so only the objects whose middle lies further on need the second term.
         self._mid_b = self._bplan.ofs_of_node[start + j + 1]
         self._mid_t = t
+        self._mid_far = np.flatnonzero(j > 0)
+        self._mid_a = self._bplan.ofs_of_node[start + j][self._mid_far]
+        self._mid_ta = 1.0 - t[self._mid_far]
         self._leaves = np.flatnonzero(leaf)
         self._tip_flat = self._bplan.flat_of_node[tip]
         lp = self._lp

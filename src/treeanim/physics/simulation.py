@@ -222,7 +222,11 @@ class Simulation(Derived, Stages, Pose):
         w = 2.0 * np.pi * f3
         self._w2, self._two_zeta_w = w * w, 2.0 * z3 * w  # ω² and 2ζω of every mode
         if self._load_path:
-            self._lp.tune(self._w2)
+            lp = self._lp
+            lp.tune(self._w2)
+            # −m_eff of the bending modes u and w (base excitation) and their mean ω (the loads' low-pass)
+            self._neg_m_eff = -np.minimum(lp.K / self._w2[[0, 2]], lp.m_modal)
+            self._spread_rate = np.sqrt(np.sqrt(self._w2[0] * self._w2[2]))
         return f3, z3
 
     # ------------------------------------------------------------------ properties

@@ -99,9 +99,9 @@ class Stages:
         self._cplan.object_frames(self._Fw, P, out=(self._frame, self._base))
         if self._load_path:  # the true middle: half the arc length along the bent object
             so = np.take(bp.o, self._mid_b, axis=1, out=ws.get("so", (3, M)))
-            so -= np.take(bp.o, self._mid_a, axis=1, out=ws.get("so2", (3, M)))
             so *= self._mid_t
-            so += np.take(bp.o, self._mid_a, axis=1, out=ws.get("so2", (3, M)))
+            if len(self._mid_far):
+                so[:, self._mid_far] += bp.o[:, self._mid_a] * self._mid_ta
         else:
             so = np.take(bp.o, self._sample_ofs, axis=1, out=ws.get("so", (3, M)))
         qrot(self._frame, so, out=self._sample_pos, ws=ws)
@@ -158,7 +158,7 @@ class Stages:
         Returns (own loads, load-point loads, torsion excess, slots) for
         :meth:`LoadPath.segment_forces`.
         """
-        a = -np.expm1(-dt * np.sqrt(np.sqrt(self._w2[0] * self._w2[2])))
+        a = -np.expm1(-dt * self._spread_rate)
         new = (F_own, F_pull, slots, E)
         if self._spread is None:
             self._spread = [v.copy() for v in new]
@@ -216,12 +216,8 @@ class Stages:
         damp += self._two_zeta_w
         acc -= damp * self._pd
         a_u, a_w = self._lp.base_acceleration(acc)
-        K = self._lp.K
-        m = self._lp.m_modal
-        g[0] = np.minimum(K / w2[0], m)
-        g[0] *= -a_w  # mode u moves along w
-        g[2] = np.minimum(K / w2[2], m)
-        g[2] *= -a_u
+        np.multiply(self._neg_m_eff[0], a_w, out=g[0])  # mode u moves along w
+        np.multiply(self._neg_m_eff[1], a_u, out=g[2])
         return g
 
     def _oscillator_response(self, f3: np.ndarray, z3: np.ndarray, dt: float,
