@@ -61,7 +61,6 @@ class Drag:
         cd = np.select([kind == "branch", kind == "leaf"], [p.drag_branch, p.drag_leaf], p.drag_blade)
         self.half_rho_cda = 0.5 * p.air_density * cd * self.area * present
         self.foliage = kind != "branch"
-        self.foliage_share = self.foliage.astype(float)
         self.c_cross = np.where(kind == "leaf", 0.0, self.half_rho_cda)
         self.c_leaf = np.where(kind == "leaf", self.half_rho_cda, 0.0)
         self.r = float(p.reconfiguration)
@@ -105,10 +104,7 @@ class Drag:
         U = qrot(frame, wind, conj=True, out=ws.get("U", (3, M)), ws=ws)
         # cross-flow (branches, blades): only the wind normal to the axis v pushes
         un = np.hypot(U[0], U[2])
-        k = self.reconfigured(un)
-        k -= 1.0
-        k *= self.foliage_share  # wood does not reconfigure
-        k += 1.0
+        k = self.reconfigured(un, self.foliage)  # wood does not reconfigure
         k *= un
         k *= self.c_cross
         F = np.empty((3, M))

@@ -187,7 +187,7 @@ class BendingPlan:
         self.d_max = float(diam.max()) if self.N else 1.0
         self.n_hinges = n_hinged
         self.hinge_tip = flat_of_node[(start + nseg)[self.order[h0:h0 + n_hinged]]]  # their last segments
-        self.hinge_gain = np.ones(S)  # cᵢ of every hinged segment (see :meth:`bend`)
+        self.hinge_gain = np.ones(S)  # cᵢ of every hinged segment (see :meth:`_hinge_turns`)
         self.reset()
 
     def _prev_flat(self, i: int) -> np.ndarray:

@@ -39,8 +39,7 @@ class Derived:
         tip = start + count - 1
         M = self._M
         frames = rest_frames(tree)  # (M, 3, 3): columns u, v, w
-        u, v, w = frames[:, :, 0], frames[:, :, 1], frames[:, :, 2]
-        self._u, self._v, self._w = u.T.copy(), v.T.copy(), w.T.copy()
+        u = frames[:, :, 0]
         kind = tree.kind
         leaf = kind == "leaf"
         # The load path bends a petiole or a grass blade at one hinge (docs/design.md §12).
@@ -73,8 +72,7 @@ class Derived:
         self._flat_area = np.add.reduceat(dseg * seg, start)  # blades: width × length
         self._lam_area = lam_area
         self._nseg = (count - 1).astype(float)
-        self._sample_node = start + count // 2  # the middle node
-        self._sample_ofs = self._bplan.ofs_of_node[self._sample_node]
+        self._sample_ofs = self._bplan.ofs_of_node[start + count // 2]  # the middle node (paper)
         self._tip_node = tip
         self._rest_P = X.T.copy()
         # Base excitation: unique attach nodes of the non-root objects.

@@ -136,11 +136,9 @@ class LoadPath:
         self.own_arm = np.linalg.norm(A, axis=0)  # the own load's lever about each joint
 
         # Per step only the joints Eq. 8 solves: a hinge object's later joints follow its first.
-        keep = np.flatnonzero(~hinged | (seg_i == 0))
-        self.keep = None if len(keep) == len(seg_obj) else keep
-        if self.keep is not None:
-            seg_obj, node, s, h, lever_vec, lever, W, A, leafseg = (
-                x[..., keep] for x in (seg_obj, node, s, h, lever_vec, lever, W, A, leafseg))
+        self.keep = keep = np.flatnonzero(~hinged | (seg_i == 0))
+        seg_obj, node, s, h, lever_vec, lever, W, A, leafseg = (
+            x[..., keep] for x in (seg_obj, node, s, h, lever_vec, lever, W, A, leafseg))
         S = len(seg_obj)
         ends = np.cumsum([0] + bplan.solved)
         self.blocks = list(zip(ends[:-1], ends[1:]))
@@ -362,10 +360,8 @@ class LoadPath:
         a0k0[so[first]] = self.own_arm[first] / np.maximum(k_E[first], 1e-300)
         self.hinge_gain = np.ones(len(so))
         self.hinge_gain[rest] = self.own_arm[rest] / np.maximum(k_E[rest], 1e-300) / np.maximum(a0k0[so[rest]], 1e-300)
-        twist_rate = twist_rate.copy()
         twist_rate[first] = np.bincount(so[hinged], twist_rate[hinged], self.M)[so[first]]
-        keep = slice(None) if self.keep is None else self.keep
-        self.k_E, self.twist_rate = k_E[keep], twist_rate[keep]
+        self.k_E, self.twist_rate = k_E[self.keep], twist_rate[self.keep]
 
     def _base_map(self) -> None:
         """``B`` (2M, 2M): the local (u, w) acceleration of each object's load point per unit

@@ -180,11 +180,10 @@ class Stages:
         object's mode and, through Q, on what it carries), which the oscillators take
         implicitly (:meth:`_advance`) — stable however light a twig and strong the wind.
         """
-        tip_q = np.take(self._bplan.q, self._tip_flat, axis=1)
         if U is None:
             F, rel = np.zeros((3, self._M)), -self._sample_vel
         else:
-            F = self._drag.loads(U.T, self._frame, tip_q)
+            F = self._drag.loads(U.T, self._frame, np.take(self._bplan.q, self._tip_flat, axis=1))
             rel = U.T - self._sample_vel
         speed = np.sqrt(np.einsum("ij,ij->j", rel, rel))
         lp = self._lp
