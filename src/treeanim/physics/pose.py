@@ -123,6 +123,7 @@ class Pose:
 
     def _tip_positions(self, objs: np.ndarray) -> np.ndarray:
         """(K, 3) deformed tip positions of objects ``objs`` (no validation)."""
-        self._bplan.finish()
+        if self._bplan.hinge[objs].any():  # only hinged objects' tips wait for the layout
+            self._bplan.finish()
         o = self._bplan.o[:, self._bplan.ofs_of_node[self._tip_node[objs]]]
         return (self._base[:, objs] + qrot(self._frame[:, objs], o)).T
