@@ -23,6 +23,7 @@ import numpy as np
 
 import treeanim as ta
 from treeanim.model.build import ObjectSpec, assemble
+from treeanim.physics.bending import rest_frames
 from treeanim.physics.simulation import Simulation
 from treeanim.physics.trace import trace_tips
 
@@ -72,7 +73,8 @@ def pull_and_release(f_u: float, f_w: float, zeta_u: float, zeta_w: float, angle
     sim = Simulation(tree)
     sim.modes.f[0] = (f_u, f_u, f_w)
     sim.modes.zeta[0] = (zeta_u, zeta_u, zeta_w)
-    u, w = sim._u[:, 0], sim._w[:, 0]
+    frame = rest_frames(tree)[0]  # the beam's rest (u, v, w), Eq. 1
+    u, w = frame[:, 0], frame[:, 2]
     a = np.radians(angle_deg)
     direction = np.cos(a) * u + np.sin(a) * w
     tip_rest = tree.rest_positions[-1]
