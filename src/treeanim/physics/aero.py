@@ -61,6 +61,7 @@ class Drag:
         cd = np.select([kind == "branch", kind == "leaf"], [p.drag_branch, p.drag_leaf], p.drag_blade)
         self.half_rho_cda = 0.5 * p.air_density * cd * self.area * present
         self.foliage = kind != "branch"
+        self.blades = bool(np.any(kind == "blade"))
         self.c_cross = np.where(kind == "leaf", 0.0, self.half_rho_cda)
         self.c_leaf = np.where(kind == "leaf", self.half_rho_cda, 0.0)
         self.r = float(p.reconfiguration)
@@ -103,9 +104,11 @@ class Drag:
         ws = self.ws
         U = qrot(frame, wind, conj=True, out=ws.get("U", (3, M)), ws=ws)
         # cross-flow (branches, blades): only the wind normal to the axis v pushes
-        un = np.hypot(U[0], U[2])
-        k = self.reconfigured(un, self.foliage)  # wood does not reconfigure
-        k *= un
+        un2 = U[0] * U[0]
+        un2 += U[2] * U[2]
+        k = np.sqrt(un2)
+        if self.blades:  # blades reconfigure, wood does not
+            k *= self.reconfigured(k, self.foliage)
         k *= self.c_cross
         F = np.empty((3, M))
         np.multiply(k, U[0], out=F[0])
@@ -113,8 +116,18 @@ class Drag:
         np.multiply(k, U[2], out=F[2])
         if len(self.leaf):  # the normal force ½ρC A |U| (U·n) n on the lamina
             w, x, y, z = tip_q  # n = the leaf's bend and twist applied to its rest normal w
-            n = np.stack([2 * (x * z + w * y), 2 * (y * z - w * x), 1 - 2 * (x * x + y * y)])
-            speed = np.sqrt(np.einsum("ij,ij->j", U, U))
+            n = ws.get("n", (3, M))
+            np.multiply(x, z, out=n[0])
+            n[0] += w * y
+            np.multiply(y, z, out=n[1])
+            n[1] -= w * x
+            n[:2] *= 2.0
+            np.multiply(x, x, out=n[2])
+            n[2] += y * y
+            n[2] *= -2.0
+            n[2] += 1.0
+            un2 += U[1] * U[1]
+            speed = np.sqrt(un2)
             un = np.einsum("ij,ij->j", U, n)
             self.leaf_speed = speed[self.leaf]
             self.leaf_incidence = un[self.leaf] / np.maximum(self.leaf_speed, 1e-300)

@@ -36,7 +36,7 @@ import numpy as np
 from scipy import sparse
 
 from .bend_angle import saturating_twist
-from .rotation import Workspace
+from .rotation import Workspace, cross, dot
 
 __all__ = ["LoadPath", "TWIST_RATIO"]
 
@@ -49,29 +49,9 @@ _T = np.linspace(0.0, 1.0, 5)
 _W = np.array([1.0, 4.0, 2.0, 4.0, 1.0]) / 12.0
 
 
-def _cross(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-    """Cross products of (3, K) column stacks (``out`` must not alias ``a`` or ``b``)."""
-    out = np.empty(np.broadcast_shapes(a.shape, b.shape)) if out is None else out
-    np.multiply(a[1], b[2], out=out[0])
-    out[0] -= a[2] * b[1]
-    np.multiply(a[2], b[0], out=out[1])
-    out[1] -= a[0] * b[2]
-    np.multiply(a[0], b[1], out=out[2])
-    out[2] -= a[1] * b[0]
-    return out
-
-
-def _dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Column-wise dot products of (3, K) stacks."""
-    d = a[0] * b[0]
-    d += a[1] * b[1]
-    d += a[2] * b[2]
-    return d
-
-
-def _csr(rows: list, cols: list, vals: list, n: int):
-    """An (n, n) CSR matrix from lists of (row indices, column indices, values) blocks."""
-    return sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n))
+def _csr(rows: list, cols: list, vals: list, shape: tuple[int, int]):
+    """A CSR matrix from lists of (row indices, column indices, values) blocks."""
+    return sparse.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=shape)
 
 
 class LoadPath:
@@ -146,24 +126,9 @@ class LoadPath:
         s_hat = s / np.maximum(h, 1e-300)
         self.lever = lever
         self.lever_per_len = lever / np.maximum(h, 1e-300)  # a·sin θ₀ = |N|·ℓ/|s|
-        # The equivalent force of Eq. 8 at the lever ℓ for the own load Fo (share W, first
-        # moment A × Fo) and the load-point load Ft (lever vector B):
-        # (F·ŝ)ŝ + (M × ŝ)/ℓ = Fo·α + (Fo·ŝ)·dA + Ft·β + (Ft·ŝ)·dB.
-        # A leaf's own load acts where the load-point load does (W = 1, A = B): the own load's
-        # terms are kept as differences from the load point's, on the other segments only.
-        lev = lever
         self.s_hat = s_hat
-        self.beta = _dot(lever_vec, s_hat) / lev
-        self.dB = s_hat - lever_vec / lev
-        self.twist_tip = _cross(s_hat, lever_vec)  # torsion per unit load: (B × F)·ŝ = F·(ŝ × B)
         self.leaf_seg = np.flatnonzero(leafseg)
-        spread = np.flatnonzero(~leafseg)
-        self.spread = slice(None) if len(spread) == S else spread
-        self.spread_obj = seg_obj[spread]
-        self.s_hat_spread = s_hat[:, spread]
-        self.d_alpha = _dot(A[:, spread], self.s_hat_spread) / lev[spread] - self.beta[spread]
-        self.d_dA = W[spread] * self.s_hat_spread - A[:, spread] / lev[spread] - self.dB[:, spread]
-        self.d_twist = _cross(self.s_hat_spread, A[:, spread]) - self.twist_tip[:, spread]
+        own = (seg_obj, s_hat, lever, lever_vec, W, A, leafseg)
 
         # Children and the nodes they sit on.
         nonroot = np.flatnonzero(parent >= 0)
@@ -183,21 +148,77 @@ class LoadPath:
         self.slot_owner = owner
         self.Xslot = np.ascontiguousarray(X[att_nodes].T)
         self.r_load = self.Xl - self.Xb
-        # Segments of objects with children: what the children put beyond each joint, as
-        # suffix sums over the object's attach slots.
-        self.k_flat = np.flatnonzero(has_kids[seg_obj])
-        ko = seg_obj[self.k_flat]
-        first = np.searchsorted(owner, ko)  # first slot of the object
-        last = np.searchsorted(owner, ko, side="right")
-        self.k_hi = np.maximum(np.searchsorted(att_nodes, node[self.k_flat], side="right"), first)
-        self.k_end = last
-        self.Xj_k = np.ascontiguousarray(X[node[self.k_flat]].T)
-        self.axes_k = self.axes[:, :, ko]
+        # Segments of objects with children: what the children put beyond each joint.
+        k_flat = np.flatnonzero(has_kids[seg_obj])
+        ko = seg_obj[k_flat]
+        hi = np.maximum(np.searchsorted(att_nodes, node[k_flat], side="right"),
+                        np.searchsorted(owner, ko))  # the object's slots after the joint
+        end = np.searchsorted(owner, ko, side="right")
+        self.seg_map = self._segment_map(*own, self._children(k_flat, hi, end, X[node[k_flat]].T, S, len(att_nodes)))
         self.start = start
         self.diam_max = float(diam.max()) if N else 1.0
         self.kind = tree.kind
         self.ws = Workspace()
         self._couplings(parent, has_kids)
+
+    def _segment_map(self, seg_obj, s_hat, lever, lever_vec, W, A, leafseg, children):
+        """(4S, 8M + 6A) sparse: the solved joints' equivalent forces (rows c·S + joint, local)
+        and torsions (rows 3S + joint) per unit load, as :meth:`segment_forces` stacks them:
+        own loads (columns c·M + object), load-point loads (3M + c·M + object), the
+        torsional excess (6M + object), L′_v (7M + object) and the children (8M + …).
+
+        Joint i's equivalent force of Eq. 8 at the lever ℓ, (F·ŝ)ŝ + (M × ŝ)/ℓ, is linear in
+        the loads at their rest levers: for the own load, share W with first moment A × F
+        about the joint, F·α + (F·ŝ)·dA with α = A·ŝ/ℓ, dA = W·ŝ − A/ℓ; for a load at the
+        load point (lever vector B: W = 1, A = B) the same. Its torsion is (A × F)·ŝ; a
+        leaf's petiole twists under L′_v alone (see :meth:`segment_forces`)."""
+        M, S = self.M, len(seg_obj)
+        seg = np.arange(S)
+        rows, cols, vals = children
+        for block, (arm, share) in enumerate(((A, W), (lever_vec, 1.0))):  # own, load point
+            alpha = dot(arm, s_hat) / lever
+            dA = share * s_hat - arm / lever
+            for c in range(3):
+                for c2 in range(3):
+                    rows.append(c * S + seg), cols.append((3 * block + c2) * M + seg_obj)
+                    vals.append(dA[c] * s_hat[c2] + (alpha if c == c2 else 0.0))
+            twist = cross(s_hat, arm)  # (A × F)·ŝ = F·(ŝ × A)
+            for c2 in range(3):
+                rows.append(3 * S + seg[~leafseg]), cols.append((3 * block + c2) * M + seg_obj[~leafseg])
+                vals.append(twist[c2, ~leafseg])
+        for col, segs in ((6, ~leafseg), (7, leafseg)):  # torsional excess, L′_v
+            rows.append(3 * S + seg[segs]), cols.append(col * M + seg_obj[segs]), vals.append(np.ones(segs.sum()))
+        m = _csr(rows, cols, vals, (4 * S, 8 * M + 6 * len(self.att_nodes)))
+        m.eliminate_zeros()
+        return m
+
+    def _children(self, k_flat, hi, end, Xj, S: int, A: int) -> tuple[list, list, list]:
+        """Rows, columns and values of :meth:`_segment_map` for the children at the attach
+        slots ``hi … end−1`` beyond each joint ``k_flat``, per rest-world force and first
+        moment of each slot (column 8M + d·A + slot).
+
+        Mᵢ = S − Xⱼ × F about the joint, local; Fᵢ = (F·ŝ)ŝ + (Mᵢ × ŝ)/ℓᵢ (Eq. 8's equivalent
+        force) and Tᵢ = Mᵢ·ŝ, linear in the slot's (F, S): built on the six unit loads."""
+        u, v, w = (a[:, self.seg_obj[k_flat]] for a in self.axes)
+        sh, lev = self.s_hat[:, k_flat], self.lever[k_flat]
+        G = np.empty((4, 6, len(k_flat)))
+        for d in range(6):
+            unit = np.zeros((6, 1))
+            unit[d] = 1.0
+            F = np.broadcast_to(unit[:3], Xj.shape)
+            Mi = unit[3:] - cross(Xj, F)
+            Fl = np.stack([dot(u, F), dot(v, F), dot(w, F)])
+            Ml = np.stack([dot(u, Mi), dot(v, Mi), dot(w, Mi)])
+            G[:3, d] = dot(Fl, sh) * sh + cross(Ml, sh) / lev
+            G[3, d] = dot(Ml, sh)
+        n = end - hi  # slots beyond each joint
+        seg = np.repeat(np.arange(len(k_flat)), n)
+        slot = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n) + np.repeat(hi, n)
+        rows, cols, vals = [], [], []
+        for r in range(4):
+            for d in range(6):
+                rows.append(r * S + k_flat[seg]), cols.append(8 * self.M + d * A + slot), vals.append(G[r, d, seg])
+        return rows, cols, vals
 
     def _couplings(self, parent: np.ndarray, has_kids: np.ndarray) -> None:
         """The tree's constant maps for the upward pass of :meth:`inward` and for :meth:`_base_map`.
@@ -221,14 +242,14 @@ class LoadPath:
             desc, via = desc[up], anc[up]
         self.pairs = tuple(np.concatenate(a) if a else np.zeros(0, int) for a in (k, j, c))
         u, v, w = self.axes
-        self.own_map = np.stack([np.concatenate([a, _cross(self.Xo, a)]) for a in (u, v, w)], axis=1)
+        self.own_map = np.stack([np.concatenate([a, cross(self.Xo, a)]) for a in (u, v, w)], axis=1)
         # E = a·S − (a × X_b)·F for a = u/ℓ, v, −w/ℓ (the moment about the base, S − X_b × F)
         a = (u / self.lever0, v, -w / self.lever0)
-        Pe = np.stack([np.concatenate([-_cross(ac, self.Xb), ac]) for ac in a])
+        Pe = np.stack([np.concatenate([-cross(ac, self.Xb), ac]) for ac in a])
         # The excess x moves the load point by u x₂ + w x₀ and twists it by v x₁.
         zero = np.zeros((3, M))
-        Q = np.stack([np.concatenate([w, _cross(self.Xl, w)]), np.concatenate([zero, v]),
-                      np.concatenate([u, _cross(self.Xl, u)])], axis=1)
+        Q = np.stack([np.concatenate([w, cross(self.Xl, w)]), np.concatenate([zero, v]),
+                      np.concatenate([u, cross(self.Xl, u)])], axis=1)
         self.up = []
         for sl, transmits in reversed(self.levels):
             lvl = {"sl": sl, "Pe": np.ascontiguousarray(Pe[:, :, sl]), "Q": np.ascontiguousarray(Q[:, :, sl])}
@@ -380,10 +401,10 @@ class LoadPath:
         u, v, w = self.axes
         rows, cols, vals = [], [], []
         for col, d in enumerate((u[:, j], w[:, j])):
-            t = self.psi[s] * d + self.chi[s] * _cross(_cross(v[:, j], d), R)
+            t = self.psi[s] * d + self.chi[s] * cross(cross(v[:, j], d), R)
             for row, axis in enumerate((u[:, k], w[:, k])):
-                rows.append(row * M + k), cols.append(col * M + j), vals.append(_dot(axis, t))
-        self.B = _csr(rows, cols, vals, 2 * M)
+                rows.append(row * M + k), cols.append(col * M + j), vals.append(dot(axis, t))
+        self.B = _csr(rows, cols, vals, (2 * M, 2 * M))
 
     def tune(self, w2: np.ndarray | None) -> None:
         """Set the stiffness of the ``modal`` objects from their modes: K = m·ω², with m the
@@ -457,7 +478,7 @@ class LoadPath:
         if len(held):
             Ft = self._to_world(F_tip[:, held], held)
             Z[:3, held] += Ft
-            Z[3:, held] += _cross(self.Xl[:, held], Ft)
+            Z[3:, held] += cross(self.Xl[:, held], Ft)
         p_free, gain = response
         x = np.multiply(gain, g_extra, out=ws.get("x", (3, self.M)))
         x += p_free
@@ -500,37 +521,11 @@ class LoadPath:
         gamma : (n_flat,) float
             Twist of every segment, in the bending pass's flat order.
         """
-        ws = self.ws
         S = len(self.seg_obj)
-        Ft = np.add(F_own, F_tip, out=ws.get("Fsum", F_own.shape))
-        Ft = np.take(Ft, self.seg_obj, axis=1, out=ws.get("Ft", (3, S)))
-        sh = self.s_hat
-        Feq = np.multiply(Ft, self.beta, out=ws.get("Feq", (3, S)))
-        Feq += np.multiply(self.dB, _dot(Ft, sh), out=ws.get("tmp", (3, S)))
-        torsion = np.take(Lv, self.seg_obj)  # a leaf's: its torsional mode's output
-        # The own load spread along a branch or blade, as its difference from the load point's
-        sp = self.spread
-        Fo = np.take(F_own, self.spread_obj, axis=1)
-        d = Fo * self.d_alpha
-        d += self.d_dA * _dot(Fo, self.s_hat_spread)
-        Feq[:, sp] += d
-        t = np.take(dT, self.spread_obj)
-        t += _dot(Ft[:, sp], self.twist_tip[:, sp])
-        t += _dot(Fo, self.d_twist)
-        torsion[sp] = t
-        if len(self.k_flat):  # children beyond the joint, rest-world → local
-            rc = np.zeros((6, slots.shape[1] + 1))
-            rc[:, :-1] = np.cumsum(slots[:, ::-1], axis=1)[:, ::-1]
-            beyond = rc[:, self.k_hi] - rc[:, self.k_end]
-            F = beyond[:3]
-            Mi = beyond[3:] - _cross(self.Xj_k, F)
-            u, v, w = self.axes_k
-            Fl = np.stack([_dot(u, F), _dot(v, F), _dot(w, F)])
-            Ml = np.stack([_dot(u, Mi), _dot(v, Mi), _dot(w, Mi)])
-            shk = sh[:, self.k_flat]
-            Feq[:, self.k_flat] += _dot(Fl, shk) * shk + _cross(Ml, shk) / self.lever[self.k_flat]
-            torsion[self.k_flat] += _dot(Ml, shk)
-        a = np.sqrt(_dot(Feq, Feq))
+        x = np.concatenate([F_own.ravel(), F_tip.ravel(), dT, Lv, slots.ravel()])
+        out = (self.seg_map @ x).reshape(4, S)
+        Feq, torsion = out[:3], out[3]
+        a = np.sqrt(dot(Feq, Feq))
         a *= self.lever
         gamma = saturating_twist(torsion, self.twist_rate, -0.5 * np.pi)
         r = self.lever_per_len

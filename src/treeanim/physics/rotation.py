@@ -41,6 +41,26 @@ class Workspace:
 
 _DEFAULT_WS = Workspace()
 
+def cross(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """Cross products of (3, K) column stacks (``out`` must not alias ``a`` or ``b``)."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape)) if out is None else out
+    np.multiply(a[1], b[2], out=out[0])
+    out[0] -= a[2] * b[1]
+    np.multiply(a[2], b[0], out=out[1])
+    out[1] -= a[0] * b[2]
+    np.multiply(a[0], b[1], out=out[2])
+    out[2] -= a[1] * b[0]
+    return out
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Column-wise dot products of (3, K) stacks."""
+    d = a[0] * b[0]
+    d += a[1] * b[1]
+    d += a[2] * b[2]
+    return d
+
+
 def qmul(a: np.ndarray, b: np.ndarray, out: np.ndarray | None = None,
          ws: Workspace | None = None) -> np.ndarray:
     """Hamilton products a ⊗ b of (4, K) quaternion stacks (rotation b first, then a).

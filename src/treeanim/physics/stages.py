@@ -183,8 +183,9 @@ class Stages:
         if U is None:
             F, rel = np.zeros((3, self._M)), -self._sample_vel
         else:
-            F = self._drag.loads(U.T, self._frame, np.take(self._bplan.q, self._tip_flat, axis=1))
-            rel = U.T - self._sample_vel
+            U = np.ascontiguousarray(U.T)  # (3, M): whole rows are many times faster to work on
+            F = self._drag.loads(U, self._frame, np.take(self._bplan.q, self._tip_flat, axis=1))
+            rel = U - self._sample_vel
         speed = np.sqrt(np.einsum("ij,ij->j", rel, rel))
         lp = self._lp
         c_air = lp.Q_foliage * self._drag.reconfigured(speed)
