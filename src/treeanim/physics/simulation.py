@@ -227,6 +227,7 @@ class Simulation(Derived, Stages, Pose):
             # −m_eff of the bending modes u and w (base excitation) and their mean ω (the loads' low-pass)
             self._neg_m_eff = -np.minimum(lp.K / self._w2[[0, 2]], lp.m_modal)
             self._spread_rate = np.sqrt(np.sqrt(self._w2[0] * self._w2[2]))
+            self._spread_alpha = (None, None)  # (dt, its filter weights): see _distributed_loads
         return f3, z3
 
     # ------------------------------------------------------------------ properties

@@ -158,14 +158,17 @@ class Stages:
         Returns (own loads, load-point loads, torsion excess, slots) for
         :meth:`LoadPath.segment_forces`.
         """
-        a = -np.expm1(-dt * self._spread_rate)
-        new = (F_own, F_pull, slots, E)
+        if self._spread_alpha[0] != dt:  # the filter's weight on the new loads, per step length
+            a = -np.expm1(-dt * self._spread_rate)
+            self._spread_alpha = (dt, np.concatenate([np.tile(a, 9), np.tile(a[self._lp.slot_owner], 6)]))
+        new = np.concatenate([F_own.ravel(), F_pull.ravel(), E.ravel(), slots.ravel()])
         if self._spread is None:
-            self._spread = [v.copy() for v in new]
+            self._spread = new
         else:
-            for bar, v, alpha in zip(self._spread, new, (a, a, a[self._lp.slot_owner], a)):
-                bar += alpha * (v - bar)
-        F_bar, P_bar, S_bar, E_bar = self._spread
+            self._spread += self._spread_alpha[1] * (new - self._spread)
+        M = self._M
+        F_bar, P_bar, E_bar = self._spread[:9 * M].reshape(3, 3, M)
+        S_bar = self._spread[9 * M:].reshape(6, -1)
         dE = self._p - E_bar  # E′ − Ē, rows of the modes u, v, w
         F_tip = P_bar.copy()
         F_tip[0] += dE[2]  # mode w bends along u, mode u along w
