@@ -362,8 +362,8 @@ class LoadPath:
                 np.add.at(sub, par, sub[kids])
         self.Q_wood, self.Q_foliage = Qw, Qf
         self.m_modal = m_modal
-        self.tune(None)
         self._base_map()
+        self.tune(None)
 
     def _hinges(self, so, k_E, twist_rate) -> None:
         """The solved joints' stiffness ``k_E`` and twist rate, and ``hinge_gain``.
@@ -426,6 +426,7 @@ class LoadPath:
         self.k = self.k_E * seg
         self.k_blocks = [self.k[a:b] for a, b in self.blocks]
         self.K = self.K_E * scale
+        self.B_K = self.B @ sparse.diags(np.tile(1.0 / self.K, 2))  # B per unit p̈ (see base_acceleration)
 
     # ------------------------------------------------------------------ per step
     def base_acceleration(self, p_acc: np.ndarray) -> np.ndarray:
@@ -433,13 +434,12 @@ class LoadPath:
 
         Parameters
         ----------
-        p_acc : (3, M) float
-            d²L′/dt² of every oscillator now (rows u, v, w), from its state at the start of
-            the step (no lag): the load point accelerates by (p̈_w, 0, p̈_u)/K, local (mode w
+        p_acc : (2, M) float
+            d²L′/dt² of the bending oscillators now (rows u, w), from their state at the start
+            of the step (no lag): the load point accelerates by (p̈_w, 0, p̈_u)/K, local (mode w
             bends along u, mode u along w), and carries every object growing on it (``B``).
         """
-        q = np.concatenate([p_acc[2] / self.K, p_acc[0] / self.K])
-        return (self.B @ q).reshape(2, self.M)
+        return (self.B_K @ p_acc[::-1].ravel()).reshape(2, self.M)
 
     def inward(self, F_own: np.ndarray, F_tip: np.ndarray, held: np.ndarray, g_extra: np.ndarray,
                response: tuple[np.ndarray, np.ndarray], g: np.ndarray) -> np.ndarray:

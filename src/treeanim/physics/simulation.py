@@ -488,7 +488,7 @@ class Simulation(Derived, Stages, Pose):
         self._att_a = np.zeros((3, U + 1))  # column U: zero, for roots
         self._dt_prev = None
         self._g_prev = np.zeros((3, M))  # the oscillators' last inputs (load path)
-        self._c_air = np.zeros(M)  # the air's damping of the last step (load path)
+        self._air_prev = np.zeros((2, M))  # the air's damping rate of the last step (load path)
         self._sample_prev = self._sample_pos.copy()
         self._sample_vel = np.zeros((3, M))
         self._leaf_twist.reset()

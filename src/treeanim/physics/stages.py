@@ -131,7 +131,6 @@ class Stages:
         g = self._g_prev
         slots = self._lp.inward(F_own, F_pull, held, g_extra, (p_free, gain), g)
         self._advance(g, p_free, pd_free, gain, gain_d, c_air, dt, held)
-        self._c_air = c_air
         self._L = g.copy()
         F_own, F_tip, dT, slots = self._distributed_loads(F_own, F_pull, slots, g - g_extra, dt)
         blocks, gamma = self._lp.segment_forces(F_own, F_tip, dT, self._p[1], slots)
@@ -209,16 +208,16 @@ class Stages:
         loads go down the tree and motion comes back up, or a gust sets it ringing), with the
         effective mass m_eff = K/(2πf)² of each bending mode (a branch's modal mass, since
         its K follows from it; for leaves and blades at most their modal mass)."""
-        g = np.zeros((3, self._M))
-        w2 = self._w2
-        # p̈ = ω²(g − p) − (2ζω + ω²c/K) ṗ: Eq. 2 in load units, with the air's damping c of
-        # the last step (in a gale it holds a light twig back far more than its own ζ does)
-        acc = self._g_prev - self._p
-        acc *= w2
-        damp = self._air_damping(self._c_air)
-        damp += self._two_zeta_w
-        acc -= damp * self._pd
+        # p̈ = ω²(g − p) − (2ζω + ω²c/K) ṗ of the bending modes (rows u, w): Eq. 2 in load
+        # units, with the air's damping c of the last step (in a gale it holds a light twig
+        # back far more than its own ζ does)
+        acc = self._g_prev[::2] - self._p[::2]
+        acc *= self._w2[::2]
+        damp = self._two_zeta_w[::2] + self._air_prev
+        damp *= self._pd[::2]
+        acc -= damp
         a_u, a_w = self._lp.base_acceleration(acc)
+        g = np.zeros((3, self._M))
         np.multiply(self._neg_m_eff[0], a_w, out=g[0])  # mode u moves along w
         np.multiply(self._neg_m_eff[1], a_u, out=g[2])
         return g
@@ -252,6 +251,7 @@ class Stages:
         np.multiply(gain_d, g, out=self._pd)
         self._pd += pd_free
         damp = self._air_damping(c_air)
+        self._air_prev = damp[::2].copy()  # for the next step's base excitation
         damp[:, held] = 0.0  # a held object approaches its pull critically damped, as it is
         damp *= dt
         damp += 1.0
