@@ -49,6 +49,26 @@ def test_summer_crown_leans_more_than_the_bare_winter_tree(cherry):
     assert summer > 0.03, "a gale leans the crown several percent of the height (Fig. 11)"
 
 
+def test_a_twig_keeps_its_wood_stiffness_when_its_leaves_fall(cherry):
+    """K = m·ω² with the leafy mass: bare in winter, the twig that carried the most leaves
+    deflects under the same pull by its summer deflection × (f_summer/f_winter)², not by its
+    bare mass's far softer K (issue #10's stiff winter shiver)."""
+    n_leaves = np.bincount(cherry.parent[cherry.kind == "leaf"], minlength=cherry.n_objects)
+    twig = int(np.argmax(n_leaves))
+    base, tip = cherry.object_start[twig], cherry.object_start[twig] + cherry.object_count[twig] - 1
+    bend, w2 = [], []
+    for season in (0.0, 1.0):
+        sim = ta.Simulation(cherry, season=season)
+        w2.append(sim.modes.f[twig, 0] * sim.modes.f[twig, 2])
+        sim.pull(twig, (0.0, 0.0, 0.02))
+        for _ in range(240):
+            sim.step(1 / 60)
+        chord = sim.positions[tip] - sim.positions[base]
+        bend.append(np.linalg.norm(chord - (cherry.rest_positions[tip] - cherry.rest_positions[base])))
+    assert n_leaves[twig] >= 10 and bend[1] > 0
+    assert bend[0] / bend[1] == pytest.approx(w2[1] / w2[0], rel=0.15)
+
+
 def test_pulling_a_limb_moves_the_trunk(cherry):
     limb = int(np.flatnonzero(cherry.level == 2)[0])
     trunk_tip = cherry.object_start[0] + cherry.object_count[0] - 1

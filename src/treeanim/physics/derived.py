@@ -141,7 +141,7 @@ class Derived:
         E = np.select([branch, self._tree.kind == "leaf"], [NOMINAL_WOOD_MODULUS, p.leaf_youngs_modulus],
                       p.blade_youngs_modulus)
         self._lp.derive(E, p.stiffness_exponent, self._drag.half_rho_cda, self._drag.foliage,
-                        self._mass * self._present, branch)
+                        self._mass * self._present, self._mass, branch)
         self._bplan.hinge_gain = self._lp.hinge_gain
         self._mode_snap = None  # the branches' stiffness follows the modes: re-tune on the next step
 

@@ -284,7 +284,7 @@ class LoadPath:
 
     # ------------------------------------------------------------------ stiffness
     def derive(self, E: np.ndarray, exponent: float, air: np.ndarray, foliage: np.ndarray,
-               mass: np.ndarray, modal: np.ndarray) -> None:
+               mass: np.ndarray, leafy_mass: np.ndarray, modal: np.ndarray) -> None:
         """Stiffness shapes, the modal masses and the air's damping participation.
 
         Parameters
@@ -299,7 +299,9 @@ class LoadPath:
         foliage : (M,) bool
             Whose drag reconfigures (leaves, blades).
         mass : (M,) float
-            Each object's own mass (kg, zero where absent).
+            Each object's own mass (kg, zero where absent): what the modes carry.
+        leafy_mass : (M,) float
+            The same with every leaf on, which sets the stiffness (:meth:`tune`).
         modal : (M,) bool
             Objects whose stiffness :meth:`tune` sets from their modal frequency and mass.
         """
@@ -350,6 +352,7 @@ class LoadPath:
         Qw, Qf = np.where(foliage, 0.0, own), np.where(foliage, own, 0.0)
         sub_w, sub_f = np.where(foliage, 0.0, air), np.where(foliage, air, 0.0)
         m_modal, sub_m = mass * share, np.array(mass, float)
+        m_leafy, sub_leafy = leafy_mass * share, np.array(leafy_mass, float)
         for sl, transmits, *_ in reversed(self.levels):
             if not transmits:
                 continue
@@ -357,11 +360,11 @@ class LoadPath:
             j = np.searchsorted(self.nonroot, kids)
             par = self.par[j]
             psi2 = self.psi[self.slot[j]] ** 2
-            for acc, sub in ((Qw, sub_w), (Qf, sub_f), (m_modal, sub_m)):
+            for acc, sub in ((Qw, sub_w), (Qf, sub_f), (m_modal, sub_m), (m_leafy, sub_leafy)):
                 np.add.at(acc, par, psi2 * sub[kids])
                 np.add.at(sub, par, sub[kids])
         self.Q_wood, self.Q_foliage = Qw, Qf
-        self.m_modal = m_modal
+        self.m_modal, self.m_leafy = m_modal, m_leafy
         self._base_map()
         self.tune(None)
 
@@ -408,8 +411,11 @@ class LoadPath:
 
     def tune(self, w2: np.ndarray | None) -> None:
         """Set the stiffness of the ``modal`` objects from their modes: K = m·ω², with m the
-        modal mass (own and carried) and ω² = ω_u·ω_w of the bending modes, so a branch's
-        static lean and its sway frequency agree (the Table 1 frequencies stay what they are).
+        modal mass (own and carried) with every leaf on and ω² = ω_u·ω_w of the bending modes,
+        so a branch's static lean and its sway frequency agree (the Table 1 frequencies stay
+        what they are). The wood does not soften as the leaves fall: a bare twig keeps the
+        stiffness that carried its leaves (and Table 1's higher winter frequencies stiffen it
+        further), where its bare mass would leave it many times softer than in summer.
         Their twist keeps the modulus-based torsional stiffness: wood twists little.
 
         Parameters
@@ -419,7 +425,7 @@ class LoadPath:
         """
         scale = np.ones(self.M)
         if w2 is not None:
-            target = self.m_modal * np.sqrt(w2[0] * w2[2])
+            target = self.m_leafy * np.sqrt(w2[0] * w2[2])
             scale[self.modal] = target[self.modal] / self.K_E[self.modal]
             scale = np.maximum(scale, 1e-300)
         seg = scale[self.seg_obj]
