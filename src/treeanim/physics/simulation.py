@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import numbers
 
 import numpy as np
@@ -14,7 +15,7 @@ from .modal import ModalDraws, ModalParameters
 from .oscillator import INTEGRATORS
 from .physical import MODAL_MODELS
 from .pose import Pose
-from .stages import Stages
+from .stages import MAX_SUBSTEP, MAX_SUBSTEPS, Stages
 from .wind import DEFAULT_BOUNDS
 
 __all__ = ["Simulation", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
@@ -511,7 +512,9 @@ class Simulation(Derived, Stages, Pose):
         dt : float
             Step length in seconds, > 0 and at most :data:`MAX_STEP`. Any such length is
             stable: the exact integrator has no step limit; Euler sub-steps (and clamps very
-            long steps, see :mod:`treeanim.physics.oscillator`).
+            long steps, see :mod:`treeanim.physics.oscillator`); the load path advances in
+            sub-steps of at most 1/60 s (up to 64 of them; see
+            :data:`~treeanim.physics.stages.MAX_SUBSTEP`).
 
         Raises
         ------
@@ -524,15 +527,19 @@ class Simulation(Derived, Stages, Pose):
         if not 0 < dt <= MAX_STEP:
             raise ValueError(f"dt must be > 0 and at most {MAX_STEP:g} s, got {dt!r}")
         f3, z3 = self._modes_arrays()
-        U = self._wind_at_samples(self._time)
-        if self._load_path:
-            self._step_load_path(U, f3, z3, dt)
-            if len(self._fallen):
-                self._fallen.step(self._wind_at_points(self._time), dt)
+        if self._load_path:  # in sub-steps short enough for the base excitation (stages.py)
+            n = min(math.ceil(dt / MAX_SUBSTEP - 1e-9), MAX_SUBSTEPS)
+            for _ in range(n):
+                h = dt / n
+                self._step_load_path(self._wind_at_samples(self._time), f3, z3, h)
+                if len(self._fallen):
+                    self._fallen.step(self._wind_at_points(self._time), h)
+                self._dt_prev = h
+                self._time += h
         else:
-            self._step_paper(U, f3, z3, dt)
-        self._dt_prev = dt
-        self._time += dt
+            self._step_paper(self._wind_at_samples(self._time), f3, z3, dt)
+            self._dt_prev = dt
+            self._time += dt
         self._pos_out = None
         self._rot_out = None
         self._fn = None

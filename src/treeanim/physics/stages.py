@@ -22,6 +22,17 @@ ACCEL_TAU = 0.01
 #: Velocities and accelerations are differences over a step of at least this (s): over a
 #: shorter one (a step of 1e-320 s) the change in position is rounding noise.
 MIN_RATE_STEP = 1e-6
+#: The load path's longest step (s). Its base excitation is explicit — each object feels its
+#: ancestors' accelerations at the start of the step — and a crown's mass far outweighs the
+#: limbs that carry it, so over steps much longer than this the loop from a child's inertia
+#: to its parent's motion and back to the child gains energy (a winter small cherry, left in
+#: a 5 m/s breeze at 1/30 s steps, thrashed within a minute; 1/40 s is about the limit).
+#: :meth:`Simulation.step <treeanim.physics.simulation.Simulation.step>` divides longer
+#: steps into sub-steps of at most this length, up to MAX_SUBSTEPS of them; over longer
+#: sub-steps still (a step over a second: the tree all but settles within it) the base
+#: excitation is off.
+MAX_SUBSTEP = 1.0 / 60.0
+MAX_SUBSTEPS = 64
 
 
 class Stages:
@@ -126,7 +137,7 @@ class Stages:
         held = np.fromiter(self._pulls, dtype=np.int64)  # the objects being pulled
         F_own, c_air = self._aero_loads(U)
         F_pull = self._pull_loads(held)
-        g_extra = self._base_excitation()
+        g_extra = self._base_excitation(dt)
         p_free, pd_free, gain, gain_d = self._oscillator_response(f3, z3, dt, held)
         g = self._g_prev
         slots = self._lp.inward(F_own, F_pull, held, g_extra, (p_free, gain), g)
@@ -203,11 +214,14 @@ class Stages:
             F[:, held] = qrot(self._frame[:, held], world, conj=True)
         return F
 
-    def _base_excitation(self) -> np.ndarray:
+    def _base_excitation(self, dt: float) -> np.ndarray:
         """(3, M) oscillator inputs −m_eff·a of the moving bases (always on in the load path:
         loads go down the tree and motion comes back up, or a gust sets it ringing), with the
-        effective mass m_eff = K/(2πf)² of each bending mode (a branch's modal mass, since
-        its K follows from it; for leaves and blades at most their modal mass)."""
+        effective mass m_eff = min(K/(2πf)², modal mass) of each bending mode, off over steps
+        longer than :data:`MAX_SUBSTEP` (the simulation sub-steps up to a second)."""
+        g = np.zeros((3, self._M))
+        if dt > MAX_SUBSTEP:  # a step over a second long: off (nearly static, and unstable)
+            return g
         # p̈ = ω²(g − p) − (2ζω + ω²c/K) ṗ of the bending modes (rows u, w): Eq. 2 in load
         # units, with the air's damping c of the last step (in a gale it holds a light twig
         # back far more than its own ζ does)
@@ -217,7 +231,6 @@ class Stages:
         damp *= self._pd[::2]
         acc -= damp
         a_u, a_w = self._lp.base_acceleration(acc)
-        g = np.zeros((3, self._M))
         np.multiply(self._neg_m_eff[0], a_w, out=g[0])  # mode u moves along w
         np.multiply(self._neg_m_eff[1], a_u, out=g[2])
         return g
