@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .rotation import Workspace, qrot
+from .rotation import Workspace, dot, qrot
 
 __all__ = ["Drag"]
 
@@ -128,7 +128,7 @@ class Drag:
             n[2] += 1.0
             un2 += U[1] * U[1]
             speed = np.sqrt(un2)
-            un = np.einsum("ij,ij->j", U, n)
+            un = dot(U, n)
             self.leaf_speed = speed[self.leaf]
             self.leaf_incidence = un[self.leaf] / np.maximum(self.leaf_speed, 1e-300)
             un *= self.reconfigured(speed)

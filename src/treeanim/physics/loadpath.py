@@ -492,16 +492,15 @@ class LoadPath:
         slots = np.empty((6, len(self.att_nodes)))
         for lvl in self.up:  # outermost first: a level's subtrees are whole when it is reached
             sl = lvl["sl"]
-            Zs, xs = Z[:, sl], x[:, sl]
-            e = np.einsum("cdk,dk->ck", lvl["Pe"], Zs)
-            np.add(e, g_extra[:, sl], out=g[:, sl])
-            e *= c1[:, sl]
-            xs += e
+            Zs, xs, E = Z[:, sl], x[:, sl], g[:, sl]
+            np.einsum("cdk,dk->ck", lvl["Pe"], Zs, out=E)  # the subtree's equivalent load
+            xs += c1[:, sl] * E
             Zs += np.einsum("dck,ck->dk", lvl["Q"], xs)
             if "first" in lvl:
                 into = slots[:, lvl["slots"]]
                 np.add.reduceat(Zs if lvl["perm"] is None else Zs[:, lvl["perm"]], lvl["first"], axis=1, out=into)
                 Z[:, lvl["owners"]] += np.add.reduceat(into, lvl["ofirst"], axis=1)
+        g += g_extra
         return slots
 
     def segment_forces(self, F_own: np.ndarray, F_tip: np.ndarray, dT: np.ndarray, Lv: np.ndarray,

@@ -14,7 +14,7 @@ import numpy as np
 
 from .bend_angle import saturating_twist
 from .oscillator import exact_coefficients, exact_response
-from .rotation import qrot
+from .rotation import dot, qrot
 
 #: Time constant (s) of the low-pass filter on base accelerations (base excitation). It keeps
 #: the finite-difference acceleration finite and smooth at any dt and delays it by ~10 ms.
@@ -142,7 +142,7 @@ class Stages:
         g = self._g_prev
         slots = self._lp.inward(F_own, F_pull, held, g_extra, (p_free, gain), g)
         self._advance(g, p_free, pd_free, gain, gain_d, c_air, dt, held)
-        self._L = g.copy()
+        self._L = g  # the loads read are the last step's (g is refilled in place)
         F_own, F_tip, dT, slots = self._distributed_loads(F_own, F_pull, slots, g - g_extra, dt)
         blocks, gamma = self._lp.segment_forces(F_own, F_tip, dT, self._p[1], slots)
         leaf = self._lp.leaf_seg  # leaves turn at a bounded speed, and flutter
@@ -199,7 +199,7 @@ class Stages:
             U = np.ascontiguousarray(U.T)  # (3, M): whole rows are many times faster to work on
             F = self._drag.loads(U, self._frame, np.take(self._bplan.q, self._tip_flat, axis=1))
             rel = U - self._sample_vel
-        speed = np.sqrt(np.einsum("ij,ij->j", rel, rel))
+        speed = np.sqrt(dot(rel, rel))
         lp = self._lp
         c_air = lp.Q_foliage * self._drag.reconfigured(speed)
         c_air += lp.Q_wood
