@@ -494,9 +494,9 @@ class LoadPath:
             sl = lvl["sl"]
             Zs, xs, E = Z[:, sl], x[:, sl], g[:, sl]
             np.einsum("cdk,dk->ck", lvl["Pe"], Zs, out=E)  # the subtree's equivalent load
-            xs += c1[:, sl] * E
-            Zs += np.einsum("dck,ck->dk", lvl["Q"], xs)
-            if "first" in lvl:
+            if "first" in lvl:  # (roots transmit nothing)
+                xs += c1[:, sl] * E
+                Zs += np.einsum("dck,ck->dk", lvl["Q"], xs)
                 into = slots[:, lvl["slots"]]
                 np.add.reduceat(Zs if lvl["perm"] is None else Zs[:, lvl["perm"]], lvl["first"], axis=1, out=into)
                 Z[:, lvl["owners"]] += np.add.reduceat(into, lvl["ofirst"], axis=1)
