@@ -521,7 +521,8 @@ class Simulation(Derived, Stages, Pose):
         ValueError
             ``dt`` not in (0, MAX_STEP], invalid ``modes`` (f not in (0, MAX_FREQUENCY], ζ not
             in [0, MAX_ZETA], wrong shape), or a wind whose ``sample`` returns the wrong
-            shape or non-finite values. The state is left unchanged.
+            shape or non-finite values. The state is left unchanged (or, where the wind fails
+            in a later sub-step of the load path, advanced by the sub-steps before it).
         """
         dt = finite_float("dt", dt)
         if not 0 < dt <= MAX_STEP:
@@ -529,8 +530,8 @@ class Simulation(Derived, Stages, Pose):
         f3, z3 = self._modes_arrays()
         if self._load_path:  # in sub-steps short enough for the base excitation (stages.py)
             n = min(math.ceil(dt / MAX_SUBSTEP - 1e-9), MAX_SUBSTEPS)
+            h = dt / n
             for _ in range(n):
-                h = dt / n
                 self._step_load_path(self._wind_at_samples(self._time), f3, z3, h)
                 if len(self._fallen):
                     self._fallen.step(self._wind_at_points(self._time), h)
