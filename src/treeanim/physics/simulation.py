@@ -529,7 +529,7 @@ class Simulation(Derived, Stages, Pose):
             raise ValueError(f"dt must be > 0 and at most {MAX_STEP:g} s, got {dt!r}")
         f3, z3 = self._modes_arrays()
         if self._load_path:  # in sub-steps short enough for the base excitation (stages.py)
-            n = min(math.ceil(dt / MAX_SUBSTEP - 1e-9), MAX_SUBSTEPS)
+            n = min(max(math.ceil(dt / MAX_SUBSTEP - 1e-9), 1), MAX_SUBSTEPS)
             h = dt / n
             for _ in range(n):
                 self._step_load_path(self._wind_at_samples(self._time), f3, z3, h)
