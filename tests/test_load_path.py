@@ -160,6 +160,20 @@ def test_a_released_limb_dies_away_in_calm_air_at_long_steps(cherry, dt):
     assert swing[1] < 0.3 * swing[0], "25 s later it swings far less, never more"
 
 
+def test_a_long_frame_is_the_same_as_its_sixtieths(cherry):
+    """``step(1/30)`` takes the load path in two sub-steps of 1/60 s: a caller at 30 fps sees
+    the tree a 60 fps caller sees, gusts and pulls included."""
+    sims = [ta.Simulation(cherry, wind=ta.WindField(speed=12.0, seed=4)) for _ in range(2)]
+    for sim in sims:
+        sim.pull(int(np.flatnonzero(cherry.level == 2)[0]), (0.0, 0.0, 20.0))
+    for _ in range(30):
+        sims[0].step(1 / 30)
+        sims[1].step(1 / 60)
+        sims[1].step(1 / 60)
+    assert sims[0].time == pytest.approx(sims[1].time)
+    np.testing.assert_allclose(sims[0].positions, sims[1].positions, atol=1e-9)
+
+
 def test_load_path_off_reproduces_the_paper_model_bit_for_bit():
     """``load_path=False`` gives the poses the paper model gave before the load path (recorded
     at commit 4ed910f by tests/data/make_paper_reference.py)."""
