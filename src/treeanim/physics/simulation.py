@@ -528,19 +528,19 @@ class Simulation(Derived, Stages, Pose):
         if not 0 < dt <= MAX_STEP:
             raise ValueError(f"dt must be > 0 and at most {MAX_STEP:g} s, got {dt!r}")
         f3, z3 = self._modes_arrays()
-        if self._load_path:  # in sub-steps short enough for the base excitation (stages.py)
-            n = min(max(math.ceil(dt / MAX_SUBSTEP - 1e-9), 1), MAX_SUBSTEPS)
-            h = dt / n
-            for _ in range(n):
-                self._step_load_path(self._wind_at_samples(self._time), f3, z3, h)
+        # the load path in sub-steps short enough for its base excitation (stages.py)
+        n = min(max(math.ceil(dt / MAX_SUBSTEP - 1e-9), 1), MAX_SUBSTEPS) if self._load_path else 1
+        h = dt / n
+        for _ in range(n):
+            U = self._wind_at_samples(self._time)
+            if self._load_path:
+                self._step_load_path(U, f3, z3, h)
                 if len(self._fallen):
                     self._fallen.step(self._wind_at_points(self._time), h)
-                self._dt_prev = h
-                self._time += h
-        else:
-            self._step_paper(self._wind_at_samples(self._time), f3, z3, dt)
-            self._dt_prev = dt
-            self._time += dt
+            else:
+                self._step_paper(U, f3, z3, h)
+            self._dt_prev = h
+            self._time += h
         self._pos_out = None
         self._rot_out = None
         self._fn = None
