@@ -1,0 +1,658 @@
+"""The whole tree as one articulated body, stepped implicitly in O(n) (docs/design.md §12).
+
+Compiled passes along the hierarchy (numba, ``cache=True``); everything else about the tree
+stepper lives in :mod:`treeanim.physics.structure` (the model) and
+:mod:`treeanim.physics.treestep` (the step). Conventions:
+
+* Every *body* is one rigid segment of a branch or a grass blade, jointed to its parent body at
+  its first node by a ball joint (three rotational degrees of freedom: two bends, one twist).
+  Bodies are ordered so that a parent comes before its children; a root's parent is the ground.
+* All spatial quantities are in world axes about each body's own joint point: a spatial velocity
+  is (ω, v) with v the velocity of the body-fixed point at the joint, a spatial force (n, f) with
+  n the moment about the joint. A joint's motion subspace is then S = [1₃; 0].
+* A body's rest-relative world rotation is R_b = R_parent·Q_b, with Q_b the joint's rotation in
+  its parent's rest axes; its joint angular velocity w_b is kept in the same axes.
+* Joint springs and dampers (K, D) and a grab's spring are integrated by the θ-method, with
+  Δ the change of the joint velocities over the step:
+
+      (M + hθ·D + h²θ²·K + Jᵀ(h·C + h²θ²·K_grab)J) Δ = h·(τ − K q − (D + θhK) q̇),
+      q⁺ = q + h(q̇ + θΔ),
+
+  solved by Featherstone's articulated-body algorithm: the joint terms join each joint's 3×3
+  D block, the body terms its spatial inertia (as point "masses" κ at the points they act on).
+  Each joint has its own θ (:func:`theta_of`): ½, the trapezoidal rule, for a swing the step
+  resolves, toward 1 for one it cannot, so stiff stub twigs never ring. The air's damping C is
+  taken by backward Euler (θ = 1): drag only ever slows a part.
+* The velocity-product (Coriolis, centrifugal, gyroscopic) forces are left out: quadratic in
+  the angular velocities, they vanish in a tree's small swings, and taken explicitly they drove
+  fast thin twigs unstable (a scanned stem's twigs whipped off to 10⁹ rad/s within a second at
+  1/60 s); without them the step is unconditionally stable and, in calm air, its energy never
+  grows.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = ["theta_of", "forward_kinematics", "articulated_step", "leaf_step", "pose_nodes", "rot_log", "rot_exp", "add_point"]
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def theta_of(x):
+    """The θ-method's weight for a joint whose own frequency ω (with all it carries) makes
+    x = ωh a step.
+
+    θ = ½ + ½·x⁴/(x⁴ + 10⁴): the trapezoidal rule (no numerical damping, θ − ½ < 10⁻³ for
+    x < 2.4) for every joint the step resolves, rising to ¾ at x = 10 and toward 1 (backward
+    Euler) for joints far stiffer than the step, whose swing then shrinks by (1 − θ)/θ a step
+    instead of ringing at the step rate. A joint's own frequency is the highest of the modes
+    that bend it much; the tree's low modes bend mostly its trunk and limbs, whose θ is ½.
+    """
+    x4 = (x * x) ** 2
+    return 0.5 + 0.5 * x4 / (x4 + 1.0e4)
+
+
+@njit(cache=True, inline="always", fastmath=True, error_model="numpy")
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def rot_exp(x, y, z, out):
+    """Rodrigues: ``out`` (3, 3) = exp([r]×) for the rotation vector r = (x, y, z)."""
+    t2 = x * x + y * y + z * z
+    if t2 < 1e-12:
+        a = 1.0 - t2 / 6.0
+        b = 0.5 - t2 / 24.0
+    else:
+        t = np.sqrt(t2)
+        a = np.sin(t) / t
+        b = (1.0 - np.cos(t)) / t2
+    out[0, 0] = 1.0 - b * (y * y + z * z)
+    out[1, 1] = 1.0 - b * (x * x + z * z)
+    out[2, 2] = 1.0 - b * (x * x + y * y)
+    out[0, 1] = b * x * y - a * z
+    out[1, 0] = b * x * y + a * z
+    out[0, 2] = b * x * z + a * y
+    out[2, 0] = b * x * z - a * y
+    out[1, 2] = b * y * z - a * x
+    out[2, 1] = b * y * z + a * x
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def rot_log(Q, out):
+    """The rotation vector ``out`` (3,) of the rotation matrix ``Q`` (3, 3) (angle < π)."""
+    c = 0.5 * (Q[0, 0] + Q[1, 1] + Q[2, 2] - 1.0)
+    c = min(1.0, max(-1.0, c))
+    t = np.arccos(c)
+    x = 0.5 * (Q[2, 1] - Q[1, 2])
+    y = 0.5 * (Q[0, 2] - Q[2, 0])
+    z = 0.5 * (Q[1, 0] - Q[0, 1])
+    s = np.sin(t)
+    f = 1.0 + t * t / 6.0 if t < 1e-4 else t / max(s, 1e-12)
+    out[0] = f * x
+    out[1] = f * y
+    out[2] = f * z
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _orthonormalize(Q):
+    """Re-orthonormalise a rotation matrix (rows by Gram–Schmidt) against round-off drift."""
+    n = np.sqrt(Q[0, 0] ** 2 + Q[0, 1] ** 2 + Q[0, 2] ** 2)
+    Q[0, 0] /= n
+    Q[0, 1] /= n
+    Q[0, 2] /= n
+    d = Q[1, 0] * Q[0, 0] + Q[1, 1] * Q[0, 1] + Q[1, 2] * Q[0, 2]
+    Q[1, 0] -= d * Q[0, 0]
+    Q[1, 1] -= d * Q[0, 1]
+    Q[1, 2] -= d * Q[0, 2]
+    n = np.sqrt(Q[1, 0] ** 2 + Q[1, 1] ** 2 + Q[1, 2] ** 2)
+    Q[1, 0] /= n
+    Q[1, 1] /= n
+    Q[1, 2] /= n
+    Q[2, 0], Q[2, 1], Q[2, 2] = _cross(Q[0, 0], Q[0, 1], Q[0, 2], Q[1, 0], Q[1, 1], Q[1, 2])
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def forward_kinematics(parent, r0, Q, w, R, P, Om, V):
+    """World rotations ``R``, joint positions ``P``, angular velocities ``Om`` and joint-point
+    velocities ``V`` of every body from its joint's rotation ``Q`` and velocity ``w``.
+
+    Parameters
+    ----------
+    parent : (B,) int64
+        Parent body (−1: the ground).
+    r0 : (B, 3)
+        Rest offset of each joint from its parent's joint (a root's: its world position).
+    Q : (B, 3, 3), w : (B, 3)
+        Joint rotations and angular velocities, in the parent's rest axes.
+    R, P, Om, V : (B, 3, 3), (B, 3), (B, 3), (B, 3)
+        Written.
+    """
+    B = parent.shape[0]
+    for b in range(B):
+        p = parent[b]
+        if p < 0:
+            for i in range(3):
+                for j in range(3):
+                    R[b, i, j] = Q[b, i, j]
+                P[b, i] = r0[b, i]
+                Om[b, i] = 0.0
+                V[b, i] = 0.0
+            for i in range(3):
+                Om[b, i] = w[b, i]
+            continue
+        for i in range(3):
+            for j in range(3):
+                s = 0.0
+                for k in range(3):
+                    s += R[p, i, k] * Q[b, k, j]
+                R[b, i, j] = s
+        rx = R[p, 0, 0] * r0[b, 0] + R[p, 0, 1] * r0[b, 1] + R[p, 0, 2] * r0[b, 2]
+        ry = R[p, 1, 0] * r0[b, 0] + R[p, 1, 1] * r0[b, 1] + R[p, 1, 2] * r0[b, 2]
+        rz = R[p, 2, 0] * r0[b, 0] + R[p, 2, 1] * r0[b, 1] + R[p, 2, 2] * r0[b, 2]
+        P[b, 0] = P[p, 0] + rx
+        P[b, 1] = P[p, 1] + ry
+        P[b, 2] = P[p, 2] + rz
+        cx, cy, cz = _cross(Om[p, 0], Om[p, 1], Om[p, 2], rx, ry, rz)
+        V[b, 0] = V[p, 0] + cx
+        V[b, 1] = V[p, 1] + cy
+        V[b, 2] = V[p, 2] + cz
+        for i in range(3):
+            Om[b, i] = Om[p, i] + R[p, i, 0] * w[b, 0] + R[p, i, 1] * w[b, 1] + R[p, i, 2] * w[b, 2]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _inv3(A, out):
+    a, b, c = A[0, 0], A[0, 1], A[0, 2]
+    d, e, f = A[1, 0], A[1, 1], A[1, 2]
+    g, h, i = A[2, 0], A[2, 1], A[2, 2]
+    c00 = e * i - f * h
+    c01 = f * g - d * i
+    c02 = d * h - e * g
+    det = a * c00 + b * c01 + c * c02
+    r = 1.0 / det
+    out[0, 0] = c00 * r
+    out[1, 0] = c01 * r
+    out[2, 0] = c02 * r
+    out[0, 1] = (c * h - b * i) * r
+    out[1, 1] = (a * i - c * g) * r
+    out[2, 1] = (b * g - a * h) * r
+    out[0, 2] = (b * f - c * e) * r
+    out[1, 2] = (c * d - a * f) * r
+    out[2, 2] = (a * e - b * d) * r
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def articulated_step(h, theta, parent, r0, m0, h0, J0, K, D, R, P, Om, V, Q, w,
+                     F, kap, IA, pA, Dinv, Ucol, u, acc):
+    """One implicit step of every body (the articulated-body algorithm, three passes).
+
+    Parameters
+    ----------
+    h : float
+        Step length (s).
+    theta : (B,) float
+        Each joint's θ (:func:`theta_of`).
+    parent, r0 : see :func:`forward_kinematics`.
+    m0, h0, J0 : (B,), (B, 3), (B, 3, 3)
+        Each body's mass, first and second moments about its joint in rest axes (what it carries
+        rigidly — its leaves — included).
+    K, D : (B, 3, 3)
+        Joint stiffness (N·m/rad) and damping (N·m·s/rad) in the parent's rest axes.
+    R, P, Om, V, Q, w : the state (see :func:`forward_kinematics`); Q and w are advanced in
+        place, R, P, Om and V are left for :func:`forward_kinematics` to redo.
+    F : (B, 6)
+        External spatial force on each body (moment about its joint, force), world.
+    kap : (B, 6, 6)
+        The implicit terms of forces linear in a point's velocity (the air, h·C) or
+        displacement (a grab, h²θ²·k): Σ Pᵀ κ P over their points, P = [−[r]×, 1] the map from
+        the body's spatial velocity to the point's (:func:`add_point`).
+    IA, pA, Dinv, Ucol, u : work arrays (B, 6, 6), (B, 6), (B, 3, 3), (B, 6, 3), (B, 3).
+    acc : (B, 6)
+        Written: each body's change of spatial velocity over the step (world, at its joint).
+    """
+    B = parent.shape[0]
+    Rm = np.empty((3, 3))
+    Jw = np.empty((3, 3))
+    Kw = np.empty((3, 3))
+    Dw = np.empty((3, 3))
+    tmp = np.empty((3, 3))
+    th = np.empty(3)
+    Dj = np.empty((3, 3))
+    Ia = np.empty((6, 6))
+    UD = np.empty((6, 3))
+    pa = np.empty(6)
+    wk = np.empty((3, 3, 3))
+    # --- 1. each body's own inertia (plus the implicit point terms) and bias force
+    for b in range(B):
+        m = m0[b]
+        hx = R[b, 0, 0] * h0[b, 0] + R[b, 0, 1] * h0[b, 1] + R[b, 0, 2] * h0[b, 2]
+        hy = R[b, 1, 0] * h0[b, 0] + R[b, 1, 1] * h0[b, 1] + R[b, 1, 2] * h0[b, 2]
+        hz = R[b, 2, 0] * h0[b, 0] + R[b, 2, 1] * h0[b, 1] + R[b, 2, 2] * h0[b, 2]
+        for i in range(3):
+            for j in range(3):
+                s = 0.0
+                for k in range(3):
+                    s += R[b, i, k] * J0[b, k, j]
+                tmp[i, j] = s
+        for i in range(3):
+            for j in range(3):
+                s = 0.0
+                for k in range(3):
+                    s += tmp[i, k] * R[b, j, k]
+                Jw[i, j] = s
+        for i in range(6):
+            pA[b, i] = -h * F[b, i]
+        for i in range(3):
+            for j in range(3):
+                IA[b, i, j] = Jw[i, j] + kap[b, i, j]
+                IA[b, 3 + i, 3 + j] = kap[b, 3 + i, 3 + j]
+            IA[b, 3 + i, 3 + i] += m
+        # upper right [h]× (+ κ's), lower left its transpose
+        IA[b, 0, 3], IA[b, 0, 4], IA[b, 0, 5] = 0.0, -hz, hy
+        IA[b, 1, 3], IA[b, 1, 4], IA[b, 1, 5] = hz, 0.0, -hx
+        IA[b, 2, 3], IA[b, 2, 4], IA[b, 2, 5] = -hy, hx, 0.0
+        for i in range(3):
+            for j in range(3):
+                IA[b, i, 3 + j] += kap[b, i, 3 + j]
+                IA[b, 3 + i, j] = IA[b, j, 3 + i]
+    # --- 2. inward: articulated inertias and bias forces, the joints' terms folded in
+    for b in range(B - 1, -1, -1):
+        p = parent[b]
+        # the joint's relative angular velocity (world) and its rotation vector (world)
+        if p >= 0:
+            for i in range(3):
+                for j in range(3):
+                    Rm[i, j] = R[p, i, j]
+        else:
+            for i in range(3):
+                for j in range(3):
+                    Rm[i, j] = 1.0 if i == j else 0.0
+        rot_log(Q[b], th)
+        wr0 = Rm[0, 0] * w[b, 0] + Rm[0, 1] * w[b, 1] + Rm[0, 2] * w[b, 2]
+        wr1 = Rm[1, 0] * w[b, 0] + Rm[1, 1] * w[b, 1] + Rm[1, 2] * w[b, 2]
+        wr2 = Rm[2, 0] * w[b, 0] + Rm[2, 1] * w[b, 1] + Rm[2, 2] * w[b, 2]
+        # Kw = Rm K Rmᵀ, Dw likewise
+        for i in range(3):
+            for j in range(3):
+                s = 0.0
+                t = 0.0
+                for k in range(3):
+                    s += Rm[i, k] * K[b, k, j]
+                    t += Rm[i, k] * D[b, k, j]
+                tmp[i, j] = s
+                Jw[i, j] = t
+        for i in range(3):
+            for j in range(3):
+                s = 0.0
+                t = 0.0
+                for k in range(3):
+                    s += tmp[i, k] * Rm[j, k]
+                    t += Jw[i, k] * Rm[j, k]
+                Kw[i, j] = s
+                Dw[i, j] = t
+        hth = h * theta[b]
+        # joint torque −K θ − (D + θhK) ω_rel, in world (θ = Rm·log Q)
+        tw0 = Rm[0, 0] * th[0] + Rm[0, 1] * th[1] + Rm[0, 2] * th[2]
+        tw1 = Rm[1, 0] * th[0] + Rm[1, 1] * th[1] + Rm[1, 2] * th[2]
+        tw2 = Rm[2, 0] * th[0] + Rm[2, 1] * th[1] + Rm[2, 2] * th[2]
+        for i in range(3):
+            tau = -(Kw[i, 0] * tw0 + Kw[i, 1] * tw1 + Kw[i, 2] * tw2)
+            tau -= (Dw[i, 0] + hth * Kw[i, 0]) * wr0 + (Dw[i, 1] + hth * Kw[i, 1]) * wr1 \
+                + (Dw[i, 2] + hth * Kw[i, 2]) * wr2
+            u[b, i] = h * tau - pA[b, i]
+        # D = Sᵀ IA S + hθ D + h²θ² K
+        for i in range(3):
+            for j in range(3):
+                Dj[i, j] = IA[b, i, j] + hth * Dw[i, j] + hth * hth * Kw[i, j]
+        _inv3(Dj, Dinv[b])
+        for i in range(6):
+            for j in range(3):
+                Ucol[b, i, j] = IA[b, i, j]
+        if p < 0:
+            continue
+        # Ia = IA − U D⁻¹ Uᵀ ; pa = pA + U D⁻¹ u
+        for i in range(6):
+            for j in range(3):
+                UD[i, j] = Ucol[b, i, 0] * Dinv[b, 0, j] + Ucol[b, i, 1] * Dinv[b, 1, j] + Ucol[b, i, 2] * Dinv[b, 2, j]
+        for i in range(6):
+            for j in range(i, 6):
+                s = IA[b, i, j] - (UD[i, 0] * Ucol[b, j, 0] + UD[i, 1] * Ucol[b, j, 1] + UD[i, 2] * Ucol[b, j, 2])
+                Ia[i, j] = s
+                Ia[j, i] = s
+        for i in range(6):
+            pa[i] = pA[b, i] + UD[i, 0] * u[b, 0] + UD[i, 1] * u[b, 1] + UD[i, 2] * u[b, 2]
+        # to the parent's joint: r = P_b − P_p
+        rx, ry, rz = P[b, 0] - P[p, 0], P[b, 1] - P[p, 1], P[b, 2] - P[p, 2]
+        _add_translated(Ia, pa, rx, ry, rz, IA[p], pA[p], wk)
+    # --- 3. outward: the joints' velocity changes and the bodies' spatial ones
+    for b in range(B):
+        p = parent[b]
+        a0 = a1 = a2 = a3 = a4 = a5 = 0.0
+        if p >= 0:
+            rx, ry, rz = P[b, 0] - P[p, 0], P[b, 1] - P[p, 1], P[b, 2] - P[p, 2]
+            a0, a1, a2 = acc[p, 0], acc[p, 1], acc[p, 2]
+            cx, cy, cz = _cross(a0, a1, a2, rx, ry, rz)
+            a3, a4, a5 = acc[p, 3] + cx, acc[p, 4] + cy, acc[p, 5] + cz
+        # Δ = D⁻¹ (u − Uᵀ a')
+        r_0 = u[b, 0] - (Ucol[b, 0, 0] * a0 + Ucol[b, 1, 0] * a1 + Ucol[b, 2, 0] * a2
+                         + Ucol[b, 3, 0] * a3 + Ucol[b, 4, 0] * a4 + Ucol[b, 5, 0] * a5)
+        r_1 = u[b, 1] - (Ucol[b, 0, 1] * a0 + Ucol[b, 1, 1] * a1 + Ucol[b, 2, 1] * a2
+                         + Ucol[b, 3, 1] * a3 + Ucol[b, 4, 1] * a4 + Ucol[b, 5, 1] * a5)
+        r_2 = u[b, 2] - (Ucol[b, 0, 2] * a0 + Ucol[b, 1, 2] * a1 + Ucol[b, 2, 2] * a2
+                         + Ucol[b, 3, 2] * a3 + Ucol[b, 4, 2] * a4 + Ucol[b, 5, 2] * a5)
+        d0 = Dinv[b, 0, 0] * r_0 + Dinv[b, 0, 1] * r_1 + Dinv[b, 0, 2] * r_2
+        d1 = Dinv[b, 1, 0] * r_0 + Dinv[b, 1, 1] * r_1 + Dinv[b, 1, 2] * r_2
+        d2 = Dinv[b, 2, 0] * r_0 + Dinv[b, 2, 1] * r_1 + Dinv[b, 2, 2] * r_2
+        acc[b, 0] = a0 + d0
+        acc[b, 1] = a1 + d1
+        acc[b, 2] = a2 + d2
+        acc[b, 3] = a3
+        acc[b, 4] = a4
+        acc[b, 5] = a5
+        # w⁺ = w + Rpᵀ Δ; Q⁺ = exp(h (w + θ Rpᵀ Δ)) Q
+        if p >= 0:
+            l0 = R[p, 0, 0] * d0 + R[p, 1, 0] * d1 + R[p, 2, 0] * d2
+            l1 = R[p, 0, 1] * d0 + R[p, 1, 1] * d1 + R[p, 2, 1] * d2
+            l2 = R[p, 0, 2] * d0 + R[p, 1, 2] * d1 + R[p, 2, 2] * d2
+        else:
+            l0, l1, l2 = d0, d1, d2
+        e0 = h * (w[b, 0] + theta[b] * l0)
+        e1 = h * (w[b, 1] + theta[b] * l1)
+        e2 = h * (w[b, 2] + theta[b] * l2)
+        w[b, 0] += l0
+        w[b, 1] += l1
+        w[b, 2] += l2
+        rot_exp(e0, e1, e2, Rm)
+        for i in range(3):
+            for j in range(3):
+                tmp[i, j] = Rm[i, 0] * Q[b, 0, j] + Rm[i, 1] * Q[b, 1, j] + Rm[i, 2] * Q[b, 2, j]
+        for i in range(3):
+            for j in range(3):
+                Q[b, i, j] = tmp[i, j]
+        _orthonormalize(Q[b])
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def add_point(kap, b, alpha, beta, nx, ny, nz, rx, ry, rz):
+    """kap[b] += Pᵀ C P for C = α·1 + β·n nᵀ acting at the point r (world, from b's joint)."""
+    C = np.empty((3, 3))
+    n = (nx, ny, nz)
+    for i in range(3):
+        for j in range(3):
+            C[i, j] = beta * n[i] * n[j]
+        C[i, i] += alpha
+    # M1 = C [r]×
+    M1 = np.empty((3, 3))
+    for i in range(3):
+        M1[i, 0] = C[i, 1] * rz - C[i, 2] * ry
+        M1[i, 1] = C[i, 2] * rx - C[i, 0] * rz
+        M1[i, 2] = C[i, 0] * ry - C[i, 1] * rx
+    # UL = −[r]× M1 ; UR = −M1ᵀ ; LL = −M1 ; LR = C
+    for j in range(3):
+        c0, c1, c2 = _cross(rx, ry, rz, M1[0, j], M1[1, j], M1[2, j])
+        kap[b, 0, j] -= c0
+        kap[b, 1, j] -= c1
+        kap[b, 2, j] -= c2
+    for i in range(3):
+        for j in range(3):
+            kap[b, i, 3 + j] -= M1[j, i]
+            kap[b, 3 + i, j] -= M1[i, j]
+            kap[b, 3 + i, 3 + j] += C[i, j]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _add_translated(Ia, pa, rx, ry, rz, IAp, pAp, wk):
+    """IAp += Xᵀ Ia X and pAp += Xᵀ pa for the translation r from the parent's joint to the
+    child's (X: motion at the parent's joint → at the child's)."""
+    # blocks of Ia: A (0:3, 0:3), Bm (0:3, 3:6), C = Bmᵀ, Dm (3:6, 3:6)
+    # A' = A − Bm[r] + [r]C − [r]Dm[r] ; Bm' = Bm + [r]Dm ; Dm' = Dm
+    rc, rD, Bn = wk[0], wk[1], wk[2]
+    rc[0, 0], rc[0, 1], rc[0, 2] = 0.0, -rz, ry
+    rc[1, 0], rc[1, 1], rc[1, 2] = rz, 0.0, -rx
+    rc[2, 0], rc[2, 1], rc[2, 2] = -ry, rx, 0.0
+    # rD = [r] Dm
+    for i in range(3):
+        for j in range(3):
+            rD[i, j] = rc[i, 0] * Ia[3, 3 + j] + rc[i, 1] * Ia[4, 3 + j] + rc[i, 2] * Ia[5, 3 + j]
+    for i in range(3):
+        for j in range(3):
+            Bn[i, j] = Ia[i, 3 + j] + rD[i, j]
+    # A' = A − Bm[r] + [r](C − Dm[r]) = A − Bm[r] + [r]C − rD[r]
+    for i in range(3):
+        for j in range(3):
+            s = Ia[i, j]
+            for k in range(3):
+                s += -Ia[i, 3 + k] * rc[k, j] + rc[i, k] * Ia[3 + k, j] - rD[i, k] * rc[k, j]
+            IAp[i, j] += s
+    for i in range(3):
+        for j in range(3):
+            IAp[i, 3 + j] += Bn[i, j]
+            IAp[3 + j, i] += Bn[i, j]
+            IAp[3 + i, 3 + j] += Ia[3 + i, 3 + j]
+    c = _cross(rx, ry, rz, pa[3], pa[4], pa[5])
+    pAp[0] += pa[0] + c[0]
+    pAp[1] += pa[1] + c[1]
+    pAp[2] += pa[2] + c[2]
+    pAp[3] += pa[3]
+    pAp[4] += pa[4]
+    pAp[5] += pa[5]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _leaf_rotation(E, th, G):
+    """G (3, 3) = exp([θ₁b₁ + θ₂b₂]×)·exp(θ₀[a]×), the leaf against its twig (E: columns a, b₁, b₂)."""
+    T = np.empty((3, 3))
+    Bm = np.empty((3, 3))
+    rot_exp(E[0, 0] * th[0], E[1, 0] * th[0], E[2, 0] * th[0], T)
+    rot_exp(E[0, 1] * th[1] + E[0, 2] * th[2], E[1, 1] * th[1] + E[1, 2] * th[2],
+            E[2, 1] * th[1] + E[2, 2] * th[2], Bm)
+    for i in range(3):
+        for j in range(3):
+            G[i, j] = Bm[i, 0] * T[0, j] + Bm[i, 1] * T[1, j] + Bm[i, 2] * T[2, j]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, R, P, Om, V, U,
+              flutter, th, thd, F, X, Nrm, kap):
+    """Advance every leaf's petiole joint (bend about two axes and twist) over one step, and
+    give the force it passes to its twig for the next.
+
+    A leaf is a lamina on a petiole, its rotation against its twig exp(E·θ) (θ in the leaf's
+    own axes E = [a, b₁, b₂], a along the lever from the petiole's base to the lamina's
+    centroid: θ_a twists it, θ_b bends it). Its inertia is small next to its twig's and rides
+    on it rigidly in the articulated step; here it turns on top, driven by the normal force
+    ½ρC_nA|U_rel|(U_rel·n)n on the lamina and the twig's acceleration, held by its petiole's
+    spring and damped by the petiole and the air, by the same θ-method per axis.
+
+    The lamina's inertia rides its twig rigidly, so the twig's acceleration is not passed to
+    it (that would feed the leaf energy its twig never gives up): a leaf moves by the air
+    relative to it, its twig's motion included — for a leaf, whose drag outweighs its
+    inertia many times, the larger part. The air against the lamina's own swing damps it at
+    c·|U_rel|·r² (c = ½ρC_nA, r its lever), at least the rate of the normal force's own
+    swing term, so in calm air the leaf and its twig together only ever lose energy.
+
+    Parameters
+    ----------
+    on : (L,) bool — leaves on the tree; body : (L,) int — the twig body each sits on.
+    base0, rc0, n0 : (L, 3) — rest offset of the petiole's base from its twig's joint, of the
+        lamina's centroid from the petiole's base, the lamina's rest normal.
+    E : (L, 3, 3) — the leaf's axes (columns a, b₁, b₂) in rest axes.
+    k, J, dstr : (L, 3) — stiffness, inertia and structural damping per axis.
+    cna : (L,) — ½ρC_nA of the lamina.
+    R, P, Om, V : the twigs' new kinematics.
+    U : (L, 3) — the wind at each lamina (m/s).
+    flutter : (L,) — the flutter's twist now (rad): its torque k_t·flutter drives the twist.
+    th, thd : (L, 3) — the state, advanced in place.
+    F : (L, 3) — written: the lamina's force (world, N) at X.
+    X : (L, 3) — written: the lamina's centroid (world) relative to its twig's joint.
+    Nrm : (L, 3) — written: the lamina's normal (world).
+    kap : (L,) — written: the air's implicit damping κ = h·½ρC_nA|U_rel| there, along the
+        normal (backward Euler).
+    """
+    G = np.empty((3, 3))
+    RG = np.empty((3, 3))
+    for l in range(body.shape[0]):
+        if not on[l]:
+            F[l, 0] = F[l, 1] = F[l, 2] = 0.0
+            kap[l] = 0.0
+            continue
+        b = body[l]
+        _leaf_rotation(E[l], th[l], G)
+        for i in range(3):
+            for j in range(3):
+                RG[i, j] = R[b, i, 0] * G[0, j] + R[b, i, 1] * G[1, j] + R[b, i, 2] * G[2, j]
+        bx = R[b, 0, 0] * base0[l, 0] + R[b, 0, 1] * base0[l, 1] + R[b, 0, 2] * base0[l, 2]
+        by = R[b, 1, 0] * base0[l, 0] + R[b, 1, 1] * base0[l, 1] + R[b, 1, 2] * base0[l, 2]
+        bz = R[b, 2, 0] * base0[l, 0] + R[b, 2, 1] * base0[l, 1] + R[b, 2, 2] * base0[l, 2]
+        cx = RG[0, 0] * rc0[l, 0] + RG[0, 1] * rc0[l, 1] + RG[0, 2] * rc0[l, 2]
+        cy = RG[1, 0] * rc0[l, 0] + RG[1, 1] * rc0[l, 1] + RG[1, 2] * rc0[l, 2]
+        cz = RG[2, 0] * rc0[l, 0] + RG[2, 1] * rc0[l, 1] + RG[2, 2] * rc0[l, 2]
+        nx = RG[0, 0] * n0[l, 0] + RG[0, 1] * n0[l, 1] + RG[0, 2] * n0[l, 2]
+        ny = RG[1, 0] * n0[l, 0] + RG[1, 1] * n0[l, 1] + RG[1, 2] * n0[l, 2]
+        nz = RG[2, 0] * n0[l, 0] + RG[2, 1] * n0[l, 1] + RG[2, 2] * n0[l, 2]
+        xx, xy, xz = bx + cx, by + cy, bz + cz  # the centroid from the twig's joint
+        X[l, 0], X[l, 1], X[l, 2] = xx, xy, xz
+        # the twig's velocity and acceleration there
+        o = _cross(Om[b, 0], Om[b, 1], Om[b, 2], xx, xy, xz)
+        ux, uy, uz = U[l, 0] - V[b, 0] - o[0], U[l, 1] - V[b, 1] - o[1], U[l, 2] - V[b, 2] - o[2]
+        s = np.sqrt(ux * ux + uy * uy + uz * uz)
+        un = ux * nx + uy * ny + uz * nz
+        fn = cna[l] * s * un
+        fx, fy, fz = fn * nx, fn * ny, fn * nz
+        F[l, 0], F[l, 1], F[l, 2] = fx, fy, fz
+        Nrm[l, 0], Nrm[l, 1], Nrm[l, 2] = nx, ny, nz
+        kap[l] = h * cna[l] * s
+        # torque about the petiole's base: the bends take its part about the rest axes b₁, b₂
+        # (in the twig's axes, Rᵀτ), the twist its part about the lamina's axis now (Ga): nil
+        # for a force at the centroid, which lies on that axis; the flutter drives it instead
+        t = _cross(cx, cy, cz, fx, fy, fz)
+        tl0 = R[b, 0, 0] * t[0] + R[b, 1, 0] * t[1] + R[b, 2, 0] * t[2]
+        tl1 = R[b, 0, 1] * t[0] + R[b, 1, 1] * t[1] + R[b, 2, 1] * t[2]
+        tl2 = R[b, 0, 2] * t[0] + R[b, 1, 2] * t[1] + R[b, 2, 2] * t[2]
+        lever2 = rc0[l, 0] ** 2 + rc0[l, 1] ** 2 + rc0[l, 2] ** 2
+        dair = cna[l] * s * lever2  # the air against the lamina's own swing
+        for i in range(3):
+            kk = k[l, i]
+            ka = 0.0
+            if i == 0:
+                tau = kk * flutter[l]
+                d = dstr[l, i]
+            else:
+                tau = E[l, 0, i] * tl0 + E[l, 1, i] * tl1 + E[l, 2, i] * tl2
+                d = dstr[l, i] + dair
+                # the air's stiffness against a turn about this axis e (world), taken implicitly
+                # where it restores (a lamina weathervaning into the flow): −e·∂τ/∂θ with
+                # ∂r = e × r, ∂n = e × n
+                ex = R[b, 0, 0] * E[l, 0, i] + R[b, 0, 1] * E[l, 1, i] + R[b, 0, 2] * E[l, 2, i]
+                ey = R[b, 1, 0] * E[l, 0, i] + R[b, 1, 1] * E[l, 1, i] + R[b, 1, 2] * E[l, 2, i]
+                ez = R[b, 2, 0] * E[l, 0, i] + R[b, 2, 1] * E[l, 1, i] + R[b, 2, 2] * E[l, 2, i]
+                dr = _cross(ex, ey, ez, cx, cy, cz)
+                dn = _cross(ex, ey, ez, nx, ny, nz)
+                udn = ux * dn[0] + uy * dn[1] + uz * dn[2]
+                g0 = cna[l] * s * (udn * nx + un * dn[0])
+                g1 = cna[l] * s * (udn * ny + un * dn[1])
+                g2 = cna[l] * s * (udn * nz + un * dn[2])
+                t1 = _cross(dr[0], dr[1], dr[2], fx, fy, fz)
+                t2 = _cross(cx, cy, cz, g0, g1, g2)
+                ka = max(0.0, -(ex * (t1[0] + t2[0]) + ey * (t1[1] + t2[1]) + ez * (t1[2] + t2[2])))
+            kt = kk + ka
+            tl = theta_of(h * np.sqrt(kt / J[l, i]))
+            hth = h * tl
+            num = h * (tau - kk * th[l, i] - (d + hth * kt) * thd[l, i])
+            dd = num / (J[l, i] + hth * d + hth * hth * kt)
+            th[l, i] += h * (thd[l, i] + tl * dd)
+            thd[l, i] += dd
+        # a petiole bends at most to a right angle (its lamina then lies in the flow)
+        bend = np.sqrt(th[l, 1] ** 2 + th[l, 2] ** 2)
+        if bend > 0.5 * np.pi:
+            sc = 0.5 * np.pi / bend
+            th[l, 1] *= sc
+            th[l, 2] *= sc
+            thd[l, 1] *= sc
+            thd[l, 2] *= sc
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _matmul_into(A, B, out):
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf_first, leaf_body, leaf_E,
+               leaf_th, leaf_on, pos, rot):
+    """Posed node positions ``pos`` (N, 3) and rest-relative rotations ``rot`` (N, 3, 3).
+
+    Bodies: the node at each joint takes the body's rotation and position; an object's tip
+    node the last body's rotation and its end. Leaves: the petiole's k segments curl evenly,
+    segment i turning by (i + 1)/k of the leaf's bend and twist against its twig; its tip
+    node (the lamina) the whole turn.
+    """
+    G = np.empty((3, 3))
+    T1 = np.empty((3, 3))
+    B1 = np.empty((3, 3))
+    Tq = np.empty((3, 3))
+    Bq = np.empty((3, 3))
+    tmp = np.empty((3, 3))
+    for b in range(body_node.shape[0]):
+        j = body_node[b]
+        for i in range(3):
+            pos[j, i] = P[b, i]
+            for c in range(3):
+                rot[j, i, c] = R[b, i, c]
+        if body_tip[b]:
+            t = body_tip_node[b]
+            for i in range(3):
+                s = P[b, i]
+                for c in range(3):
+                    s += R[b, i, c] * (Xrest[t, c] - Xrest[j, c])
+                    rot[t, i, c] = R[b, i, c]
+                pos[t, i] = s
+    for l in range(leaf_body.shape[0]):
+        b = leaf_body[l]
+        a = leaf_first[l]
+        e = leaf_first[l + 1]
+        k = e - a - 1
+        jb = body_node[b]
+        # the petiole's base on its twig
+        for i in range(3):
+            s = P[b, i]
+            for c in range(3):
+                s += R[b, i, c] * (Xrest[leaf_nodes[a], c] - Xrest[jb, c])
+            pos[leaf_nodes[a], i] = s
+        # segment q turns by G_q = B^((q+1)/k)·T^((q+1)/k): powers of one k-th of the bend B
+        # and of the twist T (each about one axis), so two exponentials a leaf
+        f = 1.0 / k if leaf_on[l] else 0.0
+        rot_exp(f * leaf_E[l, 0, 0] * leaf_th[l, 0], f * leaf_E[l, 1, 0] * leaf_th[l, 0],
+                f * leaf_E[l, 2, 0] * leaf_th[l, 0], T1)
+        rot_exp(f * (leaf_E[l, 0, 1] * leaf_th[l, 1] + leaf_E[l, 0, 2] * leaf_th[l, 2]),
+                f * (leaf_E[l, 1, 1] * leaf_th[l, 1] + leaf_E[l, 1, 2] * leaf_th[l, 2]),
+                f * (leaf_E[l, 2, 1] * leaf_th[l, 1] + leaf_E[l, 2, 2] * leaf_th[l, 2]), B1)
+        for i in range(3):
+            for c in range(3):
+                Bq[i, c] = B1[i, c]
+                Tq[i, c] = T1[i, c]
+        for q in range(k):
+            if q > 0:
+                _matmul_into(Bq, B1, tmp)
+                Bq[:, :] = tmp
+                _matmul_into(Tq, T1, tmp)
+                Tq[:, :] = tmp
+            _matmul_into(Bq, Tq, G)
+            n0 = leaf_nodes[a + q]
+            n1 = leaf_nodes[a + q + 1]
+            for i in range(3):
+                for c in range(3):
+                    rot[n0, i, c] = R[b, i, 0] * G[0, c] + R[b, i, 1] * G[1, c] + R[b, i, 2] * G[2, c]
+            for i in range(3):
+                s = pos[n0, i]
+                for c in range(3):
+                    s += rot[n0, i, c] * (Xrest[n1, c] - Xrest[n0, c])
+                pos[n1, i] = s
+            if q == k - 1:
+                for i in range(3):
+                    for c in range(3):
+                        rot[n1, i, c] = rot[n0, i, c]

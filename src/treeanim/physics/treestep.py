@@ -1,0 +1,278 @@
+"""The ``tree`` stepper: the whole tree as one structure, solved implicitly (docs/design.md §12).
+
+:class:`TreeState` is everything that changes over time (copyable, ``state.copy()``);
+:class:`~treeanim.physics.structure.Structure` is the static model; :func:`step` reads a state
+and writes the next one. One step:
+
+1. the wind at every segment's middle and every lamina's centroid (the pose at the start);
+2. the air's force on every segment, ½ρC_d·d·ℓ|U⊥|U⊥ of the wind normal to it relative to the
+   segment's own motion, and the leaves' forces of the last step, with the damping of both
+   implicit; pulls (constant forces) and a grab (a stiff spring to a target, implicit);
+3. the articulated-body step (:func:`~treeanim.physics.articulated.articulated_step`);
+4. the new pose of every body (:func:`~treeanim.physics.articulated.forward_kinematics`);
+5. every leaf's petiole joint (:func:`~treeanim.physics.articulated.leaf_step`), its force
+   kept for the twig's next step, and the leaves' flutter phase.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+from numba import njit
+
+from .articulated import add_point, articulated_step, forward_kinematics, leaf_step, pose_nodes, rot_log, theta_of
+from .structure import Structure
+
+__all__ = ["TreeState", "Grab", "step", "pose", "energy", "sample_points", "FLUTTER_STROUHAL"]
+
+#: f·ℓ/U of a lamina's flutter about its midrib (leaves of 5–15 cm flutter at several hertz in
+#: a 10 m/s wind).
+FLUTTER_STROUHAL = 0.05
+#: The flutter's highest frequency (Hz).
+MAX_FLUTTER_HZ = 12.0
+#: The wind speed (m/s) at which the flutter reaches half its amplitude (U²/(U² + U_f²)).
+FLUTTER_SPEED = 4.0
+
+
+@dataclass
+class TreeState:
+    """The tree stepper's state: joints, the bodies' pose (derived, kept), leaves, time."""
+
+    time: float
+    Q: np.ndarray       # (B, 3, 3) joint rotations
+    w: np.ndarray       # (B, 3) joint angular velocities (parent's rest axes)
+    R: np.ndarray       # (B, 3, 3) world rotations relative to rest
+    P: np.ndarray       # (B, 3) joint positions
+    Om: np.ndarray      # (B, 3) angular velocities
+    V: np.ndarray       # (B, 3) joint-point velocities
+    acc: np.ndarray     # (B, 6) the last step's change of spatial velocity
+    th: np.ndarray      # (L, 3) petiole joints (twist, bend, bend)
+    thd: np.ndarray     # (L, 3)
+    leaf_F: np.ndarray  # (L, 3) the laminas' forces of the last step (world)
+    leaf_X: np.ndarray  # (L, 3) the laminas' centroids from their twig's joint (world axes)
+    leaf_N: np.ndarray  # (L, 3) the laminas' normals (world)
+    leaf_kap: np.ndarray  # (L,)
+    phase: np.ndarray   # (L,) flutter phase (rad)
+    flutter: np.ndarray  # (L,) flutter amplitude (rad)
+
+    @classmethod
+    def rest(cls, s: Structure, seed: int = 0) -> "TreeState":
+        """The tree at rest at time 0."""
+        B, L = len(s.parent), len(s.leaf_body)
+        st = cls(time=0.0, Q=np.tile(np.eye(3), (B, 1, 1)), w=np.zeros((B, 3)), R=np.empty((B, 3, 3)),
+                 P=np.empty((B, 3)), Om=np.empty((B, 3)), V=np.empty((B, 3)), acc=np.zeros((B, 6)),
+                 th=np.zeros((L, 3)), thd=np.zeros((L, 3)), leaf_F=np.zeros((L, 3)),
+                 leaf_X=np.zeros((L, 3)), leaf_N=np.zeros((L, 3)), leaf_kap=np.zeros(L),
+                 phase=np.random.default_rng([int(seed), 0x1EAF]).uniform(0, 2 * np.pi, L), flutter=np.zeros(L))
+        forward_kinematics(s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
+        st.leaf_X[:] = s.leaf_base0 + s.leaf_rc0
+        return st
+
+    def copy(self) -> "TreeState":
+        """A deep copy."""
+        return TreeState(**{f.name: (v.copy() if isinstance(v := getattr(self, f.name), np.ndarray) else v)
+                            for f in fields(self)})
+
+    def assign(self, other: "TreeState") -> None:
+        """Become a copy of ``other`` (arrays overwritten in place)."""
+        for f in fields(self):
+            v = getattr(other, f.name)
+            if isinstance(v, np.ndarray):
+                getattr(self, f.name)[...] = v
+            else:
+                setattr(self, f.name, v)
+
+
+@dataclass
+class Grab:
+    """A point of a body held by a stiff spring toward a world target (solved in the step).
+
+    ``offset`` is the point's rest offset from the body's joint; ``k`` (N/m) and ``c`` (N·s/m)
+    the spring and its damper; ``f_max`` (N) the largest force it exerts (what the wood bears);
+    ``mass`` (kg) what the spring moves, for its θ.
+    """
+
+    body: int
+    offset: np.ndarray
+    target: np.ndarray
+    k: float
+    c: float
+    f_max: float
+    mass: float
+
+
+def sample_points(s: Structure, st: TreeState) -> np.ndarray:
+    """(B + L, 3) world points where the wind is sampled: segment middles, then laminas."""
+    mid = st.P + np.einsum("bij,bj->bi", st.R, s.mid0)
+    lam = st.P[s.leaf_body] + st.leaf_X
+    return np.concatenate([mid, lam])
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf_N, leaf_kap, F, kap):
+    """The air's force on every segment (across it) and the leaves' forces, with their implicit
+    damping terms κ as points (see :func:`~treeanim.physics.articulated.articulated_step`)."""
+    B = R.shape[0]
+    for b in range(B):
+        rx = R[b, 0, 0] * mid0[b, 0] + R[b, 0, 1] * mid0[b, 1] + R[b, 0, 2] * mid0[b, 2]
+        ry = R[b, 1, 0] * mid0[b, 0] + R[b, 1, 1] * mid0[b, 1] + R[b, 1, 2] * mid0[b, 2]
+        rz = R[b, 2, 0] * mid0[b, 0] + R[b, 2, 1] * mid0[b, 1] + R[b, 2, 2] * mid0[b, 2]
+        ax = R[b, 0, 0] * axis[b, 0] + R[b, 0, 1] * axis[b, 1] + R[b, 0, 2] * axis[b, 2]
+        ay = R[b, 1, 0] * axis[b, 0] + R[b, 1, 1] * axis[b, 1] + R[b, 1, 2] * axis[b, 2]
+        az = R[b, 2, 0] * axis[b, 0] + R[b, 2, 1] * axis[b, 1] + R[b, 2, 2] * axis[b, 2]
+        vx = V[b, 0] + Om[b, 1] * rz - Om[b, 2] * ry
+        vy = V[b, 1] + Om[b, 2] * rx - Om[b, 0] * rz
+        vz = V[b, 2] + Om[b, 0] * ry - Om[b, 1] * rx
+        ux, uy, uz = U[b, 0] - vx, U[b, 1] - vy, U[b, 2] - vz
+        d = ux * ax + uy * ay + uz * az
+        ux -= d * ax
+        uy -= d * ay
+        uz -= d * az
+        c = cda[b] * np.sqrt(ux * ux + uy * uy + uz * uz)
+        fx, fy, fz = c * ux, c * uy, c * uz
+        F[b, 0] = ry * fz - rz * fy
+        F[b, 1] = rz * fx - rx * fz
+        F[b, 2] = rx * fy - ry * fx
+        F[b, 3], F[b, 4], F[b, 5] = fx, fy, fz
+        add_point(kap, b, h * c, -h * c, ax, ay, az, rx, ry, rz)  # C = c(1 − aaᵀ)
+    for l in range(leaf_body.shape[0]):
+        b = leaf_body[l]
+        rx, ry, rz = leaf_X[l, 0], leaf_X[l, 1], leaf_X[l, 2]
+        fx, fy, fz = leaf_F[l, 0], leaf_F[l, 1], leaf_F[l, 2]
+        F[b, 0] += ry * fz - rz * fy
+        F[b, 1] += rz * fx - rx * fz
+        F[b, 2] += rx * fy - ry * fx
+        F[b, 3] += fx
+        F[b, 4] += fy
+        F[b, 5] += fz
+        if leaf_kap[l] > 0.0:
+            add_point(kap, b, 0.0, leaf_kap[l], leaf_N[l, 0], leaf_N[l, 1], leaf_N[l, 2], rx, ry, rz)
+
+
+class Work:
+    """Scratch arrays of one structure's step (allocated once)."""
+
+    def __init__(self, B: int, L: int):
+        self.F = np.zeros((B, 6))
+        self.kap = np.zeros((B, 6, 6))
+        self.IA = np.empty((B, 6, 6))
+        self.pA = np.empty((B, 6))
+        self.Dinv = np.empty((B, 3, 3))
+        self.U = np.empty((B, 6, 3))
+        self.u = np.empty((B, 3))
+        self.theta = np.empty(B)
+        self.theta_h = None
+
+
+def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: float, work: Work,
+         pulls: list[tuple[int, np.ndarray, np.ndarray]] = (), grab: Grab | None = None,
+         leaf_flutter: float = 0.0) -> None:
+    """Advance ``st`` by ``dt`` into ``out`` (which may be ``st`` itself).
+
+    Parameters
+    ----------
+    s : Structure
+    st, out : TreeState
+    wind : (B + L, 3) float
+        The wind at :func:`sample_points` of ``st`` (m/s).
+    dt : float
+        Step length (s), any length: the step is implicit.
+    work : Work
+    pulls : list of (body, rest offset from its joint (3,), world force (3,))
+        Constant forces.
+    grab : Grab or None
+    leaf_flutter : float
+        The largest flutter angle of a lamina about its midrib (rad), reached edge-on in a strong wind.
+    """
+    if out is not st:
+        out.assign(st)
+    B = len(s.parent)
+    w = work
+    w.F[:] = 0.0
+    w.kap[:] = 0.0
+    Ub = np.ascontiguousarray(wind[:B])
+    Ul = np.ascontiguousarray(wind[B:])
+    _air_forces(dt, out.R, out.Om, out.V, s.mid0, s.axis, s.cda, Ub, s.leaf_body,
+                out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, w.F, w.kap)
+    for b, ofs, f in pulls:
+        r = out.R[b] @ ofs
+        w.F[b, :3] += np.cross(r, f)
+        w.F[b, 3:] += f
+    if grab is not None:
+        _grab_force(grab, out, dt, w)
+    articulated_step(dt, _thetas(s, dt, work), s.parent, s.r0, s.m0, s.h0, s.J0, s.K, s.D, out.R, out.P, out.Om, out.V,
+                     out.Q, out.w, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.u, out.acc)
+    forward_kinematics(s.parent, s.r0, out.Q, out.w, out.R, out.P, out.Om, out.V)
+    if len(Ul):
+        _flutter(s, out, Ul, dt, leaf_flutter)
+    leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
+              s.leaf_J, s.leaf_d, s.leaf_cna, out.R, out.P, out.Om, out.V, Ul,
+              out.flutter * np.sin(out.phase), out.th, out.thd, out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap)
+    out.time = st.time + dt
+
+
+def _thetas(s: Structure, h: float, w: Work) -> np.ndarray:
+    """Each joint's θ at step h (kept while h is)."""
+    if w.theta_h != h:
+        w.theta = theta_of(h * s.omega_j)
+        w.theta_h = h
+    return w.theta
+
+
+def _grab_force(g: Grab, st: TreeState, h: float, w: Work) -> None:
+    """The grab's spring −k(x − target) − (c + θhk)v, capped at f_max, its implicit part as κ
+    (θ of the spring's own frequency with the mass it moves, ``g.mass``)."""
+    b = g.body
+    theta = theta_of(h * np.sqrt(g.k / g.mass))
+    r = st.R[b] @ g.offset
+    x = st.P[b] + r
+    v = st.V[b] + np.cross(st.Om[b], r)
+    fs = -g.k * (x - g.target)
+    n = float(np.linalg.norm(fs))
+    k = g.k
+    if n > g.f_max:  # beyond what the wood bears: a constant pull
+        fs *= g.f_max / n
+        k = 0.0
+    f = fs - (g.c + theta * h * k) * v
+    w.F[b, :3] += np.cross(r, f)
+    w.F[b, 3:] += f
+    add_point(w.kap, b, h * g.c + (h * theta) ** 2 * k, 0.0, 0.0, 0.0, 0.0, r[0], r[1], r[2])
+
+
+def _flutter(s: Structure, st: TreeState, U: np.ndarray, h: float, amp: float) -> None:
+    """Advance the laminas' flutter: a frequency St·|U|/ℓ (at most :data:`MAX_FLUTTER_HZ` and a
+    quarter of the step rate), an amplitude growing as U²/(U² + U_f²)."""
+    speed = np.sqrt(np.einsum("ij,ij->i", U, U))
+    f = np.minimum(FLUTTER_STROUHAL * speed / np.maximum(s.leaf_size, 1e-3), min(MAX_FLUTTER_HZ, 0.25 / h))
+    st.phase += 2 * np.pi * f * h
+    np.mod(st.phase, 2 * np.pi, out=st.phase)
+    u2 = speed * speed
+    st.flutter[:] = amp * u2 / (u2 + FLUTTER_SPEED**2) * s.leaf_on
+
+
+def pose(s: Structure, st: TreeState, rest: np.ndarray, pos: np.ndarray, rot: np.ndarray) -> None:
+    """Write the posed nodes: ``pos`` (N, 3) and rest-relative rotations ``rot`` (N, 3, 3)."""
+    pose_nodes(s.node, s.tip, s.tip_node, rest, st.R, st.P, s.leaf_nodes, s.leaf_first, s.leaf_body, s.leaf_E,
+               st.th, s.leaf_on, pos, rot)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _logs(Q, out):
+    for b in range(Q.shape[0]):
+        rot_log(Q[b], out[b])
+
+
+def energy(s: Structure, st: TreeState) -> float:
+    """Kinetic energy of every body and leaf plus the elastic energy of every joint (J)."""
+    m = s.m0
+    hw = np.einsum("bij,bj->bi", st.R, s.h0)
+    Jw = np.einsum("bij,bjk,blk->bil", st.R, s.J0, st.R)
+    om, v = st.Om, st.V
+    ke = 0.5 * (np.einsum("bi,bij,bj->b", om, Jw, om) + m * np.einsum("bi,bi->b", v, v)) \
+        + np.einsum("bi,bi->b", v, np.cross(om, hw))
+    th = np.empty((len(m), 3))
+    _logs(st.Q, th)
+    pe = 0.5 * np.einsum("bi,bij,bj->b", th, s.K, th)
+    lk = 0.5 * np.sum(s.leaf_J * st.thd**2 + s.leaf_k * st.th**2, axis=1) * s.leaf_on
+    return float(ke.sum() + pe.sum() + lk.sum())
