@@ -95,7 +95,7 @@ def test_held_beam_matches_the_reference(seed):
     ei_max, m, c0 = 10 ** rng.uniform(1, 3), rng.choice([2.0, 3.0, 4.0]), rng.uniform(0, 2)
     tree = assemble([ObjectSpec(pts, diam, "branch", 1)], name="beam",
                     physics=PhysicsParams(ei_max=ei_max, stiffness_exponent=m, twist_c0=c0))
-    sim = Simulation(tree, load_path=False)  # the paper's held beam (Eqs. 2–11)
+    sim = Simulation(tree)  # the paper's held beam (Eqs. 2–11)
     force = rng.normal(size=3) * 10 ** rng.uniform(-1, 2)
     sim.pull(0, force)
     sim.step(1 / 60)  # held: the oscillators sit at the static load, L′ = L
@@ -144,7 +144,7 @@ def two_level():
 
 def test_children_ride_rigidly_on_the_parent_when_unloaded():
     tree = two_level()
-    sim = Simulation(tree, coupling=False, load_path=False)  # (the load path's air would load them)
+    sim = Simulation(tree, coupling=False)
     sim.pull(0, (30.0, 0.0, 20.0))
     for _ in range(3):
         sim.step(1 / 60)

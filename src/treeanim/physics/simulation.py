@@ -1,8 +1,8 @@
-"""The whole-tree simulation (docs/design.md §6): wind → loads → oscillators → bending → hierarchy."""
+"""The paper's tree simulation (Hu, Chiba & He 2012; docs/design.md §6): wind → loads →
+oscillators → bending → hierarchy, every object driven by the load on its own area."""
 
 from __future__ import annotations
 
-import math
 import numbers
 
 import numpy as np
@@ -15,7 +15,7 @@ from .modal import ModalDraws, ModalParameters
 from .oscillator import INTEGRATORS
 from .physical import MODAL_MODELS
 from .pose import Pose
-from .stages import MAX_SUBSTEP, MAX_SUBSTEPS, Stages
+from .stages import Stages
 from .wind import DEFAULT_BOUNDS
 
 __all__ = ["Simulation", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
@@ -49,17 +49,8 @@ class Simulation(Derived, Stages, Pose):
     integrator : {'exact', 'euler'}
         Oscillator integrator (:mod:`treeanim.physics.oscillator`).
     coupling : bool
-        Base excitation in the paper's model: every object also feels −(acceleration of its
-        base node) × its mass, so a swinging trunk shakes its twigs. False restores the paper's
-        independent objects. The load path always couples (its loads go down the tree, so the
-        motion must come back up: one without the other feeds energy into a gusty crown).
-    load_path : bool
-        True (default): the tree is one structure (docs/design.md §12, :mod:`~treeanim.physics.loadpath`):
-        every object carries its children's loads down to the trunk, drag is quadratic in the
-        air-relative wind with foliage reconfiguration (:mod:`~treeanim.physics.aero`), joints
-        are as stiff as a tapered cantilever of the preset's Young's modulus, and pulls build
-        up critically damped. False: the paper's model exactly (each object feels only the
-        linear load on its own area), as the notes below describe.
+        Base excitation: every object also feels −(acceleration of its base node) × its mass,
+        so a swinging trunk shakes its twigs. False restores the paper's independent objects.
     modes : {'paper', 'physical'} or None
         Where the modal f and ζ come from: 'paper' maps the preset's ranges (Eqs. 20–22);
         'physical' gives every branch its first bending frequency as a tapered cantilever
@@ -85,10 +76,7 @@ class Simulation(Derived, Stages, Pose):
         Objects on the tree at the current season (fallen leaves are False); ``present_nodes``
         is the same per node. Absent leaves are still simulated (cheap), carrying no load.
     shown : (M,) bool, read-only
-        Objects to draw: those present plus, with the load path, the leaves that fell while
-        the simulation ran — they tumble down and lie on the ground (:mod:`.falling`), posed in
-        ``positions`` and ``rotations``. The paper's model (``load_path=False``) drops them
-        out of sight, as ``present``.
+        Objects to draw: ``present`` (fallen leaves drop out of sight).
     season : float
         Settable, in [0, 1].
     physics : PhysicsParams
@@ -126,8 +114,7 @@ class Simulation(Derived, Stages, Pose):
     """
 
     def __init__(self, tree: Tree, wind=None, season: float = 0.0, seed: int = 0,
-                 integrator: str = "exact", coupling: bool = True, load_path: bool = True,
-                 modes: str | None = None):
+                 integrator: str = "exact", coupling: bool = True, modes: str | None = None):
         if not isinstance(tree, Tree):
             raise ValueError(f"tree must be a treeanim Tree, got {type(tree).__name__}")
         if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
@@ -136,7 +123,6 @@ class Simulation(Derived, Stages, Pose):
         self._seed = int(seed)
         self.integrator = integrator
         self._coupling = bool(coupling)
-        self._load_path = bool(load_path)
         self._modal = self._check_modal(tree.modes if modes is None else modes)
         season = self._check_season(season)
         kinds = [k for k in KINDS if np.any(tree.kind == k)]
@@ -220,15 +206,6 @@ class Simulation(Derived, Stages, Pose):
         f3, z3 = fa.T.copy(), za.T.copy()
         self._mode_snap = (f, z, fa.copy(), za.copy(), f3, z3)
         self._osc.clear()
-        w = 2.0 * np.pi * f3
-        self._w2, self._two_zeta_w = w * w, 2.0 * z3 * w  # ω² and 2ζω of every mode
-        if self._load_path:
-            lp = self._lp
-            lp.tune(self._w2)
-            # −m_eff of the bending modes u and w (base excitation) and their mean ω (the loads' low-pass)
-            self._neg_m_eff = -np.minimum(lp.K / self._w2[[0, 2]], lp.m_modal)
-            self._spread_rate = np.sqrt(np.sqrt(self._w2[0] * self._w2[2]))
-            self._spread_alpha = (None, None)  # (dt, its filter weights): see _distributed_loads
         return f3, z3
 
     # ------------------------------------------------------------------ properties
@@ -263,16 +240,8 @@ class Simulation(Derived, Stages, Pose):
         self._season = s
         present = self._tree.leaves_present(s)
         present.setflags(write=False)
-        if self._load_path:  # leaves dropped now fall from where they are; regrown ones are back
-            fell = np.flatnonzero(self._present & ~present)
-            if len(fell):
-                self._fallen.detach(fell, self.positions, self.rotations)
-            self._fallen.remove(np.flatnonzero(present & ~self._present))
-            self._pos_out = self._rot_out = self._shown_out = None
         self._present = present
         self._derive_modes()
-        if self._load_path:
-            self._derive_load_path()
 
     @property
     def present(self) -> np.ndarray:
@@ -281,13 +250,8 @@ class Simulation(Derived, Stages, Pose):
 
     @property
     def shown(self) -> np.ndarray:
-        """(M,) bool: objects to draw, the present ones and the fallen leaves (see the class)."""
-        if not len(self._fallen):
-            return self._present
-        if self._shown_out is None:
-            self._shown_out = self._present | self._fallen.shown(self._M)
-            self._shown_out.setflags(write=False)
-        return self._shown_out
+        """(M,) bool: objects to draw, ``present`` itself (fallen leaves drop out of sight)."""
+        return self._present
 
     @property
     def present_nodes(self) -> np.ndarray:
@@ -342,25 +306,6 @@ class Simulation(Derived, Stages, Pose):
         self._coupling = bool(on)
 
     @property
-    def load_path(self) -> bool:
-        """Whether the tree is one structure (docs/design.md §12) or the paper's independent objects
-        (settable; switching restarts from rest, keeping time, season and physics)."""
-        return self._load_path
-
-    @load_path.setter
-    def load_path(self, on: bool) -> None:
-        on = bool(on)
-        if on == self._load_path:
-            return
-        self._load_path = on
-        self._geometry()  # the bending plan differs (hinged petioles)
-        self._derive_physics()
-        self._derive_modes()
-        time = self._time
-        self.reset()
-        self._time = time
-
-    @property
     def wind(self):
         """The wind field or None (settable; a wind on its default bounds is fitted to the tree)."""
         return self._wind
@@ -397,9 +342,8 @@ class Simulation(Derived, Stages, Pose):
         pose), for a pull controller's spring.
 
         The point is carried by segment ``k`` at ``s`` (0 … 1) along it, plus ``offset`` (a
-        point on a leaf's lamina lies beyond the petiole's tip). The paper's model sums Eq. 10's
-        hinges; the load path scales the compliance 1/K at the object's load point by the
-        cube of the point's share of the lever (a cantilever's x³ law).
+        point on a leaf's lamina lies beyond the petiole's tip): the sum over Eq. 10's hinges
+        up to the point.
         """
         i = self._check_object(int(i))
         tree = self._tree
@@ -407,10 +351,6 @@ class Simulation(Derived, Stages, Pose):
         X = tree.rest_positions[nodes]
         seg = np.diff(X, axis=0)
         anchor = X[k] + s * seg[k] + np.asarray(offset, float)
-        if self._load_path:
-            self._modes_arrays()  # the stiffness follows the modes
-            share = np.linalg.norm(anchor - X[0]) / max(float(self._lp.lever0[i]), 1e-12)
-            return float(min(share, 4.0) ** 3 / self._lp.K[i])
         L = np.linalg.norm(seg, axis=1)
         n = len(L)
         stiff = np.concatenate(self._k)[self._bplan.flat_of_node[nodes[:-1]]]  # Eq. 10's k, as the bending uses it
@@ -488,60 +428,39 @@ class Simulation(Derived, Stages, Pose):
         self._att_v = np.zeros((3, U))
         self._att_a = np.zeros((3, U + 1))  # column U: zero, for roots
         self._dt_prev = None
-        self._g_prev = np.zeros((3, M))  # the oscillators' last inputs (load path)
-        self._air_prev = np.zeros((2, M))  # the air's damping rate of the last step (load path)
-        self._sample_prev = self._sample_pos.copy()
-        self._sample_vel = np.zeros((3, M))
-        self._leaf_twist.reset()
-        self._fallen.clear()
-        self._shown_out = None
-        self._spread = None  # the low-passed loads along the objects (load path)
         self._pulls.clear()
         self._pos_out = None
         self._rot_out = None
         self._fn = None
 
     def step(self, dt: float) -> None:
-        """Advance the simulation by ``dt`` seconds (docs/design.md §6; §12 with the load path).
+        """Advance the simulation by ``dt`` seconds (docs/design.md §6).
 
-        One step is a pipeline of stages: wind → aerodynamic loads → (load path and)
-        oscillators → bending → hierarchy.
+        One step is a pipeline of stages: wind → loads → oscillators → bending → hierarchy
+        (:mod:`~treeanim.physics.stages`).
 
         Parameters
         ----------
         dt : float
             Step length in seconds, > 0 and at most :data:`MAX_STEP`. Any such length is
             stable: the exact integrator has no step limit; Euler sub-steps (and clamps very
-            long steps, see :mod:`treeanim.physics.oscillator`); the load path advances in
-            sub-steps of at most 1/60 s (up to 64 of them; see
-            :data:`~treeanim.physics.stages.MAX_SUBSTEP`).
+            long steps, see :mod:`treeanim.physics.oscillator`).
 
         Raises
         ------
         ValueError
             ``dt`` not in (0, MAX_STEP], invalid ``modes`` (f not in (0, MAX_FREQUENCY], ζ not
             in [0, MAX_ZETA], wrong shape), or a wind whose ``sample`` returns the wrong
-            shape or non-finite values. The state is left unchanged (or, where the wind fails
-            in a later sub-step of the load path, advanced by the sub-steps before it).
+            shape or non-finite values. The state is left unchanged.
         """
         dt = finite_float("dt", dt)
         if not 0 < dt <= MAX_STEP:
             raise ValueError(f"dt must be > 0 and at most {MAX_STEP:g} s, got {dt!r}")
         f3, z3 = self._modes_arrays()
-        # the load path in sub-steps short enough for its base excitation (stages.py)
-        n = min(max(math.ceil(dt / MAX_SUBSTEP - 1e-9), 1), MAX_SUBSTEPS) if self._load_path else 1
-        h = dt / n
-        for _ in range(n):
-            U = self._wind_at_samples(self._time)
-            if self._load_path:
-                self._step_load_path(U, f3, z3, h)
-                if len(self._fallen):
-                    self._fallen.step(self._wind_at_points(self._time), h)
-            else:
-                self._step_paper(U, f3, z3, h)
-            self._dt_prev = h
-            self._time += h
+        U = self._wind_at_samples(self._time)
+        self._step_paper(U, f3, z3, dt)
+        self._dt_prev = dt
+        self._time += dt
         self._pos_out = None
         self._rot_out = None
         self._fn = None
-
