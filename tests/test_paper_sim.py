@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from treeanim.physics.simulation import Simulation
+from treeanim.physics.paper_sim import PaperSim
 
 DATA = Path(__file__).parent / "data"
 
@@ -26,7 +26,7 @@ def test_the_paper_model_reproduces_its_reference_bit_for_bit():
     ref = np.load(DATA / "paper_reference.npz")
     mod = _reference_module()
     for name, scenario in mod.SCENARIOS.items():
-        pos, rot = mod.run(*scenario, sim_class=Simulation)
+        pos, rot = mod.run(*scenario, sim_class=PaperSim)
         np.testing.assert_array_equal(pos, ref[f"{name}/positions"], err_msg=name)
         if f"{name}/rotations" in ref:
             np.testing.assert_array_equal(rot, ref[f"{name}/rotations"], err_msg=name)

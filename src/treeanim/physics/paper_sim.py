@@ -18,7 +18,7 @@ from .pose import Pose
 from .stages import Stages
 from .wind import DEFAULT_BOUNDS
 
-__all__ = ["Simulation", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
+__all__ = ["PaperSim", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
 
 #: Largest pull force accepted (N): far beyond any hand on a tree (the bending stays finite
 #: and keeps lengths far above it; the cap keeps absurd inputs out).
@@ -32,7 +32,7 @@ MAX_FREQUENCY = 1e4
 MAX_ZETA = 1e3
 
 
-class Simulation(Derived, Stages, Pose):
+class PaperSim(Derived, Stages, Pose):
     """A tree animated by wind and by pulls (Hu, Chiba & He 2012; docs/design.md §5–§8).
 
     Parameters
