@@ -34,7 +34,6 @@ SLOW = (
     "test_presets_fuzz.py::test_a_mutated_preset",
     "test_leaves.py",
     "test_grass.py",
-    "test_load_path.py",
     "test_simulation_hypothesis.py",
     "test_wind_physical.py",
     "test_junctions.py::test_collars_stay_welded_in_a_gale",

@@ -11,7 +11,7 @@ from treeanim.model.build import ObjectSpec, assemble
 from treeanim.model.params import PhysicsParams
 from treeanim.physics.bend_angle import solve_bend_angle
 from treeanim.physics.bending import rest_frames
-from treeanim.physics.simulation import Simulation
+from treeanim.physics.paper_sim import PaperSim
 
 
 # ---------------------------------------------------------------------------- the angle solve
@@ -95,7 +95,7 @@ def test_held_beam_matches_the_reference(seed):
     ei_max, m, c0 = 10 ** rng.uniform(1, 3), rng.choice([2.0, 3.0, 4.0]), rng.uniform(0, 2)
     tree = assemble([ObjectSpec(pts, diam, "branch", 1)], name="beam",
                     physics=PhysicsParams(ei_max=ei_max, stiffness_exponent=m, twist_c0=c0))
-    sim = Simulation(tree, load_path=False)  # the paper's held beam (Eqs. 2–11)
+    sim = PaperSim(tree)  # the paper's held beam (Eqs. 2–11)
     force = rng.normal(size=3) * 10 ** rng.uniform(-1, 2)
     sim.pull(0, force)
     sim.step(1 / 60)  # held: the oscillators sit at the static load, L′ = L
@@ -117,7 +117,7 @@ def test_bend_direction_lengths_and_no_stretch_in_a_huge_load():
     pts = np.stack([np.zeros(6), np.linspace(0, 2, 6), np.zeros(6)], 1)
     tree = assemble([ObjectSpec(pts, np.linspace(0.1, 0.04, 6), "branch", 1)], name="straight")
     for mag in (1e-3, 1.0, 1e3, 1e9):
-        sim = Simulation(tree)
+        sim = PaperSim(tree)
         sim.pull(0, (mag, 0.0, 0.0))
         sim.step(0.1)
         P = sim.positions
@@ -144,7 +144,7 @@ def two_level():
 
 def test_children_ride_rigidly_on_the_parent_when_unloaded():
     tree = two_level()
-    sim = Simulation(tree, coupling=False, load_path=False)  # (the load path's air would load them)
+    sim = PaperSim(tree, coupling=False)
     sim.pull(0, (30.0, 0.0, 20.0))
     for _ in range(3):
         sim.step(1 / 60)
@@ -159,7 +159,7 @@ def test_children_ride_rigidly_on_the_parent_when_unloaded():
 
 def test_output_convention_rigid_points_follow_their_node():
     tree = two_level()
-    sim = Simulation(tree, coupling=False)
+    sim = PaperSim(tree, coupling=False)
     sim.pull(1, (0.0, -5.0, 3.0))
     sim.pull(2, (0.0, 0.0, 0.05))
     sim.step(1 / 60)
@@ -180,7 +180,7 @@ def test_rest_pose_is_exact_for_presets():
     for name in ("beam", "small_cherry", "tulip_poplar", "grassland"):
         tree = ta.load_preset(name)
         for integrator in ("exact", "euler"):
-            sim = Simulation(tree, integrator=integrator)
+            sim = PaperSim(tree, integrator=integrator)
             np.testing.assert_allclose(sim.positions, tree.rest_positions, rtol=0, atol=1e-12)
             for _ in range(3):
                 sim.step(1 / 60)

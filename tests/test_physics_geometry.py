@@ -19,7 +19,7 @@ from treeanim.model.geometry import (
 from treeanim.physics import modal
 from treeanim.physics.bending import BendingPlan, rest_frames
 from treeanim.physics.modal import ModalDraws
-from treeanim.physics.simulation import Simulation
+from treeanim.physics.paper_sim import PaperSim
 from treeanim.render import mesh
 from treeanim.validate import finite_float
 
@@ -134,7 +134,7 @@ def _beam():
 def test_bending_huge_forces_stays_finite_and_keeps_lengths(F, tree):
     with np.errstate(all="raise"):
         for t in (_beam(), tree):
-            sim = Simulation(t)
+            sim = PaperSim(t)
             plan = BendingPlan(t, rest_frames(t))
             M = t.n_objects
             plan.bend(np.full(M, F), np.full(M, -0.5 * F), np.zeros(M), sim._k)

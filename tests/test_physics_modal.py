@@ -15,7 +15,7 @@ from treeanim.physics.modal import (
     mean_diameters,
     object_lengths,
 )
-from treeanim.physics.simulation import Simulation
+from treeanim.physics.paper_sim import PaperSim
 
 
 def fan_tree():
@@ -110,7 +110,7 @@ def test_season_interpolates_and_drops_leaves(fan):
     summer = SeasonModes(branch=ModeRange((0.4, 0.8), (0.12, 0.3)), leaf=ModeRange((1.0, 1.4), (0.08, 0.12)))
     winter = SeasonModes(branch=ModeRange((0.6, 1.3), (0.07, 0.15)), leaf=ModeRange((1.6, 2.8), (0.03, 0.07)))
     tree = dataclasses.replace(fan, physics=PhysicsParams(summer=summer, winter=winter))
-    sim = Simulation(tree)
+    sim = PaperSim(tree)
     f0, z0 = sim.modes.f.copy(), sim.modes.zeta.copy()
     ref = sim.modes.f  # the arrays are updated in place
     sim.season = 0.5
@@ -127,7 +127,7 @@ def test_season_interpolates_and_drops_leaves(fan):
 
 
 def test_physics_setter_rederives(fan):
-    sim = Simulation(fan)
+    sim = PaperSim(fan)
     p = sim.physics
     faster = dataclasses.replace(p, summer=dataclasses.replace(p.summer, branch=ModeRange((2.0, 3.0), (0.01, 0.02))))
     sim.physics = faster
@@ -143,7 +143,7 @@ def test_physics_setter_rederives(fan):
 
 def test_large_cherry_seasons():
     tree = ta.load_preset("large_cherry")
-    sim = Simulation(tree, season=0.0)
+    sim = PaperSim(tree, season=0.0)
     br = tree.kind == "branch"
     f0, z0 = sim.modes.f[br].mean(), sim.modes.zeta[br].mean()
     sim.season = 1.0

@@ -1,4 +1,4 @@
-"""Invariants of the Simulation under hypothesis: any wind, any step, any preset.
+"""Invariants of the paper model (PaperSim) under hypothesis: any wind, any step, any preset.
 
 Segment lengths are kept (only rotations are applied, docs/design.md §5), everything stays finite,
 rotations stay rotations, and the same inputs give the same result.
@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import treeanim as ta
-from treeanim.physics.simulation import Simulation
+from treeanim.physics.paper_sim import PaperSim
 
 PRESETS = ["beam", "small_cherry", "tulip_poplar", "grassland", "large_cherry"]
 
@@ -52,7 +52,7 @@ def test_gale_keeps_lengths_and_stays_finite(name, azimuth, speed, turbulence, w
     tree, within, rest_len = preset(name)
     wind = ta.WindField(direction=(np.cos(azimuth), 0.0, np.sin(azimuth)), speed=speed, turbulence=turbulence,
                         seed=wind_seed, grid=16, model="paper")
-    sim = Simulation(tree, wind=wind, seed=seed, integrator=integrator, coupling=coupling, season=season)
+    sim = PaperSim(tree, wind=wind, seed=seed, integrator=integrator, coupling=coupling, season=season)
     for dt in dts:
         sim.step(dt)
     check_pose(sim, within, rest_len)
@@ -65,7 +65,7 @@ def test_gale_keeps_lengths_and_stays_finite(name, azimuth, speed, turbulence, w
 def test_any_pull_and_release_keeps_lengths(name, obj_frac, force, hold, after):
     tree, within, rest_len = preset(name)
     obj = min(int(obj_frac * tree.n_objects), tree.n_objects - 1)
-    sim = Simulation(tree)
+    sim = PaperSim(tree)
     sim.pull(obj, force)
     for _ in range(hold):
         sim.step(1 / 60)
@@ -83,7 +83,7 @@ def test_same_inputs_same_result(name, seed, speed, steps):
     tree, _, _ = preset(name)
     runs = []
     for _ in range(2):
-        sim = Simulation(tree, wind=ta.WindField(speed=speed, seed=seed, grid=16), seed=seed)
+        sim = PaperSim(tree, wind=ta.WindField(speed=speed, seed=seed, grid=16), seed=seed)
         for _ in range(steps):
             sim.step(1 / 60)
         runs.append(sim.positions)

@@ -1,4 +1,4 @@
-"""Record the paper model's poses (``load_path=False``) as the reference of test_paper_model.py.
+"""Record the paper model's poses as the reference of tests/test_paper_sim.py.
 
 Run once, with the release whose behaviour the paper model must keep (commit 4ed910f, before the
 load path): ``python tests/data/make_paper_reference.py``. When the presets change (issue #13
@@ -27,11 +27,15 @@ SCENARIOS = {
 }
 
 
-def run(preset, speed, season, integrator, dt, steps, pulls, **sim_kwargs):
-    """The poses of one scenario: (every fifth node's positions, rotations)."""
+def run(preset, speed, season, integrator, dt, steps, pulls, sim_class=None, **sim_kwargs):
+    """The poses of one scenario: (every fifth node's positions, rotations).
+
+    ``sim_class`` (default ``ta.Simulation``, the class at 4ed910f) is the simulation to run.
+    """
     tree = ta.load_preset(preset)
     wind = ta.WindField(direction=(1.0, 0.0, 0.3), speed=speed, seed=3, model="paper") if speed else None
-    sim = ta.Simulation(tree, wind=wind, season=season, seed=1, integrator=integrator, **sim_kwargs)
+    sim_class = ta.Simulation if sim_class is None else sim_class
+    sim = sim_class(tree, wind=wind, season=season, seed=1, integrator=integrator, **sim_kwargs)
     for k in range(steps):
         for obj, force, on, off in pulls:
             if k == on:

@@ -28,10 +28,6 @@ segments are a prefix of that order and the i-th pass works on contiguous slices
 unit quaternions; block i of the flat (4, S) array ``q`` holds segment i of every object that
 has one, and block i of the flat (3, S) array ``o`` the bent offset of node i + 1 from the
 object's base, Σ_{j<=i} Cⱼ sⱼ (accumulated per object, so no round-off crosses objects).
-
-**Hinged objects** (the load path's petioles and blades, docs/design.md §12) are solved at
-their first segment only: they sort after the solved objects with more segments, and each
-block ends with their segment i, which follows the first in closed form.
 """
 
 from __future__ import annotations
@@ -90,13 +86,9 @@ class BendingPlan:
     Attributes
     ----------
     order : (M,) int
-        Objects by decreasing solved segment count, then segment count (stable);
-        ``order[:solved[i]]`` have a solved segment i.
-    counts, solved : list of int
-        Objects having a segment i, and a solved one (block i: the solved first), for
-        i = 0 … max segments − 1.
-    hinge : (M,) bool
-        The hinged objects (``hinge`` given, more than one segment).
+        Objects by decreasing segment count (stable); ``order[:counts[i]]`` have a segment i.
+    counts : list of int
+        Objects having a segment i, for i = 0 … max segments − 1.
     seg_obj, seg_index : (S,) int
         Object and segment index of every flat slot.
     offsets : list of int
@@ -114,38 +106,26 @@ class BendingPlan:
     o : (3, S + 1) float
         Bent offsets from the object's base, in world rest coordinates; column S is zero.
     phi : (S,) float
-        Bend angles (of the solved segments).
-    turn : (S,) float
-        A hinged segment's turn from its rest direction.
+        Bend angles.
     rho : (S,) float
         φ/θ₀, the warm start of the next solve.
     """
 
-    def __init__(self, tree, frames: np.ndarray, hinge: np.ndarray | None = None):
+    def __init__(self, tree, frames: np.ndarray):
         X = np.asarray(tree.rest_positions, float)
         start = np.asarray(tree.object_start)
         nseg = np.asarray(tree.object_count) - 1
         self.M = M = len(start)
         self.N = len(X)
-        self.hinge = hinge = np.zeros(M, bool) if hinge is None else np.asarray(hinge, bool) & (nseg > 1)
-        eff = np.where(hinge, 1, nseg)  # segments solved by Eq. 8: a hinge object's first only
-        self.order = np.lexsort((-nseg, -eff))  # stable: by decreasing eff, then decreasing nseg
+        self.order = np.argsort(-nseg, kind="stable")  # by decreasing segment count
         max_n = int(nseg.max()) if M else 0
-        n_hinged = int(hinge.sum())
-        self.hinge_start = h0 = M - int(np.count_nonzero(eff == 1)) if n_hinged else M
-        # Block i: segment i of the solved objects having one (a prefix of ``order``), then of
-        # the hinge objects having one (a prefix of their run ``order[h0:h0 + n_hinged]``).
-        self.solved = [int(np.count_nonzero(eff > i)) for i in range(max_n)]
-        hinged = [0] + [int(np.count_nonzero(hinge & (nseg > i))) for i in range(1, max_n)]
-        block_objs = [np.concatenate([self.order[:ks], self.order[h0:h0 + kh]]) for ks, kh in zip(self.solved, hinged)]
-        self.counts = [len(b) for b in block_objs]
+        # Block i: segment i of the objects having one (a prefix of ``order``).
+        self.counts = [int(np.count_nonzero(nseg > i)) for i in range(max_n)]
+        block_objs = [self.order[:K] for K in self.counts]
         self.offsets = [int(x) for x in np.concatenate([[0], np.cumsum(self.counts)])]
         self.n_flat = S = self.offsets[-1]
         self.seg_obj = np.concatenate(block_objs) if S else np.zeros(0, np.int64)
         self.seg_index = np.repeat(np.arange(max_n), self.counts)
-        # Where block i's hinge entries find their previous segment in block i − 1.
-        self.hinge_prev = [h0 if i == 1 else self.solved[i - 1] for i in range(max_n)]
-        self.n_solved = sum(self.solved)
         R = np.asarray(frames, float)  # (M, 3, 3) local → world rest
 
         flat_of_node = np.empty(self.N, np.int64)
@@ -179,21 +159,13 @@ class BendingPlan:
             self.frac_len.append(self.frac[-1] * np.sqrt(self.seg_len2[-1]))  # |Fᵢ||sᵢ| / |F|
             t = i / np.maximum(n - 1, 1)
             self.taper.append(d_root[objs] - (d_root[objs] - d_tip[objs]) * t)
-            self.rest_o[:, flat] = s if i == 0 else self.rest_o[:, self._prev_flat(i)] + s
+            self.rest_o[:, flat] = s if i == 0 else self.rest_o[:, self.offsets[i - 1]:self.offsets[i - 1] + K] + s
         self.max_seg = max((float(np.sqrt(x.max())) for x in self.seg_len2 if len(x)), default=0.0)
         self.flat_of_node = flat_of_node
         self.ofs_of_node = ofs_of_node
         self.ws = Workspace()
         self.d_max = float(diam.max()) if self.N else 1.0
-        self.n_hinges = n_hinged
-        self.hinge_tip = flat_of_node[(start + nseg)[self.order[h0:h0 + n_hinged]]]  # their last segments
-        self.hinge_gain = np.ones(S)  # cᵢ of every hinged segment (see :meth:`_hinge_turns`)
         self.reset()
-
-    def _prev_flat(self, i: int) -> np.ndarray:
-        """Flat slots of the previous segment of each entry of block i >= 1."""
-        ks, kh = self.solved[i], self.counts[i] - self.solved[i]
-        return self.offsets[i - 1] + np.concatenate([np.arange(ks), self.hinge_prev[i] + np.arange(kh)])
 
     def reset(self) -> None:
         """Back to the unbent rest state."""
@@ -205,8 +177,6 @@ class BendingPlan:
         self.rho = np.zeros(S)
         self.rho_old = np.zeros(S)
         self.rho_start = np.zeros(S)
-        self.turn = np.zeros(S)  # a hinged later segment's turn from its rest direction (see _hinge_turns)
-        self._hinge = None  # the hinges' last solve, until :meth:`finish` lays out their segments
 
     def stiffness(self, ei_max: float, exponent: float) -> list[np.ndarray]:
         """kᵢ = EI_max (Dᵢ/D_max)^m per block (Eq. 10).
@@ -224,8 +194,8 @@ class BendingPlan:
         """
         return [ei_max * np.maximum(d / self.d_max, 0.0) ** exponent for d in self.taper]
 
-    def bend(self, Fu: np.ndarray | None, Fw: np.ndarray | None, gamma: np.ndarray, k: list[np.ndarray],
-             predict: float = 0.0, blocks: list[tuple] | None = None) -> None:
+    def bend(self, Fu: np.ndarray, Fw: np.ndarray, gamma: np.ndarray, k: list[np.ndarray],
+             predict: float = 0.0) -> None:
         """Bend every object in its local rest frame; update ``q``, ``o`` and ``phi``.
 
         In the local frame (u, v, w) the force of Eq. 6 is (L′_w, 0, L′_u), the twist is a
@@ -233,24 +203,18 @@ class BendingPlan:
 
         Parameters
         ----------
-        Fu, Fw : (M,) float or None
+        Fu, Fw : (M,) float
             u and w components of the force on each object (L′_w and L′_u), in ``order``;
-            segment i feels F·(n − i)/n at the lever |sᵢ| (Eq. 7). None with ``blocks``.
-        gamma : (M,) or (n_flat,) float
+            segment i feels F·(n − i)/n at the lever |sᵢ| (Eq. 7).
+        gamma : (M,) float
             Twist per segment about v (Eq. 11), in ``order``: one value per object (every
-            segment twists alike, the paper) or one per flat segment (the load path, where
-            each joint twists under its own torsion); applied as Rot(v, −γ).
+            segment twists alike); applied as Rot(v, −γ).
         k : list of (K_i,) float
             Stiffness per block, from :meth:`stiffness`.
         predict : float
             The solver starts from ρ·θ₀ with ρ = φ/θ₀ extrapolated as ρ + predict·(ρ −
             ρ_previous): 0 restarts from the last fractions, dt/dt_prev extrapolates linearly
             in time (a better start, fewer iterations).
-        blocks : list of (fu, fv, fw, a, r), optional
-            Instead of Eq. 7's fractions of one force: per block i, the force on each
-            segment (local components, (K_i,) each), a = |Fᵢ|·ℓᵢ, the moment it exerts at
-            its lever ℓᵢ (Eq. 8's |Fᵢ||sᵢ|), and r = ℓᵢ/|sᵢ|. Used by the load path; ``a`` is
-            overwritten.
         """
         # Start of the angle solve: the bend as a fraction ρ = φ/θ₀ of the angle to the force
         # (nearly constant from step to step even where θ₀ moves), extrapolated linearly.
@@ -271,41 +235,19 @@ class BendingPlan:
         sv = th
         sv *= cv
         np.negative(sv, out=sv)
-        if blocks is None:
-            Fmag = np.hypot(Fu, Fw)  # |F| per object
-            fmax = Fmag.max(initial=0.0)
-        else:
-            nmax = max(((bl[3] / bl[4]).max(initial=0.0) for bl in blocks), default=0.0)  # a/r = |F||s|
+        Fmag = np.hypot(Fu, Fw)  # |F| per object
         # |N| <= |F||s|: below the bound the plain sum of squares cannot overflow.
-        safe = not ((fmax * self.max_seg if blocks is None else nmax) > _SQUARE_SAFE)
+        safe = not (Fmag.max(initial=0.0) * self.max_seg > _SQUARE_SAFE)
         prev = None
         prev_o = None
-        per_segment = len(gamma) == self.n_solved
-        h0, H = self.hinge_start, self.n_hinges
-        ta = 0  # start of block i among the solved segments (``gamma`` per segment)
-        for i, K in enumerate(self.solved):
-            if K == 0:  # the rest are hinged segments (their counts never grow with i)
-                break
+        for i, K in enumerate(self.counts):
             a, b = self.offsets[i], self.offsets[i + 1]
-            tw = slice(ta, ta + K) if per_segment else slice(0, K)
-            ta += K
-            if blocks is None:
-                fu = mul(Fu[:K], self.frac[i], out=ws.get("fu", (K,)))  # Eq. 7
-                fw = mul(Fw[:K], self.frac[i], out=ws.get("fw", (K,)))
-                fv = None
-                amag = mul(Fmag[:K], self.frac_len[i], out=ws.get("amag", (K,)))  # a = |Fᵢ||sᵢ|
-            else:
-                fu, fv, fw, amag, r = (x[:K] for x in blocks[i])
+            fu = mul(Fu[:K], self.frac[i], out=ws.get("fu", (K,)))  # Eq. 7
+            fw = mul(Fw[:K], self.frac[i], out=ws.get("fw", (K,)))
+            amag = mul(Fmag[:K], self.frac_len[i], out=ws.get("amag", (K,)))  # a = |Fᵢ||sᵢ|
             tmp = ws.get("tmp", (K,))
-            c_, s_ = cv[tw], sv[tw]
-            sp, T, n, nn, dot, theta0 = self._moment(i, K, (fu, fv, fw), prev, c_, s_, safe, tmp)
-            if blocks is not None:
-                # The load path: a force's compression along the segment does not bend it (a
-                # twig held well below its buckling load) — only the part across it does, so a
-                # force pointing back along a segment cannot flip its bend from side to side.
-                # There a·sin θ₀ = |N|·ℓ/|s| (a = |F|·ℓ, sin θ₀ = |N|/(|F||s|)).
-                np.multiply(nn, r, out=amag, where=dot < 0.0)
-                np.minimum(theta0, 0.5 * np.pi, out=theta0)
+            c_, s_ = cv[:K], sv[:K]
+            sp, T, n, nn, dot, theta0 = self._moment(i, K, (fu, fw), prev, c_, s_, safe, tmp)
             phi, t = solve_bend_angle(nn, dot, k[i][:K], theta0, mul(rho_start[a:a + K], theta0),
                                       a=amag)  # Eqs. 8–9
             # No bend where the force is zero or (anti)parallel to the segment.
@@ -316,74 +258,14 @@ class BendingPlan:
             np.divide(1.0, inv, out=inv)
             self.phi[a:a + K] = phi
             np.divide(phi, np.maximum(theta0, 1e-300), out=self.rho[a:a + K])
-            if i == 0 and H:
-                hs = slice(h0, h0 + H)
-                self._hinge = (n[0][hs] * inv[hs], n[2][hs] * inv[hs], c_[hs], s_[hs])
-                self._hinge_turns(phi[hs], theta0[hs])
             dst = self.q[:, a:a + K]
             t2, ch2 = self._rotation(i, K, n, t, inv, T, c_, s_, dst, tmp)
             oo = self.o[:, a:a + K]
-            self._bent_segment(i, sp, (fu, fv, fw), t, t2, ch2, inv, dot, oo, tmp)
+            self._bent_segment(i, sp, (fu, fw), t, t2, ch2, inv, dot, oo, tmp)
             if i > 0:
                 oo += prev_o[:, :K]  # accumulate along the object
             prev = self.q[:, a:b]
             prev_o = self.o[:, a:b]
-
-    def _hinge_turns(self, phi: np.ndarray, theta0: np.ndarray) -> None:
-        """The hinge objects' later segments turn with their first (hinged objects, docs/design.md §12).
-
-        Their first joint was solved by Eq. 8 with angle φ about N̂ (and twisted by γ, the
-        whole object's twist). Joint i turns by cᵢ·φ (``hinge_gain``: as much as joint i of a
-        chain of hinges turns for joint 0's angle in small bends) times the share of its moment
-        arm left, sin(θ₀ − βᵢ₋₁)/sin θ₀, after the joints before it turned the object by βᵢ₋₁
-        towards the force: so the object curls as the chain does and never turns past the
-        force. The tips' rotations are set now (a step needs them, for the laminas' normal
-        force); :meth:`finish` lays out the rest."""
-        beta = phi.copy()
-        tip = beta.copy()
-        arm = 1.0 / np.maximum(np.sin(theta0), 1e-12)
-        for i in range(1, len(self.counts)):
-            a, b = self.offsets[i] + self.solved[i], self.offsets[i + 1]
-            K = b - a
-            left = np.sin(theta0[:K] - beta[:K])
-            np.maximum(left, 0.0, out=left)
-            left *= arm[:K]
-            left *= self.hinge_gain[a:b]
-            left *= phi[:K]
-            beta = beta[:K] + left
-            self.turn[a:b] = beta
-            tip[:K] = beta
-        self.q[:, self.hinge_tip] = self._hinge_rotation(tip, np.empty((4, self.n_hinges)))
-
-    def finish(self) -> None:
-        """Lay out the hinge objects' later segments (``q`` and ``o``) from their last solve;
-        :meth:`bend` sets only their tips' rotations, all a step needs."""
-        if self._hinge is None:
-            return
-        for i in range(1, len(self.counts)):
-            lo, hi = self.offsets[i] + self.solved[i], self.offsets[i + 1]
-            if hi > lo:  # Cᵢ = Rot(N̂, βᵢ) ⊗ Rot(v, −γ), oᵢ = oᵢ₋₁ + Cᵢsᵢ
-                p0 = self.offsets[i - 1] + self.hinge_prev[i]
-                dst = self.q[:, lo:hi]
-                self._hinge_rotation(self.turn[lo:hi], dst)
-                oo = self.o[:, lo:hi]
-                qrot(dst, self.seg[i][:, self.solved[i]:], out=oo, ws=self.ws)
-                oo += self.o[:, p0:p0 + hi - lo]
-        self._hinge = None
-
-    def _hinge_rotation(self, beta: np.ndarray, out: np.ndarray) -> np.ndarray:
-        """Rot(N̂, β) ⊗ Rot(v, −γ) of the first K = len(β) hinge objects, into ``out`` (4, K)."""
-        n0, n2, c, s = (x[:len(beta)] for x in self._hinge)
-        half = 0.5 * beta
-        sh = np.sin(half)
-        a0, a1, a3 = np.cos(half), sh * n0, sh * n2
-        np.multiply(a0, c, out=out[0])  # (a0, a1, 0, a3) ⊗ (c, 0, s, 0)
-        np.multiply(a1, c, out=out[1])
-        out[1] -= a3 * s
-        np.multiply(a0, s, out=out[2])
-        np.multiply(a3, c, out=out[3])
-        out[3] += a1 * s
-        return out
 
     def _twisted(self, C, c_, s_):
         """T = Rot(v, −γ) ⊗ C = cos(γ/2)·C + sin(γ/2)·(−C_y, C_z, C_w, −C_x) (c_, s_: the halves)."""
@@ -401,10 +283,10 @@ class BendingPlan:
         Returns (s′, T, (n0, n1, n2), |N|, s′·F, θ₀) with T = Rot(v, −γ) ⊗ C_{i−1}
         (None for the first segment, whose s′ = s₀ = (0, l, 0) and n1 = None)."""
         mul, ws = np.multiply, self.ws
-        fu, fv, fw = f
+        fu, fw = f
         s = self.seg[i][:, :K]
         if i == 0:
-            # s′ = s₀ = (0, l, 0):  N = s′ × F = (l·F_w, 0, −l·F_u), s′·F = l·F_v
+            # s′ = s₀ = (0, l, 0):  N = s′ × F = (l·F_w, 0, −l·F_u), s′·F = 0 (F has no v part)
             l = s[1]
             n0 = mul(l, fw)
             n2 = mul(l, fu)
@@ -415,10 +297,7 @@ class BendingPlan:
                 np.sqrt(nn, out=nn)
             else:
                 nn = np.hypot(n0, n2)
-            if fv is None:
-                return s, None, (n0, None, n2), nn, np.zeros(K), np.full(K, 0.5 * np.pi)
-            dot = mul(l, fv)
-            return s, None, (n0, None, n2), nn, dot, np.arctan2(nn, dot)
+            return s, None, (n0, None, n2), nn, np.zeros(K), np.full(K, 0.5 * np.pi)
         T = self._twisted(prev[:, :K], c_, s_)  # Rot(v, −γ) ⊗ C_{i−1}
         sp = qrot(T, s, out=ws.get("sp", (3, K)), ws=ws)
         sx, sy, sz = sp
@@ -427,9 +306,6 @@ class BendingPlan:
         n1 -= mul(sx, fw, out=tmp)
         n2 = mul(sy, fu)
         np.negative(n2, out=n2)
-        if fv is not None:
-            n0 -= mul(sz, fv, out=tmp)
-            n2 += mul(sx, fv, out=tmp)
         if safe:
             nn = mul(n0, n0)
             nn += mul(n1, n1, out=tmp)
@@ -439,8 +315,6 @@ class BendingPlan:
             nn = np.hypot(np.hypot(n0, n1), n2)
         dot = mul(sx, fu)
         dot += mul(sz, fw, out=tmp)
-        if fv is not None:
-            dot += mul(sy, fv, out=tmp)
         return sp, T, (n0, n1, n2), nn, dot, np.arctan2(nn, dot)
 
     def _rotation(self, i, K, n, t, inv, T, c_, s_, dst, tmp):
@@ -478,7 +352,7 @@ class BendingPlan:
         """The bent segment Cᵢsᵢ = cos φ·s′ + sin φ·(N̂ × s′) into ``oo``, with
         N̂ × s′ = (F|s|² − s′(s′·F))/|N|."""
         mul = np.multiply
-        fu, fv, fw = f
+        fu, fw = f
         c_phi = 1.0 - t2
         c_phi *= ch2
         s_phi = mul(t, ch2)
@@ -489,9 +363,7 @@ class BendingPlan:
         mul(sp, c_phi, out=oo)
         oo[0] += mul(fu, s_phi, out=tmp)
         oo[2] += mul(fw, s_phi, out=tmp)
-        if fv is not None:
-            oo[1] += mul(fv, s_phi, out=tmp)
-        if i > 0 or fv is not None:
+        if i > 0:
             s_phi /= l2
             s_phi *= dot
             oo -= mul(sp, s_phi, out=self.ws.get("v3", sp.shape))

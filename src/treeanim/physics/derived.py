@@ -1,9 +1,9 @@
-"""What a :class:`~treeanim.physics.simulation.Simulation` derives from its tree and physics
-(docs/design.md §5–§8, §12): rest geometry and the bending, composition and load path plans,
-stiffness, masses, drag, and the modes (Eqs. 20–22).
+"""What a :class:`~treeanim.physics.paper_sim.PaperSim` derives from its tree and physics
+(docs/design.md §5–§8): rest geometry and the bending and composition plans, stiffness,
+masses, and the modes (Eqs. 20–22; the drag constants for ``modes='physical'``).
 
-:class:`Derived` is mixed into the Simulation; it computes once per tree what the step's
-stages (:mod:`~treeanim.physics.stages`) read, and again when the physics, the season or the
+:class:`Derived` is mixed into PaperSim; it computes once per tree what the step's stages
+(:mod:`~treeanim.physics.stages`) read, and again when the physics, the season or the modal
 model change.
 """
 
@@ -11,24 +11,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model.geometry import arc_length, lamina_frames, object_lengths, polygon_centroid, segment_lengths
+from ..model.geometry import lamina_frames, object_lengths, polygon_centroid, segment_lengths
 from .aero import Drag
 from .bending import BendingPlan, rest_frames
-from .falling import FallingLeaves
 from .hierarchy import CompositionPlan
-from .leaves import LeafTwist
-from .loadpath import LoadPath
 from .modal import derive_modes, mean_diameters
 from .physical import physical_modes
 from .rotation import Workspace, matrix_to_quat
 
-#: E (Pa) that shapes a branch's stiffness along its length before :meth:`LoadPath.tune` sets
-#: its magnitude from the branch's frequency and mass (any value gives the same tree).
-NOMINAL_WOOD_MODULUS = 6e9
-
 
 class Derived:
-    """Set-up of a Simulation: everything computed from the tree, its physics and the season."""
+    """Set-up of a PaperSim: everything computed from the tree, its physics and the season."""
 
     def _geometry(self) -> None:
         """Per-object rest frames, lever arms, areas and volumes (fixed for the tree)."""
@@ -42,15 +35,13 @@ class Derived:
         u = frames[:, :, 0]
         kind = tree.kind
         leaf = kind == "leaf"
-        # The load path bends a petiole or a grass blade at one hinge (docs/design.md §12).
-        self._bplan = BendingPlan(tree, frames, hinge=(kind != "branch") if self._load_path else None)
+        self._bplan = BendingPlan(tree, frames)
         self._cplan = CompositionPlan(tree, self._bplan, matrix_to_quat(frames))
         length = object_lengths(tree)
         dmean = mean_diameters(tree)
         p0pn = X[tip] - X[start]
         r = np.einsum("ij,ij->i", u, p0pn)  # Eq. 3: r = u · P0Pn
         lam_area = np.zeros(M)
-        load_point = X[tip].copy()  # where each object's own load acts (load path)
         if tree.lamina is not None and np.any(leaf):
             leaves = np.flatnonzero(leaf)
             unit_area = float(tree.lamina.area)
@@ -61,7 +52,6 @@ class Derived:
             tipn, lu, lv, _ = lamina_frames(tree, leaves)
             centroid = X[tipn] + L * (cx * lu + cy * lv)
             r[leaves] = np.linalg.norm(centroid - X[start[leaves]], axis=1)
-            load_point[leaves] = centroid
         self._lever = r
         self._area = length * dmean + lam_area
         # Volumes: tapered segments (frusta ≈ cylinders of the mean diameter).
@@ -72,7 +62,7 @@ class Derived:
         self._flat_area = np.add.reduceat(dseg * seg, start)  # blades: width × length
         self._lam_area = lam_area
         self._nseg = (count - 1).astype(float)
-        self._sample_ofs = self._bplan.ofs_of_node[start + count // 2]  # the middle node (paper)
+        self._sample_ofs = self._bplan.ofs_of_node[start + count // 2]  # the middle node: where the wind is sampled
         self._tip_node = tip
         self._rest_P = X.T.copy()
         # Base excitation: unique attach nodes of the non-root objects.
@@ -86,30 +76,8 @@ class Derived:
         o = self._bplan.order
         self._neg_half_pi_over_n_ord = -0.5 * np.pi / self._nseg[o]
         self._rest_bounds = (X.min(axis=0), X.max(axis=0))
-        # The load path (docs/design.md §12): its plan, the drag, and each object's true middle (half
-        # its arc length, on segment j at fraction t) where it samples the wind.
-        self._lp = LoadPath(tree, frames, self._bplan, load_point)
+        # Drag constants, for the modes of ``modes='physical'`` (:mod:`~treeanim.physics.physical`).
         self._drag = Drag(kind, np.where(leaf, lam_area, length * dmean))
-        arc = arc_length(tree)
-        half = 0.5 * length
-        below = np.add.reduceat((arc <= np.repeat(half, count)).astype(np.int64), start)
-        j = np.clip(below - 1, 0, count - 2)
-        t = np.clip((half - arc[start + j]) / np.maximum(seg[start + j], 1e-300), 0.0, 1.0)
-        hinge = self._bplan.hinge  # hinged: on its first segment (bent each step), extended to half the arc
-        j[hinge], t[hinge] = 0, half[hinge] / np.maximum(seg[start[hinge]], 1e-300)
-        # The point is t·o[b] + (1 − t)·o[a] of the bent offsets; o[a] is the base (zero) on a
-        # first segment, so only the objects whose middle lies further on need the second term.
-        self._mid_b = self._bplan.ofs_of_node[start + j + 1]
-        self._mid_t = t
-        self._mid_far = np.flatnonzero(j > 0)
-        self._mid_a = self._bplan.ofs_of_node[start + j][self._mid_far]
-        self._mid_ta = 1.0 - t[self._mid_far]
-        self._leaves = np.flatnonzero(leaf)
-        self._tip_flat = self._bplan.flat_of_node[tip]
-        lp = self._lp
-        self._leaf_twist = LeafTwist(np.searchsorted(self._leaves, lp.seg_obj[lp.leaf_seg]),
-                                     np.asarray(tree.lamina_length, float)[self._leaves], self._seed)
-        self._fallen = FallingLeaves(tree.object_start, tree.object_count, tree.rest_w, self._seed)
 
     def _derive_physics(self) -> None:
         """Stiffness, gains, masses and twist constants from ``self._physics``."""
@@ -130,24 +98,11 @@ class Derived:
         k_root[self._bplan.order] = self._k[0]
         self._c0k = c0 / np.maximum(k_root, 1e-300)
         self._c0k_ord = self._c0k[self._bplan.order]
-        if self._load_path:
-            self._derive_load_path()
-
-    def _derive_load_path(self) -> None:
-        """The load path's drag, stiffness shapes and masses (physics and present leaves)."""
-        p = self._physics
-        self._drag.derive(p, self._present)
-        branch = self._tree.kind == "branch"
-        E = np.select([branch, self._tree.kind == "leaf"], [NOMINAL_WOOD_MODULUS, p.leaf_youngs_modulus],
-                      p.blade_youngs_modulus)
-        self._lp.derive(E, p.stiffness_exponent, self._drag.half_rho_cda, self._drag.foliage,
-                        self._mass * self._present, self._mass, branch)
-        self._bplan.hinge_gain = self._lp.hinge_gain
-        self._mode_snap = None  # the branches' stiffness follows the modes: re-tune on the next step
 
     def _derive_modes(self) -> None:
-        present = self._present if self._load_path else None  # Eq. 21 with the leaves still on
-        m = derive_modes(self._tree, self._physics, self._season, self._draws, present)
+        """The modes f and ζ (Eqs. 20–22; Eq. 21 counts the fallen leaves too, as the paper does),
+        or the physical ones (``modes='physical'``), into ``self._modes`` (in place when possible)."""
+        m = derive_modes(self._tree, self._physics, self._season, self._draws)
         if self._modal == "physical":
             self._drag.derive(self._physics, self._present)
             m = physical_modes(self._tree, self._physics, m, self._mass * self._present, self._drag.half_rho_cda)

@@ -1,8 +1,8 @@
-"""What a :class:`~treeanim.physics.simulation.Simulation` shows of its state: the posed
-nodes (``positions``, ``rotations``), built lazily once a step, the loads, the pulls and the
+"""What a :class:`~treeanim.physics.paper_sim.PaperSim` shows of its state: the posed nodes
+(``positions``, ``rotations``), built lazily once a step, the loads, the pulls and the
 objects' tips.
 
-:class:`Pose` is mixed into the Simulation.
+:class:`Pose` is mixed into PaperSim.
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ _UNSHARED_REFS = _unshared_refs()
 
 
 class Pose:
-    """The Simulation's pose and loads, read-only views of its state."""
+    """PaperSim's pose and loads, read-only views of its state."""
 
     @property
     def rest_positions(self) -> np.ndarray:
@@ -63,9 +63,7 @@ class Pose:
         """
         if self._pos_out is None:
             buf = self._recycled("_pos_buf", (self._N, 3))
-            self._bplan.finish()
             pos = self._cplan.positions(self._bplan.o, self._node_frames(), self._base, out=buf)
-            self._fallen.pose(pos)
             pos.setflags(write=False)
             self._pos_out = self._pos_buf = pos
         return self._pos_out
@@ -79,9 +77,7 @@ class Pose:
         """
         if self._rot_out is None:
             buf = self._recycled("_rot_buf", (self._N, 3, 3))
-            self._bplan.finish()
             rot = self._cplan.rotations(self._bplan.q, self._node_frames(), out=buf)
-            self._fallen.pose(None, rot)
             rot.setflags(write=False)
             self._rot_out = self._rot_buf = rot
         return self._rot_out
@@ -123,7 +119,5 @@ class Pose:
 
     def _tip_positions(self, objs: np.ndarray) -> np.ndarray:
         """(K, 3) deformed tip positions of objects ``objs`` (no validation)."""
-        if self._bplan.hinge[objs].any():  # only hinged objects' tips wait for the layout
-            self._bplan.finish()
         o = self._bplan.o[:, self._bplan.ofs_of_node[self._tip_node[objs]]]
         return (self._base[:, objs] + qrot(self._frame[:, objs], o)).T

@@ -1,8 +1,9 @@
-"""The whole-tree simulation (docs/design.md §6): wind → loads → oscillators → bending → hierarchy."""
+"""The paper's tree simulation (Hu, Chiba & He 2012; docs/design.md §6): wind → loads →
+oscillators → bending → hierarchy, every object driven by the load on its own area."""
 
 from __future__ import annotations
 
-import math
+import dataclasses
 import numbers
 
 import numpy as np
@@ -15,10 +16,10 @@ from .modal import ModalDraws, ModalParameters
 from .oscillator import INTEGRATORS
 from .physical import MODAL_MODELS
 from .pose import Pose
-from .stages import MAX_SUBSTEP, MAX_SUBSTEPS, Stages
+from .stages import Stages
 from .wind import DEFAULT_BOUNDS
 
-__all__ = ["Simulation", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
+__all__ = ["PaperSim", "PaperState", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
 
 #: Largest pull force accepted (N): far beyond any hand on a tree (the bending stays finite
 #: and keeps lengths far above it; the cap keeps absurd inputs out).
@@ -31,8 +32,77 @@ MAX_STEP = 1e6
 MAX_FREQUENCY = 1e4
 MAX_ZETA = 1e3
 
+#: PaperSim's time-varying arrays (attribute ``_name``) and its bending plan's (``BendingPlan.name``).
+_SIM_ARRAYS = ("p", "pd", "L", "P", "Fw", "frame", "base", "sample_pos", "att_x", "att_v", "att_a")
+_BEND_ARRAYS = ("q", "o", "phi", "rho", "rho_old", "rho_start")
 
-class Simulation(Derived, Stages, Pose):
+
+@dataclasses.dataclass
+class PaperState:
+    """A snapshot of a :class:`PaperSim`'s motion (:meth:`PaperSim.get_state`).
+
+    Everything a step reads or writes that changes over time; not the settings (tree, wind,
+    season, physics, modes, modal model, integrator, coupling), which stay the simulation's.
+
+    Attributes
+    ----------
+    time : float
+        Simulated time (s).
+    dt_prev : float or None
+        The last step's length (None before the first step): the base accelerations'
+        difference and the bending solver's extrapolation read it.
+    p, pd, L : (3, M) float
+        The oscillators' outputs L′ and their rates (Eq. 5), and the last local loads.
+    bend_q, bend_o : (4, S + 1), (3, S + 1) float
+        The bending's segment rotations and bent offsets (:class:`~treeanim.physics.bending.BendingPlan`).
+    bend_phi, bend_rho, bend_rho_old, bend_rho_start : (S,) float
+        Bend angles and the fractions φ/θ₀ the next solve starts from.
+    P, Fw : (3, N), (4, N + 1) float
+        World positions and segment frames of the structural nodes (Eq. 12).
+    frame, base, sample_pos : (4, M), (3, M), (3, M) float
+        Each object's carried frame, base and wind sample point.
+    att_x, att_v, att_a : (3, U), (3, U), (3, U + 1) float
+        Position, velocity and low-passed acceleration of the attach nodes (base excitation).
+    pulls : dict of int to (3,) float
+        Held objects and their world forces.
+    """
+
+    time: float
+    dt_prev: float | None
+    p: np.ndarray
+    pd: np.ndarray
+    L: np.ndarray
+    P: np.ndarray
+    Fw: np.ndarray
+    frame: np.ndarray
+    base: np.ndarray
+    sample_pos: np.ndarray
+    att_x: np.ndarray
+    att_v: np.ndarray
+    att_a: np.ndarray
+    bend_q: np.ndarray
+    bend_o: np.ndarray
+    bend_phi: np.ndarray
+    bend_rho: np.ndarray
+    bend_rho_old: np.ndarray
+    bend_rho_start: np.ndarray
+    pulls: dict[int, np.ndarray]
+
+    def copy(self) -> PaperState:
+        """A deep copy (no array shared with this one)."""
+        return PaperState(**{f.name: _copied(getattr(self, f.name)) for f in dataclasses.fields(self)})
+
+
+def _copied(x):
+    """A deep copy of a state field: arrays and dicts of arrays copied, scalars as they are."""
+    if isinstance(x, np.ndarray):
+        return x.copy()
+    if isinstance(x, dict):
+        return {int(i): np.array(f, dtype=float) for i, f in x.items()}
+    return x
+
+
+class PaperSim(Derived, Stages, Pose):
     """A tree animated by wind and by pulls (Hu, Chiba & He 2012; docs/design.md §5–§8).
 
     Parameters
@@ -49,17 +119,8 @@ class Simulation(Derived, Stages, Pose):
     integrator : {'exact', 'euler'}
         Oscillator integrator (:mod:`treeanim.physics.oscillator`).
     coupling : bool
-        Base excitation in the paper's model: every object also feels −(acceleration of its
-        base node) × its mass, so a swinging trunk shakes its twigs. False restores the paper's
-        independent objects. The load path always couples (its loads go down the tree, so the
-        motion must come back up: one without the other feeds energy into a gusty crown).
-    load_path : bool
-        True (default): the tree is one structure (docs/design.md §12, :mod:`~treeanim.physics.loadpath`):
-        every object carries its children's loads down to the trunk, drag is quadratic in the
-        air-relative wind with foliage reconfiguration (:mod:`~treeanim.physics.aero`), joints
-        are as stiff as a tapered cantilever of the preset's Young's modulus, and pulls build
-        up critically damped. False: the paper's model exactly (each object feels only the
-        linear load on its own area), as the notes below describe.
+        Base excitation: every object also feels −(acceleration of its base node) × its mass,
+        so a swinging trunk shakes its twigs. False restores the paper's independent objects.
     modes : {'paper', 'physical'} or None
         Where the modal f and ζ come from: 'paper' maps the preset's ranges (Eqs. 20–22);
         'physical' gives every branch its first bending frequency as a tapered cantilever
@@ -85,10 +146,7 @@ class Simulation(Derived, Stages, Pose):
         Objects on the tree at the current season (fallen leaves are False); ``present_nodes``
         is the same per node. Absent leaves are still simulated (cheap), carrying no load.
     shown : (M,) bool, read-only
-        Objects to draw: those present plus, with the load path, the leaves that fell while
-        the simulation ran — they tumble down and lie on the ground (:mod:`.falling`), posed in
-        ``positions`` and ``rotations``. The paper's model (``load_path=False``) drops them
-        out of sight, as ``present``.
+        Objects to draw: ``present`` (fallen leaves drop out of sight).
     season : float
         Settable, in [0, 1].
     physics : PhysicsParams
@@ -123,11 +181,13 @@ class Simulation(Derived, Stages, Pose):
     petiole. Exposed area: length × mean diameter; a leaf adds its lamina
     (``tree.lamina.area × lamina_length²``). Mass: density × volume (a lamina is
     ``lamina_thickness`` thick).
+
+    :meth:`get_state` takes a snapshot of the motion (:class:`PaperState`) and :meth:`set_state`
+    restores it: the steps after it are then bit for bit those that followed the snapshot.
     """
 
     def __init__(self, tree: Tree, wind=None, season: float = 0.0, seed: int = 0,
-                 integrator: str = "exact", coupling: bool = True, load_path: bool = True,
-                 modes: str | None = None):
+                 integrator: str = "exact", coupling: bool = True, modes: str | None = None):
         if not isinstance(tree, Tree):
             raise ValueError(f"tree must be a treeanim Tree, got {type(tree).__name__}")
         if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
@@ -136,7 +196,6 @@ class Simulation(Derived, Stages, Pose):
         self._seed = int(seed)
         self.integrator = integrator
         self._coupling = bool(coupling)
-        self._load_path = bool(load_path)
         self._modal = self._check_modal(tree.modes if modes is None else modes)
         season = self._check_season(season)
         kinds = [k for k in KINDS if np.any(tree.kind == k)]
@@ -220,15 +279,6 @@ class Simulation(Derived, Stages, Pose):
         f3, z3 = fa.T.copy(), za.T.copy()
         self._mode_snap = (f, z, fa.copy(), za.copy(), f3, z3)
         self._osc.clear()
-        w = 2.0 * np.pi * f3
-        self._w2, self._two_zeta_w = w * w, 2.0 * z3 * w  # ω² and 2ζω of every mode
-        if self._load_path:
-            lp = self._lp
-            lp.tune(self._w2)
-            # −m_eff of the bending modes u and w (base excitation) and their mean ω (the loads' low-pass)
-            self._neg_m_eff = -np.minimum(lp.K / self._w2[[0, 2]], lp.m_modal)
-            self._spread_rate = np.sqrt(np.sqrt(self._w2[0] * self._w2[2]))
-            self._spread_alpha = (None, None)  # (dt, its filter weights): see _distributed_loads
         return f3, z3
 
     # ------------------------------------------------------------------ properties
@@ -263,16 +313,8 @@ class Simulation(Derived, Stages, Pose):
         self._season = s
         present = self._tree.leaves_present(s)
         present.setflags(write=False)
-        if self._load_path:  # leaves dropped now fall from where they are; regrown ones are back
-            fell = np.flatnonzero(self._present & ~present)
-            if len(fell):
-                self._fallen.detach(fell, self.positions, self.rotations)
-            self._fallen.remove(np.flatnonzero(present & ~self._present))
-            self._pos_out = self._rot_out = self._shown_out = None
         self._present = present
         self._derive_modes()
-        if self._load_path:
-            self._derive_load_path()
 
     @property
     def present(self) -> np.ndarray:
@@ -281,13 +323,8 @@ class Simulation(Derived, Stages, Pose):
 
     @property
     def shown(self) -> np.ndarray:
-        """(M,) bool: objects to draw, the present ones and the fallen leaves (see the class)."""
-        if not len(self._fallen):
-            return self._present
-        if self._shown_out is None:
-            self._shown_out = self._present | self._fallen.shown(self._M)
-            self._shown_out.setflags(write=False)
-        return self._shown_out
+        """(M,) bool: objects to draw, ``present`` itself (fallen leaves drop out of sight)."""
+        return self._present
 
     @property
     def present_nodes(self) -> np.ndarray:
@@ -342,25 +379,6 @@ class Simulation(Derived, Stages, Pose):
         self._coupling = bool(on)
 
     @property
-    def load_path(self) -> bool:
-        """Whether the tree is one structure (docs/design.md §12) or the paper's independent objects
-        (settable; switching restarts from rest, keeping time, season and physics)."""
-        return self._load_path
-
-    @load_path.setter
-    def load_path(self, on: bool) -> None:
-        on = bool(on)
-        if on == self._load_path:
-            return
-        self._load_path = on
-        self._geometry()  # the bending plan differs (hinged petioles)
-        self._derive_physics()
-        self._derive_modes()
-        time = self._time
-        self.reset()
-        self._time = time
-
-    @property
     def wind(self):
         """The wind field or None (settable; a wind on its default bounds is fitted to the tree)."""
         return self._wind
@@ -397,9 +415,8 @@ class Simulation(Derived, Stages, Pose):
         pose), for a pull controller's spring.
 
         The point is carried by segment ``k`` at ``s`` (0 … 1) along it, plus ``offset`` (a
-        point on a leaf's lamina lies beyond the petiole's tip). The paper's model sums Eq. 10's
-        hinges; the load path scales the compliance 1/K at the object's load point by the
-        cube of the point's share of the lever (a cantilever's x³ law).
+        point on a leaf's lamina lies beyond the petiole's tip): the sum over Eq. 10's hinges
+        up to the point.
         """
         i = self._check_object(int(i))
         tree = self._tree
@@ -407,10 +424,6 @@ class Simulation(Derived, Stages, Pose):
         X = tree.rest_positions[nodes]
         seg = np.diff(X, axis=0)
         anchor = X[k] + s * seg[k] + np.asarray(offset, float)
-        if self._load_path:
-            self._modes_arrays()  # the stiffness follows the modes
-            share = np.linalg.norm(anchor - X[0]) / max(float(self._lp.lever0[i]), 1e-12)
-            return float(min(share, 4.0) ** 3 / self._lp.K[i])
         L = np.linalg.norm(seg, axis=1)
         n = len(L)
         stiff = np.concatenate(self._k)[self._bplan.flat_of_node[nodes[:-1]]]  # Eq. 10's k, as the bending uses it
@@ -488,60 +501,102 @@ class Simulation(Derived, Stages, Pose):
         self._att_v = np.zeros((3, U))
         self._att_a = np.zeros((3, U + 1))  # column U: zero, for roots
         self._dt_prev = None
-        self._g_prev = np.zeros((3, M))  # the oscillators' last inputs (load path)
-        self._air_prev = np.zeros((2, M))  # the air's damping rate of the last step (load path)
-        self._sample_prev = self._sample_pos.copy()
-        self._sample_vel = np.zeros((3, M))
-        self._leaf_twist.reset()
-        self._fallen.clear()
-        self._shown_out = None
-        self._spread = None  # the low-passed loads along the objects (load path)
         self._pulls.clear()
         self._pos_out = None
         self._rot_out = None
         self._fn = None
 
-    def step(self, dt: float) -> None:
-        """Advance the simulation by ``dt`` seconds (docs/design.md §6; §12 with the load path).
+    def get_state(self) -> PaperState:
+        """A snapshot of the motion, to come back to with :meth:`set_state`.
 
-        One step is a pipeline of stages: wind → aerodynamic loads → (load path and)
-        oscillators → bending → hierarchy.
+        Returns
+        -------
+        PaperState
+            Deep copies of everything that changes from step to step (time, oscillators,
+            bending, pose, base motion, pulls); later steps leave it as it is.
+        """
+        bp = self._bplan
+        return PaperState(time=self._time, dt_prev=self._dt_prev, pulls=_copied(self._pulls),
+                          **{n: getattr(self, "_" + n).copy() for n in _SIM_ARRAYS},
+                          **{"bend_" + n: getattr(bp, n).copy() for n in _BEND_ARRAYS})
+
+    def set_state(self, state: PaperState) -> None:
+        """Restore a snapshot of :meth:`get_state`: the next steps are bit for bit those that
+        followed when it was taken (given the same settings, wind and inputs).
+
+        The settings (wind, season, physics, modes, integrator, coupling) are not part of the
+        snapshot and stay as they are. ``state`` itself is copied, so it can be restored again.
+
+        Parameters
+        ----------
+        state : PaperState
+            From this simulation or another of the same tree.
+
+        Raises
+        ------
+        ValueError
+            Not a PaperState, or one of another tree (array shapes differ), or a malformed
+            time, step or pull (the simulation unchanged).
+        """
+        if not isinstance(state, PaperState):
+            raise ValueError(f"state must be a PaperState from get_state(), got {type(state).__name__}")
+        bp = self._bplan
+        new = {}
+        for owner, names, prefix in ((self, _SIM_ARRAYS, "_"), (bp, _BEND_ARRAYS, "")):
+            for n in names:
+                field = n if owner is self else "bend_" + n
+                cur = getattr(owner, prefix + n)
+                try:
+                    a = np.array(getattr(state, field), dtype=float)
+                except (TypeError, ValueError):
+                    raise ValueError(f"state.{field} must be an array of numbers") from None
+                if a.shape != cur.shape:
+                    raise ValueError(f"state.{field} has shape {a.shape}, expected {cur.shape} "
+                                     f"(a state of another tree?)")
+                new[owner, prefix + n] = a
+        time = finite_float("state.time", state.time)
+        dt_prev = None if state.dt_prev is None else finite_float("state.dt_prev", state.dt_prev)
+        if not isinstance(state.pulls, dict):
+            raise ValueError(f"state.pulls must be a dict, got {type(state.pulls).__name__}")
+        pulls = {self._check_object(i): finite_vector3("state.pulls force", f) for i, f in state.pulls.items()}
+        for (owner, attr), a in new.items():
+            setattr(owner, attr, a)
+        self._time = time
+        self._dt_prev = dt_prev
+        self._pulls.clear()
+        self._pulls.update(pulls)
+        self._pos_out = None
+        self._rot_out = None
+        self._fn = None
+
+    def step(self, dt: float) -> None:
+        """Advance the simulation by ``dt`` seconds (docs/design.md §6).
+
+        One step is a pipeline of stages: wind → loads → oscillators → bending → hierarchy
+        (:mod:`~treeanim.physics.stages`).
 
         Parameters
         ----------
         dt : float
             Step length in seconds, > 0 and at most :data:`MAX_STEP`. Any such length is
             stable: the exact integrator has no step limit; Euler sub-steps (and clamps very
-            long steps, see :mod:`treeanim.physics.oscillator`); the load path advances in
-            sub-steps of at most 1/60 s (up to 64 of them; see
-            :data:`~treeanim.physics.stages.MAX_SUBSTEP`).
+            long steps, see :mod:`treeanim.physics.oscillator`).
 
         Raises
         ------
         ValueError
             ``dt`` not in (0, MAX_STEP], invalid ``modes`` (f not in (0, MAX_FREQUENCY], ζ not
             in [0, MAX_ZETA], wrong shape), or a wind whose ``sample`` returns the wrong
-            shape or non-finite values. The state is left unchanged (or, where the wind fails
-            in a later sub-step of the load path, advanced by the sub-steps before it).
+            shape or non-finite values. The state is left unchanged.
         """
         dt = finite_float("dt", dt)
         if not 0 < dt <= MAX_STEP:
             raise ValueError(f"dt must be > 0 and at most {MAX_STEP:g} s, got {dt!r}")
         f3, z3 = self._modes_arrays()
-        # the load path in sub-steps short enough for its base excitation (stages.py)
-        n = min(max(math.ceil(dt / MAX_SUBSTEP - 1e-9), 1), MAX_SUBSTEPS) if self._load_path else 1
-        h = dt / n
-        for _ in range(n):
-            U = self._wind_at_samples(self._time)
-            if self._load_path:
-                self._step_load_path(U, f3, z3, h)
-                if len(self._fallen):
-                    self._fallen.step(self._wind_at_points(self._time), h)
-            else:
-                self._step_paper(U, f3, z3, h)
-            self._dt_prev = h
-            self._time += h
+        U = self._wind_at_samples(self._time)
+        self._step_paper(U, f3, z3, dt)
+        self._dt_prev = dt
+        self._time += dt
         self._pos_out = None
         self._rot_out = None
         self._fn = None
-
