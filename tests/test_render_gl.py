@@ -189,6 +189,50 @@ def test_a_hard_pulled_one_segment_twig_is_drawn_as_a_curve(offscreen):
         assert abs(drawn - y) < 1.0, (x, y, drawn)
 
 
+def test_a_bent_beam_is_picked_where_it_is_drawn(offscreen):
+    """Issue 26: a press on the drawn beam grabs it. The beam preset in one segment (drawn in
+    four bands along its Hermite curve), pulled sideways by the simulation: every pixel the
+    drawn beam covers picks it, though the segment's chord runs far beside it."""
+    import treeanim as ta
+    from treeanim.model.generate import generate
+    from treeanim.model.presets import read_spec
+    from treeanim.physics.simulation import Simulation
+    from treeanim.render.camera import framed_camera as frame
+    from treeanim.render.picking import Picker
+
+    w, h = 320, 240
+    spec = read_spec(ta.load_preset("beam").source)
+    tree = generate(dataclasses.replace(spec, beam=dataclasses.replace(spec.beam, segments=1)))
+    sim = Simulation(tree)
+    sim.pull(0, (30.0, 0.0, 0.0))
+    for _ in range(30):
+        sim.step(1 / 60)
+    P, R = sim.positions, sim.rotations
+    offscreen.resize(w, h)
+    r = offscreen.load(tree)
+    cam = frame(tree, w, h)
+    bg = background(offscreen, r, cam)
+    offscreen.update(P, R)
+    beam = changed(offscreen.render(cam), bg)
+
+    (bx, by), (tx, ty) = cam.project(P, w, h)[:, :2]
+    assert tx > bx + 40  # bent well to the right
+    picker = Picker(tree)
+    gaps = []
+    for y in np.linspace(ty, by, 10)[1:-2].astype(int):  # clear of the tip and of the shadow at the base
+        cols = np.flatnonzero(beam[y])
+        assert len(cols) and np.ptp(cols) == len(cols) - 1, (y, cols)  # one run of covered pixels
+        for x in cols:
+            o, d = cam.ray(x + 0.5, y + 0.5, w, h)
+            hit = picker.pick(P, R, o, d, pixel_angle=cam.pixel_angle(h), min_pixels=4.0)
+            assert hit is not None and hit.object == 0, (x, y)
+            assert np.hypot(*(cam.project(hit.point, w, h)[0, :2] - (x + 0.5, y + 0.5))) < 5.0
+        chord_x = bx + (y + 0.5 - by) * (tx - bx) / (ty - by)
+        gaps.append(abs(chord_x - 0.5 * (cols[0] + cols[-1] + 1)) - 0.5 * len(cols))
+    # The chord's capsule (4 px around it) misses the drawn beam on most of these rows.
+    assert np.sum(np.array(gaps) > 6.0) >= len(gaps) // 2, gaps
+
+
 # ------------------------------------------------------------------------------ leaves, season
 def bare(off, r, cam, season=0.0):
     """The tree with every leaf hidden."""

@@ -335,6 +335,88 @@ def test_pick_lamina_follows_pose_and_present_mask():
     assert pick(tree, P + shift, R, o + shift, d).object == leaf
 
 
+def test_pick_axis_runs_through_the_rings_the_mesh_draws():
+    """The picker's axis points inside a segment are the centres of the mesh's rings there,
+    skinned: on the curve the shader draws, not on the chord."""
+    from treeanim.model.tree import BRANCH_SIDES
+    from treeanim.physics.simulation import Simulation
+
+    tree = small_tree()
+    twig = int(np.flatnonzero(tree.level == tree.level.max())[0])
+    sim = Simulation(tree)
+    sim.pull(twig, (0.0, -40.0, 20.0))
+    for _ in range(10):
+        sim.step(1 / 60)
+    P, R = sim.positions, sim.rotations
+    picker = Picker(tree)
+    axis = picker.axis_points(P, R)
+    mesh = build_mesh(tree)
+    pts, _ = mesh.skin(P, R)
+    bark = mesh.material == MATERIAL_BARK
+    t_mesh = mesh.vertices["curve"][:, 0]
+    inside = np.flatnonzero(picker.t > 0)
+    assert len(inside) > 20
+    r = 0.5 * tree.node_diameter
+    for q in inside:
+        j, t = picker.node[q], picker.t[q]
+        ring = pts[bark & (mesh.node == j) & np.isclose(t_mesh, t)]
+        radius = (1 - t) * r[j] + t * r[j + 1]
+        on_ring = np.isclose(np.linalg.norm(ring - axis[q], axis=1), radius, rtol=1e-4, atol=1e-6)
+        assert on_ring.sum() == BRANCH_SIDES, (j, t)
+    # ... which lie off the chords in this pose.
+    j, t = picker.node[inside], picker.t[inside, None]
+    off = np.linalg.norm(axis[inside] - ((1 - t) * P[j] + t * P[j + 1]), axis=1)
+    assert off.max() > 0.005, off.max()
+
+
+def test_pick_thin_twigs_as_drawn_a_pixel_wider_and_behind_solid_surfaces():
+    """A twig thinner than ``thin_pixels`` is drawn a pixel wider each side, behind every solid
+    surface (shaders/tree.vert, DEPTH_THIN); a ray through a drawn surface picks it before one
+    that only passes within ``min_pixels`` of something nearer."""
+    from treeanim.model.build import ObjectSpec, assemble
+
+    x = np.linspace(-1.0, 1.0, 5)[:, None]
+    trunk = ObjectSpec(np.array([[0.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 2.0, 0.0]]), np.full(3, 0.2))
+    thin = ObjectSpec(np.hstack([x, np.ones_like(x), np.full_like(x, 0.5)]), np.full(5, 0.004))
+    tree = assemble([trunk, thin], name="crossing")
+    picker = Picker(tree)
+    P, R = tree.rest_positions, identity(tree)
+    eye, d = np.array([0.0, 1.0, 5.0]), np.array([0.0, 0.0, -1.0])
+    angle = 1e-3  # a pixel: 4.5 mm at the twig (radius 2 mm, under 1.5 px), 5 mm at the trunk
+
+    def hit(at, **kw):
+        h = picker.pick(P, R, eye + at, d, pixel_angle=angle, **kw)
+        return None if h is None else h.object
+
+    assert hit([0.0, 0.0, 0.0]) == 1  # the nearest surface
+    assert hit([0.0, 0.0, 0.0], thin_pixels=1.5) == 0  # the thin twig is drawn behind the trunk
+    assert hit([0.5, 0.0, 0.0], thin_pixels=1.5) == 1  # over the sky it shows
+    # Drawn a pixel wider each side: 2 mm + 1 px (4.5 mm) from its axis.
+    assert hit([0.5, 0.006, 0.0], thin_pixels=1.5, min_pixels=0.0) == 1
+    assert hit([0.5, 0.006, 0.0], min_pixels=0.0) is None
+    assert hit([0.5, 0.009, 0.0], thin_pixels=1.5, min_pixels=0.0) is None
+    # 3 px beside the twig (within its 4 px reach) the trunk behind it is drawn: it is picked;
+    # over the sky, the twig.
+    assert hit([0.0, 0.0135, 0.0]) == 0
+    assert hit([0.5, 0.0135, 0.0]) == 1
+
+
+def test_pick_reaches_a_blades_apex():
+    """A blade ends in a triangle to an apex half its last segment beyond its tip."""
+    tree = grass_patch()
+    picker = Picker(tree)
+    P, R = tree.rest_positions, identity(tree)
+    blade = 7
+    tip = tree.object_start[blade] + tree.object_count[blade] - 1
+    point = P[tip] + 0.3 * (P[tip] - P[tip - 1])  # 0.6 of the way to the apex
+    w = tree.rest_w[blade]
+    present = np.arange(tree.n_objects) == blade
+    hit = picker.pick(P, R, point + w, -w, present=present, min_pixels=0.0)
+    assert hit is not None and hit.object == blade
+    assert picker.pick(P, R, point + w + 0.02 * _unit(P[tip] - P[tip - 1]), -w, present=present,
+                       min_pixels=0.0) is None
+
+
 # ------------------------------------------------------------------------------ small pieces
 def test_pull_trace_ring_buffer_keeps_the_newest_in_order():
     from treeanim.render.overlays import PullTrace

@@ -372,8 +372,10 @@ class Viewer(ViewerInput):
     def pick(self, x: float, y: float):
         """The object under window point (x, y) (screen units, y down), or None."""
         o, d = self._ray(x, y)
+        h = max(self._win[1], 1)
+        thin = self.scene.thin_pixels * h / (self._fb[1] or h)  # framebuffer pixels, in screen units
         return self.picker.pick(self.sim.positions, self.sim.rotations, o, d, present=self.sim.present,
-                                pixel_angle=self.camera.pixel_angle(max(self._win[1], 1)), min_pixels=4.0)
+                                pixel_angle=self.camera.pixel_angle(h), min_pixels=4.0, thin_pixels=thin)
 
     def start_pull(self, x: float, y: float) -> bool:
         """Grab the object under (x, y), if any. Returns whether something was grabbed."""

@@ -183,31 +183,68 @@ class TreeMesh:
         points, normals : (V, 3) float64
         """
         v = self.vertices
-        j, prev = v["ids"][:, 0], v["ids"][:, 1]
-        w = v["extra"][:, 0, None, None].astype(float)
-        t = v["curve"][:, 0].astype(float)
-        offset = v["offset"].astype(float)
-        P = np.asarray(positions, float)
-        R = np.asarray(rotations, float)
-        Rs = R[j]
-        Rp = np.where(prev[:, None, None] >= 0, R[np.maximum(prev, 0)], np.eye(3))
-        F = np.where(w > 0, blend_rotations(Rs * (1.0 - w) + Rp * w), Rs)  # T₀
-        points = P[j] + np.einsum("vij,vj->vi", F, offset)
-        m = np.flatnonzero(t > 0)
-        if len(m):
-            jm, tm, T0, Rm = j[m], t[m, None], F[m], Rs[m]
-            c = np.einsum("vji,vj->vi", Rm, P[jm + 1] - P[jm])  # rest chord
-            tip = (v["curve"][m, 1] > 0.5)[:, None, None]
-            T1 = blend_rotations(np.where(tip, 1.5 * Rm - 0.5 * T0, 0.5 * (Rm + R[jm + 1])))
-            t2, t3 = tm * tm, tm * tm * tm
-            centre = ((2 * t3 - 3 * t2 + 1) * P[jm] + (3 * t2 - 2 * t3) * P[jm + 1]
-                      + (t3 - 2 * t2 + tm) * np.einsum("vij,vj->vi", T0, c)
-                      + (t3 - t2) * np.einsum("vij,vj->vi", T1, c))
-            t2, tm = t2[:, :, None], tm[:, :, None]
-            F[m] = blend_rotations((3 * t2 - 4 * tm + 1) * T0 + (6 * tm - 6 * t2) * Rm + (3 * t2 - 2 * tm) * T1)
-            points[m] = centre + np.einsum("vij,vj->vi", F[m], offset[m] - tm[:, 0] * c)
+        points, F = skin_points(positions, rotations, v["ids"][:, 0], v["ids"][:, 1], v["extra"][:, 0],
+                                v["curve"][:, 0], v["curve"][:, 1] > 0.5, v["offset"])
         normals = np.einsum("vij,vj->vi", F, v["normal"].astype(float))
         return points, normals
+
+
+def skin_points(positions, rotations, node, prev, weight, t, tip, offset) -> tuple[np.ndarray, np.ndarray]:
+    """Where the vertex shader (``shaders/skin.glsl``) puts points, and the frames they turn with.
+
+    The formula of the module notes, vectorised: a point with ``t`` = 0 is placed at
+    ``positions[node] + T₀ @ offset``, one with ``t`` > 0 on the cubic Hermite curve of the
+    segment leaving ``node``. :meth:`TreeMesh.skin` places the mesh's vertices with it, the
+    picker (:mod:`treeanim.render.picking`) the centres of the tube's rings.
+
+    Parameters
+    ----------
+    positions : (N, 3) float
+        Node positions, world.
+    rotations : (N, 3, 3) float
+        Node rotations relative to rest.
+    node, prev : (V,) int
+        The node each point follows, and the node whose rotation T₀ blends in (< 0: the
+        ground's identity).
+    weight : (V,) float
+        Weight of ``prev``'s rotation in T₀ (0: T₀ = ``rotations[node]``).
+    t : (V,) float
+        Fraction along the segment leaving ``node``, in [0, 1].
+    tip : (V,) bool
+        The segment ends at its object's free tip (T₁ = orthonormalise(1.5 R − ½ T₀)).
+    offset : (V, 3) float
+        Rest offset from ``node``'s rest position, metres.
+
+    Returns
+    -------
+    points : (V, 3) float64
+    frames : (V, 3, 3) float64
+        The rotation each point turns with (T₀ where ``t`` = 0).
+    """
+    j, prev = np.asarray(node), np.asarray(prev)
+    w = np.asarray(weight, float)[:, None, None]
+    t = np.asarray(t, float)
+    offset = np.asarray(offset, float)
+    P = np.asarray(positions, float)
+    R = np.asarray(rotations, float)
+    Rs = R[j]
+    Rp = np.where(prev[:, None, None] >= 0, R[np.maximum(prev, 0)], np.eye(3))
+    F = np.where(w > 0, blend_rotations(Rs * (1.0 - w) + Rp * w), Rs)  # T₀
+    points = P[j] + np.einsum("vij,vj->vi", F, offset)
+    m = np.flatnonzero(t > 0)
+    if len(m):
+        jm, tm, T0, Rm = j[m], t[m, None], F[m], Rs[m]
+        c = np.einsum("vji,vj->vi", Rm, P[jm + 1] - P[jm])  # rest chord
+        end = np.asarray(tip, bool)[m, None, None]
+        T1 = blend_rotations(np.where(end, 1.5 * Rm - 0.5 * T0, 0.5 * (Rm + R[jm + 1])))
+        t2, t3 = tm * tm, tm * tm * tm
+        centre = ((2 * t3 - 3 * t2 + 1) * P[jm] + (3 * t2 - 2 * t3) * P[jm + 1]
+                  + (t3 - 2 * t2 + tm) * np.einsum("vij,vj->vi", T0, c)
+                  + (t3 - t2) * np.einsum("vij,vj->vi", T1, c))
+        t2, tm = t2[:, :, None], tm[:, :, None]
+        F[m] = blend_rotations((3 * t2 - 4 * tm + 1) * T0 + (6 * tm - 6 * t2) * Rm + (3 * t2 - 2 * tm) * T1)
+        points[m] = centre + np.einsum("vij,vj->vi", F[m], offset[m] - tm[:, 0] * c)
+    return points, F
 
 
 def blend_rotations(m: np.ndarray) -> np.ndarray:

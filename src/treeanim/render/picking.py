@@ -1,9 +1,19 @@
-"""Vectorised ray picking against the tree's deformed segments.
+"""Vectorised ray picking against the tree as the renderer draws it.
 
-Every segment of every object is a capsule around its axis, of radius half its mean diameter
-(a blade: half its width), widened to at least ``min_pixels`` pixels at its distance from the
-eye. A leaf's lamina is one more capsule, from the petiole's tip along the lamina's midrib,
-as wide as the lamina. The hit is the capsule the ray meets nearest the eye.
+The axis of every tube is the polyline through the centres of its mesh rings
+(:mod:`treeanim.render.mesh`), placed each pick by the vertex shader's own formula
+(:func:`~treeanim.render.mesh.skin_points`): a branch's segment runs along its cubic Hermite
+curve in :func:`~treeanim.model.tree.curve_bands` bands (four along a one-segment twig), a
+petiole's and a blade's straight from node to node, a blade on to its apex half a segment
+beyond its tip. Each piece of the polyline is a capsule of the tube's radius (a blade: half its
+width), tapering along it as the tube does. A leaf's lamina is one more capsule, along the
+midrib of its outline's middle, 0.8 of its half width.
+
+A ray meets a capsule within its radius, or within ``min_pixels`` pixels of its axis at its
+distance from the eye. Twigs and blades thinner than ``thin_pixels`` are drawn a pixel wider
+each side (``shaders/tree.vert``), and such twigs behind every solid surface (``DEPTH_THIN``).
+The hit is the nearest capsule whose drawn surface the ray meets, save thin twigs; failing
+that, the nearest capsule within reach.
 """
 
 from __future__ import annotations
@@ -12,8 +22,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..model.tree import Tree
-from .mesh import lamina_frames
+from ..model.tree import Tree, curve_bands
+from .mesh import _object_nodes, lamina_frames, skin_points
 
 
 class PickHit(NamedTuple):
@@ -26,7 +36,7 @@ class PickHit(NamedTuple):
 
 
 class Picker:
-    """Segment tables of ``tree`` built once; :meth:`pick` per click.
+    """Axis and capsule tables of ``tree`` built once; :meth:`pick` per click.
 
     Parameters
     ----------
@@ -35,36 +45,109 @@ class Picker:
 
     def __init__(self, tree: Tree) -> None:
         self.tree = tree
+        kind = np.asarray(tree.kind)
+        P = tree.rest_positions
         N = tree.n_nodes
-        node_obj = tree.node_object
-        a = np.arange(N - 1)
-        a = a[node_obj[a] == node_obj[a + 1]]  # segments inside one object
-        self.seg_a = a
-        self.seg_b = a + 1
-        self.seg_object = node_obj[a]
-        self.seg_radius = 0.25 * (tree.node_diameter[a] + tree.node_diameter[a + 1])
+        r = 0.5 * np.asarray(tree.node_diameter, float)
 
-        leaves = np.flatnonzero(tree.kind == "leaf")
+        # The tubes' rings, as render/mesh.py's _tubes places them: from each node but an
+        # object's tip, one ring per band of the segment leaving it; then the object's end
+        # ring (a branch's at t = 1 on its last segment, else its tip node's own).
+        objs = np.flatnonzero(tree.object_count >= 2)
+        nodes, k, obj = _object_nodes(tree, objs)
+        count = tree.object_count[obj]
+        base, tip = k == 0, k == count - 1
+        inner = ~(base | tip)
+        curved = kind[obj] == "branch"
+        bands = np.where(curved, curve_bands(count), 1)
+        reps = np.where(tip, 1, bands)
+        src = np.repeat(np.arange(len(nodes)), reps)
+        t = (np.arange(len(src)) - np.repeat(np.cumsum(reps) - reps, reps)) / bands[src]
+        end = tip[src]
+        shift = end & curved[src]
+        src = np.where(shift, src - 1, src)
+        t = np.where(shift, 1.0, t)
+        # T₀ of the segment leaving each node: a branch's base turns with its parent's attach
+        # node (the ground's identity under a root), an inner joint with the node before.
+        child = tree.parent[obj] >= 0
+        prev = np.where(curved & base, np.where(child, tree.attach_node[obj], -1), np.where(inner, nodes - 1, nodes))
+        weight = np.where(curved & base, 1.0, np.where(inner, 0.5, 0.0))
+        # A branch carrying branches on its tip ends in their base frame, not a free tip's.
+        carries = np.zeros(tree.n_objects, bool)
+        sub = np.flatnonzero((tree.parent >= 0) & (kind == "branch"))
+        par = tree.parent[sub]
+        carries[par[tree.attach_node[sub] == tree.object_start[par] + tree.object_count[par] - 1]] = True
+        ring_obj = obj[src]
+        free_end = curved[src] & tip[np.minimum(src + 1, len(nodes) - 1)] & ~carries[ring_obj]
+        j = nodes[src]
+        j1 = np.minimum(j + 1, N - 1)
+        offset = t[:, None] * (P[j1] - P[j])
+        radius = (1.0 - t) * r[j] + t * r[j1]
+        first_cap = np.flatnonzero(~end)  # a piece from each ring to the next, within an object
+
+        # A blade ends in a triangle to an apex half its last segment beyond its tip.
+        blade_end = np.flatnonzero(end & (kind[ring_obj] == "blade"))
+        bt = j[blade_end]
+        apex = len(src) + np.arange(len(bt))
+
+        # A lamina: its midrib through the middle of its outline, in the leaf's rest frame.
+        leaves = np.flatnonzero(kind == "leaf")
         lam = tree.lamina
         if lam is not None and len(leaves) and len(lam.outline):
             tipn, u, v, w = lamina_frames(tree, leaves)
             x, y = lam.outline[:, 0], lam.outline[:, 1]
-            L = tree.lamina_length[leaves][:, None]
-            self.lam_node = tipn
-            self.lam_object = leaves
-            self.lam_start = L * (y.min() * v)  # rest offsets from the tip node
-            self.lam_vec = L * ((y.max() - y.min()) * v)
-            self.lam_radius = (L[:, 0] * 0.5 * (x.max() - x.min())) * 0.8
+            xm = 0.5 * (x.max() + x.min())
+            L = np.asarray(tree.lamina_length, float)[leaves][:, None]
+            lam_start = L * (xm * u + y.min() * v + lam.curl * xm * xm * w)
+            lam_end = lam_start + L * ((y.max() - y.min()) * v)
+            lam_radius = 0.8 * L[:, 0] * 0.5 * (x.max() - x.min())
         else:
-            self.lam_node = np.zeros(0, int)
-            self.lam_object = np.zeros(0, int)
-            self.lam_start = self.lam_vec = np.zeros((0, 3))
-            self.lam_radius = np.zeros(0)
+            tipn = leaves = np.zeros(0, np.int64)
+            lam_start = lam_end = np.zeros((0, 3))
+            lam_radius = np.zeros(0)
+        lam_a = len(src) + len(bt) + np.arange(len(leaves))
+        lam_b = lam_a + len(leaves)
+
+        # Points skinned per pick: rings, blades' apexes, laminas' midrib ends (t = 0 on their
+        # node: placed rigidly with T₀ = its rotation).
+        z = np.zeros(len(bt) + 2 * len(leaves))
+        self.node = np.concatenate([j, bt, tipn, tipn])
+        self.prev = np.concatenate([prev[src], bt, tipn, tipn])
+        self.weight = np.concatenate([weight[src], z])
+        self.t = np.concatenate([t, z])
+        self.free_end = np.concatenate([free_end, z > 0])
+        self.offset = np.concatenate([offset, 0.5 * (P[bt] - P[bt - 1]), lam_start, lam_end])
+
+        # Capsules: from point ia to ib, radius r0 there and r1 at ib.
+        self.cap_a = np.concatenate([first_cap, blade_end, lam_a])
+        self.cap_b = np.concatenate([first_cap + 1, apex, lam_b])
+        self.cap_object = np.concatenate([ring_obj[first_cap], ring_obj[blade_end], leaves]).astype(np.int64)
+        self.cap_r0 = np.concatenate([radius[first_cap], radius[blade_end], lam_radius])
+        self.cap_r1 = np.concatenate([radius[first_cap + 1], np.zeros(len(bt)), lam_radius])
+        cap_kind = kind[self.cap_object]
+        self.cap_bark = cap_kind == "branch"
+        self.cap_thin_drawn = self.cap_bark | (cap_kind == "blade")  # drawn wider when thin
+
+    def axis_points(self, positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+        """The skinned points the capsules join, for a pose.
+
+        Parameters
+        ----------
+        positions : (N, 3), rotations : (N, 3, 3)
+            The pose (as ``Simulation.positions`` / ``rotations``).
+
+        Returns
+        -------
+        (Q, 3) float
+            The capsules run from row :attr:`cap_a` to row :attr:`cap_b` of it.
+        """
+        return skin_points(positions, rotations, self.node, self.prev, self.weight, self.t, self.free_end,
+                           self.offset)[0]
 
     def pick(self, positions: np.ndarray, rotations: np.ndarray, origin, direction, *,
              present: np.ndarray | None = None, pixel_angle: float = 0.0,
-             min_pixels: float = 4.0) -> PickHit | None:
-        """The object nearest the eye whose capsule the ray meets, or None.
+             min_pixels: float = 4.0, thin_pixels: float = 0.0) -> PickHit | None:
+        """The object the ray picks (module notes), or None.
 
         Parameters
         ----------
@@ -77,17 +160,23 @@ class Picker:
         pixel_angle : float
             Size of a pixel at 1 m from the eye (``OrbitCamera.pixel_angle(height)``); with
             ``min_pixels`` it sets the smallest pick radius at each distance.
+        min_pixels : float
+            Smallest pick radius, pixels.
+        thin_pixels : float
+            The renderer's ``Scene.thin_pixels`` in the same pixels: twigs and blades of a
+            smaller half width on screen are drawn a pixel wider each side, and such twigs
+            behind every solid surface (0: none is).
+
+        Returns
+        -------
+        PickHit or None
         """
         o = np.asarray(origin, float)
         d = np.asarray(direction, float)
         d = d / np.linalg.norm(d)
-        P = np.asarray(positions, float)
-        a = np.concatenate([P[self.seg_a], P[self.lam_node] + np.einsum(
-            "kij,kj->ki", rotations[self.lam_node], self.lam_start)])
-        e = np.concatenate([P[self.seg_b] - P[self.seg_a], np.einsum(
-            "kij,kj->ki", rotations[self.lam_node], self.lam_vec)])
-        obj = np.concatenate([self.seg_object, self.lam_object])
-        radius = np.concatenate([self.seg_radius, self.lam_radius])
+        pts = self.axis_points(positions, rotations)
+        a = pts[self.cap_a]
+        e = pts[self.cap_b] - a
 
         # Closest points between the segments a + s e (s in [0, 1]) and the ray o + t d (t >= 0).
         r = a - o
@@ -104,16 +193,34 @@ class Picker:
         on_seg = a + s[:, None] * e
         dist = np.linalg.norm(on_seg - (o + t[:, None] * d), axis=1)
 
-        reach = np.maximum(radius, min_pixels * pixel_angle * t)
-        hit = (dist <= reach) & (t > 0)
+        radius = self.cap_r0 + s * (self.cap_r1 - self.cap_r0)
+        px = pixel_angle * t  # a pixel's size there, metres
+        thin = self.cap_thin_drawn & (radius < thin_pixels * px)
+        drawn = np.where(thin, radius + px, radius)
+        hit = (dist <= np.maximum(drawn, min_pixels * px)) & (t > 0)
         if present is not None:
-            hit &= np.asarray(present, bool)[obj]
+            hit &= np.asarray(present, bool)[self.cap_object]
         if not hit.any():
             return None
-        k = np.flatnonzero(hit)[np.argmin(t[hit])]
-        return PickHit(int(obj[k]), on_seg[k], float(t[k]))
+        solid = hit & (dist <= drawn) & ~(thin & self.cap_bark)
+        pool = solid if solid.any() else hit
+        k = np.flatnonzero(pool)[np.argmin(t[pool])]
+        return PickHit(int(self.cap_object[k]), on_seg[k], float(t[k]))
 
 
 def pick(tree: Tree, positions, rotations, origin, direction, **kw) -> PickHit | None:
-    """One-off :meth:`Picker.pick` (builds the segment tables each call)."""
+    """One-off :meth:`Picker.pick` (builds the tables each call).
+
+    Parameters
+    ----------
+    tree : Tree
+    positions, rotations, origin, direction
+        As :meth:`Picker.pick`.
+    **kw
+        Keywords of :meth:`Picker.pick`.
+
+    Returns
+    -------
+    PickHit or None
+    """
     return Picker(tree).pick(positions, rotations, origin, direction, **kw)
