@@ -63,10 +63,10 @@ def trace_tips(sim: Simulation, objects, duration: float, dt: float) -> tuple[np
     n = int(round(steps))
     out = np.empty((n + 1, len(objs), 3))
     times = np.empty(n + 1)
-    out[0] = sim._tip_positions(objs)
+    out[0] = sim.tip_positions(objs)
     times[0] = sim.time
     for k in range(n):
         sim.step(dt)
-        out[k + 1] = sim._tip_positions(objs)
+        out[k + 1] = sim.tip_positions(objs)
         times[k + 1] = sim.time
     return times, out
