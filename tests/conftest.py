@@ -19,7 +19,6 @@ SLOW = (
     "test_simulation.py::test_release_in_the_u_w_plane_shows_both_frequencies",
     "test_simulation.py::test_euler_agrees_with_exact_at_small_dt",
     "test_simulation.py::test_modal_loads_settle_at_the_load_unit_static_gain",
-    "test_simulation.py::test_load_path_free_decay_in_calm_air_keeps_the_set_f_and_zeta",
     "test_export.py",
     "test_examples.py",
     "test_readme.py::test_the_quick_readme_commands_run_as_typed",

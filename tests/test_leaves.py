@@ -160,5 +160,5 @@ def test_leaves_back_on_the_tree_leave_the_ground_and_the_paper_drops_them_unsee
     sim.step(1.0 / 30.0)
     rest = sim.tree.rest_positions[leaf_nodes(sim.tree, fell)]
     assert np.abs(sim.positions[leaf_nodes(sim.tree, fell)] - rest).max() < 0.5  # on their twigs again
-    paper = drop_leaves(5.0, 0.5, load_path=False)[0]
+    paper = drop_leaves(5.0, 0.5, model="paper")[0]
     assert np.array_equal(paper.shown, paper.present)

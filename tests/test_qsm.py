@@ -249,7 +249,7 @@ def beam_theory(length, diameter, wood):
                                                            (3.0, 0.05, 4, "softwood")])
 def test_a_uniform_cylinder_has_the_first_cantilever_frequency(length, diameter, segments, wood):
     w = WOOD_TYPES[wood]
-    sim = ta.Simulation(cylinder(length, diameter, segments, w), modes="physical")
+    sim = ta.Simulation(cylinder(length, diameter, segments, w), modes="physical", model="paper")
     assert sim.modal == "physical"
     np.testing.assert_allclose(sim.modes.f[0], beam_theory(length, diameter, w), rtol=0.02)
     assert sim.modes.zeta[0, 0] == pytest.approx(w["wood_damping"], abs=0.01)  # its wood, and a little air
@@ -259,7 +259,7 @@ def test_a_released_cylinder_sways_at_the_beam_frequency():
     w = WOOD_TYPES["hardwood"]
     tree = cylinder(wood=w)
     f_beam = beam_theory(10.0, 0.3, w)
-    sim = ta.Simulation(tree, modes="physical")
+    sim = ta.Simulation(tree, modes="physical", model="paper")
     sim.pull(0, (2000.0, 0.0, 0.0))
     sim.step(30.0)  # a held pull settles
     sim.release()
@@ -274,21 +274,21 @@ def test_a_released_cylinder_sways_at_the_beam_frequency():
 
 def test_paper_modes_stay_the_default_for_presets_and_physical_is_selectable():
     tree = ta.load_preset("small_cherry")
-    paper = ta.Simulation(tree)
+    paper = ta.Simulation(tree, model="paper")
     assert paper.modal == "paper"
     rng = tree.physics.modes("branch", 0.0)
     assert rng.f[0] - 1e-9 <= paper.modes.f[tree.kind == "branch", 0].min()
-    phys = ta.Simulation(tree, modes="physical")
+    phys = ta.Simulation(tree, modes="physical", model="paper")
     assert not np.allclose(phys.modes.f, paper.modes.f)
     paper.modal = "physical"
     np.testing.assert_allclose(paper.modes.f, phys.modes.f)
     with pytest.raises(ValueError, match="modes must be one of"):
-        ta.Simulation(tree, modes="guess")
+        ta.Simulation(tree, modes="guess", model="paper")
 
 
 def trunk_modes(height, dbh, leaves=None, season=0.0):
     tree = build_tree(synthetic_table(height=height, dbh=dbh), leaves=leaves)
-    sim = ta.Simulation(tree, season=season)  # an imported tree: physical modes by default
+    sim = ta.Simulation(tree, season=season, model="paper")  # an imported tree: physical modes by default
     return sim.modes.f[0, 0], sim.modes.zeta[0, 0]
 
 
@@ -310,7 +310,7 @@ def test_leaves_lower_the_frequency_and_raise_the_damping():
     assert f_on < f_winter and z_on > z_winter
     # and so for a preset's twigs (their stubs ring too fast to show: critically damped)
     tree = ta.load_preset("small_cherry")
-    summer, winter = (ta.Simulation(tree, season=s, modes="physical") for s in (0.0, 1.0))
+    summer, winter = (ta.Simulation(tree, season=s, modes="physical", model="paper") for s in (0.0, 1.0))
     twigs = (tree.kind == "branch") & np.isin(np.arange(tree.n_objects), tree.parent[tree.kind == "leaf"])
     assert np.all(summer.modes.f[twigs, 0] < winter.modes.f[twigs, 0])
     assert np.all(summer.modes.zeta[twigs, 0] == 1.0)
@@ -319,7 +319,7 @@ def test_leaves_lower_the_frequency_and_raise_the_damping():
 @pytest.mark.parametrize("name", ["small_cherry", "large_cherry", "tulip_poplar"])
 def test_presets_with_physical_modes_stay_calm_in_a_gale(name):
     tree = ta.load_preset(name)
-    sim = ta.Simulation(tree, wind=ta.WindField(speed=25.0, seed=1), modes="physical")
+    sim = ta.Simulation(tree, wind=ta.WindField(speed=25.0, seed=1), modes="physical", model="paper")
     for _ in range(120):
         sim.step(1 / 60)
     height = np.ptp(tree.rest_positions[:, 1])
@@ -331,7 +331,7 @@ def test_presets_with_physical_modes_stay_calm_in_a_gale(name):
 def test_physical_parameters_are_checked():
     tree = cylinder()
     bad = dataclasses.replace(tree.physics, wood_youngs_modulus=0.0)
-    sim = ta.Simulation(tree, modes="physical")
+    sim = ta.Simulation(tree, modes="physical", model="paper")
     with pytest.raises(ValueError, match="wood_youngs_modulus must be > 0"):
         sim.physics = bad
 

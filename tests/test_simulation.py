@@ -12,6 +12,7 @@ from treeanim.model.build import ObjectSpec, assemble
 from treeanim.model.geometry import lamina_frames, polygon_centroid
 from treeanim.model.params import PhysicsParams
 from treeanim.physics.bending import rest_frames
+from treeanim.physics.paper_sim import PaperSim
 from treeanim.physics.simulation import MAX_PULL, Simulation
 from treeanim.physics.trace import trace_tips
 
@@ -37,8 +38,8 @@ def fit_damped(t, x):
 def release_trace(tree, f, zeta, direction, dt, seconds, integrator="exact", deflection=0.01, **kw):
     """Hold the tip of object 0 deflected by ``deflection`` × its length along ``direction``
     (world), release it, and return (times, tip displacement from rest). The paper's model
-    unless ``kw`` says otherwise (the load path's held objects settle over a long step)."""
-    kw.setdefault("load_path", False)
+    unless ``kw`` says otherwise."""
+    kw.setdefault("model", "paper")
     sim = Simulation(tree, integrator=integrator, **kw)
     sim.modes.f[0] = f
     sim.modes.zeta[0] = zeta
@@ -47,7 +48,7 @@ def release_trace(tree, f, zeta, direction, dt, seconds, integrator="exact", def
     force = 1.0
     for _ in range(20):  # a held object sits at its static deflection: scale the force to it
         sim.pull(0, force * np.asarray(direction))
-        sim.step(dt if not kw["load_path"] else 30.0)
+        sim.step(dt)
         d = np.linalg.norm(sim.tip_position(0) - tip_rest)
         if abs(d / (deflection * length) - 1) < 1e-4:
             break
@@ -117,7 +118,7 @@ def test_static_deflection_points_along_the_pull(angle):
         F = rest_frames(tree)[obj]
         a = np.radians(angle)
         direction = np.cos(a) * F[:, 0] + np.sin(a) * F[:, 2]
-        sim = Simulation(tree, coupling=False, load_path=False)  # the paper's held pull
+        sim = Simulation(tree, coupling=False, model="paper")  # the paper's held pull
         tip = tree.object_start[obj] + tree.object_count[obj] - 1
         length = np.sum(np.linalg.norm(np.diff(tree.rest_positions[tree.object_nodes(obj)], axis=0), axis=1))
         sim.pull(obj, direction)
@@ -138,12 +139,8 @@ def test_static_deflection_points_along_the_pull(angle):
 
 def test_modal_loads_settle_at_the_load_unit_static_gain():
     tree = straight_beam()
-    sim = Simulation(tree, load_path=False)
     force = np.array([0.3, 0.0, -0.2])
-    sim.pull(0, force)
-    sim.release()
-    sim.step(1 / 60)  # nothing held now
-    sim2 = Simulation(tree, wind=None, load_path=False)
+    sim2 = PaperSim(tree, wind=None)
     sim2.modes.zeta[:] = 0.4
     sim2._pulls[0] = force  # a constant force, not held (the oscillators respond freely)
     for _ in range(3000):
@@ -156,7 +153,7 @@ def test_trunk_release_shakes_leaves_only_with_coupling(tree):
     weak = dataclasses.replace(tree, physics=dataclasses.replace(tree.physics, ei_max=2000.0))
     motion = {}
     for coupling in (True, False):
-        sim = Simulation(weak, coupling=coupling, load_path=False)  # the paper's objects, Eq. 12
+        sim = Simulation(weak, coupling=coupling, model="paper")  # the paper's objects, Eq. 12
         sim.pull(0, (60.0, 0.0, 30.0))
         for _ in range(30):
             sim.step(1 / 60)
@@ -178,9 +175,9 @@ def test_trunk_release_shakes_leaves_only_with_coupling(tree):
 
 
 # ---------------------------------------------------------------------------- robustness
-@pytest.mark.parametrize("integrator", ["exact", "euler"])
-def test_one_step_of_several_seconds_stays_finite(integrator, tree):
-    sim = Simulation(tree, wind=Uniform((60.0, 0.0, 10.0)), integrator=integrator)
+@pytest.mark.parametrize("model, integrator", [("tree", "exact"), ("paper", "exact"), ("paper", "euler")])
+def test_one_step_of_several_seconds_stays_finite(model, integrator, tree):
+    sim = Simulation(tree, wind=Uniform((60.0, 0.0, 10.0)), model=model, integrator=integrator)
     sim.pull(3, (0.0, -50.0, 20.0))
     X = tree.rest_positions
     within = tree.node_object[1:] == tree.node_object[:-1]
@@ -195,23 +192,22 @@ def test_one_step_of_several_seconds_stays_finite(integrator, tree):
     assert np.all(np.isfinite(sim.positions))
 
 
-def test_determinism_per_seed(tree):
+@pytest.mark.parametrize("model", ["tree", "paper"])
+def test_determinism_per_seed(tree, model):
     def run(seed, wind_seed=1):
-        sim = Simulation(tree, wind=ta.WindField(speed=8.0, seed=wind_seed), seed=seed)
+        sim = Simulation(tree, wind=ta.WindField(speed=8.0, seed=wind_seed), seed=seed, model=model)
         for _ in range(20):
             sim.step(1 / 60)
-        return sim.positions.copy(), sim.modes.f.copy()
+        return sim.positions.copy()
 
-    p1, f1 = run(3)
-    p2, f2 = run(3)
-    np.testing.assert_array_equal(p1, p2)
-    np.testing.assert_array_equal(f1, f2)
-    p3, f3 = run(4)
-    assert not np.array_equal(f1, f3) and not np.array_equal(p1, p3)
+    p1 = run(3)
+    np.testing.assert_array_equal(p1, run(3))
+    assert not np.array_equal(p1, run(4))  # the paper's modal draws; the tree's leaves' flutter
 
 
-def test_reset_returns_to_rest(tree):
-    sim = Simulation(tree, wind=Uniform((10.0, 0.0, 0.0)))
+@pytest.mark.parametrize("model", ["tree", "paper"])
+def test_reset_returns_to_rest(tree, model):
+    sim = Simulation(tree, wind=Uniform((10.0, 0.0, 0.0)), model=model)
     sim.pull(2, (1.0, 0.0, 0.0))
     for _ in range(5):
         sim.step(1 / 60)
@@ -238,7 +234,7 @@ def test_wind_bends_the_tree_downwind_and_harder_in_a_gale():
     top = np.argsort(X[:, 1])[-30:]
     disp = {}
     for speed in (5.0, 25.0):
-        sim = Simulation(tree, wind=Uniform((0.0, 0.0, speed)), coupling=False, load_path=False)  # linear drag
+        sim = Simulation(tree, wind=Uniform((0.0, 0.0, speed)), coupling=False, model="paper")  # linear drag
         for _ in range(4):
             sim.step(5.0)  # long steps: the static response
         d = sim.positions[top] - X[top]
@@ -250,24 +246,32 @@ def test_wind_bends_the_tree_downwind_and_harder_in_a_gale():
 
 # ---------------------------------------------------------------------------- bad input
 def snapshot(sim):
-    return (sim.time, sim.positions.copy(), sim.modal_loads, sim._pd.copy(), sim.season, sim.integrator,
-            dict(sim.pulls), sim.modes.f.copy())
+    return (sim.time, sim.positions.copy(), sim.rotations.copy(), sim.season, sim.model, dict(sim.pulls))
 
 
 def assert_same(a, b):
-    assert a[0] == b[0] and a[4] == b[4] and a[5] == b[5]
-    for x, y in zip(a[1:4], b[1:4]):
+    assert a[0] == b[0] and a[3] == b[3] and a[4] == b[4]
+    for x, y in zip(a[1:3], b[1:3]):
         np.testing.assert_array_equal(x, y)
-    assert a[6].keys() == b[6].keys()
+    assert a[5].keys() == b[5].keys()
 
 
-@pytest.fixture
-def busy(tree):
-    sim = Simulation(tree, wind=Uniform((4.0, 0.0, 1.0)))
+def _busy(tree, model):
+    sim = Simulation(tree, wind=Uniform((4.0, 0.0, 1.0)), model=model)
     sim.pull(1, (0.0, 0.0, 3.0))
     for _ in range(4):
         sim.step(1 / 60)
     return sim
+
+
+@pytest.fixture(params=["tree", "paper"])
+def busy(tree, request):
+    return _busy(tree, request.param)
+
+
+@pytest.fixture
+def busy_paper(tree):
+    return _busy(tree, "paper")
 
 
 @pytest.mark.parametrize("dt", [0.0, -0.01, float("nan"), float("inf"), -float("inf"), "fast", None, 1e154, 2e6])
@@ -281,7 +285,8 @@ def test_bad_dt(busy, dt):
 @pytest.mark.parametrize("name, value", [("f", 0.0), ("f", -1.0), ("f", float("nan")), ("f", float("inf")),
                                          ("f", 1e155), ("zeta", -0.01), ("zeta", float("nan")),
                                          ("zeta", float("inf")), ("zeta", 1e4)])
-def test_bad_modes(busy, name, value):
+def test_bad_modes(busy_paper, name, value):
+    busy = busy_paper
     before = snapshot(busy)
     arr = getattr(busy.modes, name)
     old = arr[2, 1]
@@ -295,30 +300,32 @@ def test_bad_modes(busy, name, value):
     assert busy.time > before[0]
 
 
-@pytest.mark.parametrize("load_path", [True, False])
-def test_the_state_stays_finite_at_the_bounds_of_dt_f_and_zeta(tree, load_path):
-    """The longest step, the tiniest one before a normal one, the highest frequency and the
-    strongest damping accepted (Euler included) all leave a finite tree."""
+@pytest.mark.parametrize("model, integrator", [("tree", "exact"), ("paper", "exact"), ("paper", "euler")])
+def test_the_state_stays_finite_at_the_bounds_of_dt_f_and_zeta(tree, model, integrator):
+    """The longest step, the tiniest one before a normal one, and for the paper's oscillators
+    the highest frequency and the strongest damping accepted (Euler included) all leave a
+    finite tree."""
     from treeanim.physics.simulation import MAX_FREQUENCY, MAX_STEP, MAX_ZETA
 
-    for integrator in ("exact", "euler"):
-        sim = Simulation(tree, wind=Uniform((12.0, 0.0, 3.0)), load_path=load_path, integrator=integrator)
-        for dt in (1 / 60, MAX_STEP, 1e-320, 1 / 60):
-            sim.step(dt)
-        assert np.isfinite(sim.positions).all(), integrator
-        sim.modes.f[:] = MAX_FREQUENCY
-        sim.modes.zeta[:] = MAX_ZETA
-        for _ in range(10):
-            sim.step(1 / 60)
-        assert np.isfinite(sim.positions).all() and np.isfinite(sim.rotations).all(), integrator
-        sim.modes.f[:], sim.modes.zeta[:] = 1.0, 25.0  # Euler once diverged above ζ ≈ 25
-        for _ in range(60):
-            sim.step(1 / 60)
-        assert np.isfinite(sim.positions).all(), integrator
+    sim = Simulation(tree, wind=Uniform((12.0, 0.0, 3.0)), model=model, integrator=integrator)
+    for dt in (1 / 60, MAX_STEP, 1e-320, 1 / 60):
+        sim.step(dt)
+    assert np.isfinite(sim.positions).all(), integrator
+    if model == "tree":
+        return
+    sim.modes.f[:] = MAX_FREQUENCY
+    sim.modes.zeta[:] = MAX_ZETA
+    for _ in range(10):
+        sim.step(1 / 60)
+    assert np.isfinite(sim.positions).all() and np.isfinite(sim.rotations).all(), integrator
+    sim.modes.f[:], sim.modes.zeta[:] = 1.0, 25.0  # Euler once diverged above ζ ≈ 25
+    for _ in range(60):
+        sim.step(1 / 60)
+    assert np.isfinite(sim.positions).all(), integrator
 
 
-@pytest.mark.parametrize("load_path", [True, False])
-def test_lengths_hold_where_forces_and_stiffness_underflow(load_path):
+@pytest.mark.parametrize("model", ["tree", "paper"])
+def test_lengths_hold_where_forces_and_stiffness_underflow(model):
     """31 levels each 1e-5 as thick as the last (stiffness and loads down to 1e-600 and beyond,
     far below the smallest double) and an EI_max of 1e-300: every segment keeps its length."""
     specs, base, d, parent = [], np.zeros(3), 0.1, -1
@@ -332,7 +339,7 @@ def test_lengths_hold_where_forces_and_stiffness_underflow(load_path):
     seg = np.concatenate([np.arange(a, a + c - 1) for a, c in zip(start, count)])
     rest = np.linalg.norm(np.diff(tree.rest_positions, axis=0)[seg], axis=1)
     for ei_max in (None, 1e-300):
-        sim = Simulation(tree, wind=Uniform((15.0, 0.0, 4.0)), load_path=load_path)
+        sim = Simulation(tree, wind=Uniform((15.0, 0.0, 4.0)), model=model)
         if ei_max is not None:
             sim.physics = dataclasses.replace(sim.physics, ei_max=ei_max)
         for _ in range(30):
@@ -358,7 +365,7 @@ def test_the_paper_models_compliance_predicts_a_small_pull():
 
     pts = np.outer(np.linspace(0.0, 1.5, 4), (0.0, 1.0, 0.0))
     tree = assemble([ObjectSpec(pts, np.array([0.08, 0.05, 0.03, 0.01]), "branch", 1)], name="tapered")
-    sim = Simulation(tree, load_path=False)
+    sim = Simulation(tree, model="paper")
     force = 1e-5 * sim.physics.ei_max / 1.5**2  # small: the tip moves about a millimetre
     sim.pull(0, (0.0, 0.0, force))
     sim.step(1 / 60)  # held: the static deflection at once
@@ -366,10 +373,23 @@ def test_the_paper_models_compliance_predicts_a_small_pull():
     assert moved == pytest.approx(force * sim.compliance(0, 2, 1.0), rel=0.02)
 
 
-def test_bad_modes_shape(busy):
-    busy.modes.f = np.ones((3, 3))
+def test_bad_modes_shape(busy_paper):
+    busy_paper.modes.f = np.ones((3, 3))
     with pytest.raises(ValueError, match="modes.f"):
-        busy.step(1 / 60)
+        busy_paper.step(1 / 60)
+
+
+def test_the_paper_models_own_settings_are_refused_on_the_tree_model(busy_paper, tree):
+    sim = Simulation(tree)
+    for name in ("modes", "integrator", "coupling", "compliance"):
+        with pytest.raises(AttributeError, match="paper"):
+            getattr(sim, name)
+    with pytest.raises(AttributeError, match="paper"):
+        sim.integrator = "euler"
+    with pytest.raises(AttributeError, match="tree"):
+        busy_paper.energy
+    with pytest.raises(ValueError, match="model"):
+        Simulation(tree, model="fem")
 
 
 @pytest.mark.parametrize("obj", [-1, 10**6, 1.5, "3", True, None])
@@ -400,13 +420,14 @@ def test_bad_season(busy, tree, season):
         Simulation(tree, season=season)
 
 
-def test_bad_integrator(busy, tree):
+def test_bad_integrator(busy_paper, tree):
+    busy = busy_paper
     before = snapshot(busy)
     with pytest.raises(ValueError, match="integrator"):
         busy.integrator = "rk4"
     assert_same(before, snapshot(busy))
     with pytest.raises(ValueError, match="integrator"):
-        Simulation(tree, integrator="verlet")
+        Simulation(tree, integrator="verlet", model="paper")
 
 
 def test_bad_constructor_arguments(tree):
@@ -468,9 +489,9 @@ def test_pull_above_the_largest_force_is_refused(busy, force):
     assert_same(before, snapshot(busy))
 
 
-@pytest.mark.parametrize("integrator", ["exact", "euler"])
-def test_largest_legal_pulls_give_finite_positions(tree, integrator):
-    sim = Simulation(tree, wind=Uniform((30.0, 0.0, 10.0)), integrator=integrator)
+@pytest.mark.parametrize("model, integrator", [("tree", "exact"), ("paper", "exact"), ("paper", "euler")])
+def test_largest_legal_pulls_give_finite_positions(tree, model, integrator):
+    sim = Simulation(tree, wind=Uniform((30.0, 0.0, 10.0)), model=model, integrator=integrator)
     d = np.array([1.0, -2.0, 2.0]) / 3.0
     for i in (0, 1, 5, tree.n_objects - 1):
         sim.pull(i, MAX_PULL * d)
@@ -508,12 +529,12 @@ def test_trace_tips_accepts_numpy_indices(tree):
 
 
 def test_modal_seeds_use_every_bit(tree):
-    a = Simulation(tree, seed=0).modes
-    b = Simulation(tree, seed=2**32).modes
-    c = Simulation(tree, seed=2**64 + 7).modes
+    a = Simulation(tree, seed=0, model="paper").modes
+    b = Simulation(tree, seed=2**32, model="paper").modes
+    c = Simulation(tree, seed=2**64 + 7, model="paper").modes
     assert not np.array_equal(a.f, b.f)
     assert not np.array_equal(b.f, c.f)
-    np.testing.assert_array_equal(Simulation(tree, seed=2**32).modes.f, b.f)
+    np.testing.assert_array_equal(Simulation(tree, seed=2**32, model="paper").modes.f, b.f)
 
 
 def test_leaf_lever_arm_uses_the_lamina_frame_of_the_mesh(tree):
@@ -526,7 +547,7 @@ def test_leaf_lever_arm_uses_the_lamina_frame_of_the_mesh(tree):
 
     mesh_frame = lambda t, leaves: lamina_frames(t, leaves)[:3]  # noqa: E731
     leaves, r = lever(tree, mesh_frame)
-    np.testing.assert_allclose(Simulation(tree)._lever[leaves], r, rtol=1e-12)
+    np.testing.assert_allclose(PaperSim(tree)._lever[leaves], r, rtol=1e-12)
 
     # A petiole bent through a right angle: the lamina lies along its last segment (as the
     # mesh and picking draw it), not along the first.
@@ -540,18 +561,6 @@ def test_leaf_lever_arm_uses_the_lamina_frame_of_the_mesh(tree):
                                      rest_frames(t)[leaves, :, 0], rest_frames(t)[leaves, :, 1])
     leaves, r = lever(bent, mesh_frame)
     _, r_first = lever(bent, first_frame)
-    lev = Simulation(bent)._lever[leaves]
+    lev = PaperSim(bent)._lever[leaves]
     np.testing.assert_allclose(lev, r, rtol=1e-12)
     assert abs(lev[0] - r_first[0]) > 0.01
-
-
-def test_load_path_free_decay_in_calm_air_keeps_the_set_f_and_zeta():
-    """The load path's oscillators filter the whole load: released in still air, a beam swings
-    at its own f and ζ (air damping at a 1 % swing is small)."""
-    tree = straight_beam()
-    w = rest_frames(tree)[0][:, 2]
-    f, zeta = (0.75, 0.9, 1.25), (0.045, 0.05, 0.08)
-    t, d, _ = release_trace(tree, f, zeta, w, 1 / 60, 30.0, load_path=True)
-    fm, zm = fit_damped(t, d @ w)
-    assert fm == pytest.approx(0.75, rel=5e-3)
-    assert zm == pytest.approx(0.045, rel=0.15)

@@ -15,13 +15,14 @@ stepper lives in :mod:`treeanim.physics.structure` (the model) and
 * Joint springs and dampers (K, D) and a grab's spring are integrated by the θ-method, with
   Δ the change of the joint velocities over the step:
 
-      (M + hθ·D + h²θ²·K + Jᵀ(h·C + h²θ²·K_grab)J) Δ = h·(τ − K q − (D + θhK) q̇),
-      q⁺ = q + h(q̇ + θΔ),
+      (M + hΘD + h²Θ²K + Jᵀ(h·C + h²θ²·K_grab)J) Δ = h·(τ − K q − (D + hΘK) q̇),
+      q⁺ = q + h(q̇ + ΘΔ),
 
   solved by Featherstone's articulated-body algorithm: the joint terms join each joint's 3×3
   D block, the body terms its spatial inertia (as point "masses" κ at the points they act on).
-  Each joint has its own θ (:func:`theta_of`): ½, the trapezoidal rule, for a swing the step
-  resolves, toward 1 for one it cannot, so stiff stub twigs never ring. The air's damping C is
+  Each joint has its own Θ = θ_b(1 − aaᵀ) + θ_t·aaᵀ (:func:`theta_of`, one θ for its bends and
+  one for its twist about its axis a): ½, the trapezoidal rule, for a swing the step resolves,
+  toward 1 for one it cannot, so stiff stub twigs and thin twisting segments never ring. The air's damping C is
   taken by backward Euler (θ = 1): drag only ever slows a part.
 * The velocity-product (Coriolis, centrifugal, gyroscopic) forces are left out: quadratic in
   the angular velocities, they vanish in a tree's small swings, and taken explicitly they drove
@@ -36,6 +37,11 @@ import numpy as np
 from numba import njit
 
 __all__ = ["theta_of", "forward_kinematics", "articulated_step", "leaf_step", "pose_nodes", "rot_log", "rot_exp", "add_point"]
+
+#: The most a joint turns against its parent (rad): beyond it a segment stops, its outward
+#: speed taken away (a soft grass blade can fold; no joint wraps past π).
+JOINT_STOP = 0.6 * np.pi
+
 
 @njit(cache=True, fastmath=True, error_model="numpy")
 def theta_of(x):
@@ -184,7 +190,7 @@ def _inv3(A, out):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def articulated_step(h, theta, parent, r0, m0, h0, J0, K, D, R, P, Om, V, Q, w,
+def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, K, D, R, P, Q, w,
                      F, kap, IA, pA, Dinv, Ucol, u, acc):
     """One implicit step of every body (the articulated-body algorithm, three passes).
 
@@ -192,16 +198,19 @@ def articulated_step(h, theta, parent, r0, m0, h0, J0, K, D, R, P, Om, V, Q, w,
     ----------
     h : float
         Step length (s).
-    theta : (B,) float
-        Each joint's θ (:func:`theta_of`).
+    theta, theta_t : (B,) float
+        Each joint's θ (:func:`theta_of`) for its bends and its twist (the twist of a thin
+        segment is far stiffer for its inertia than its bend).
+    axis : (B, 3)
+        Each segment's rest axis (its twist axis, in the parent's rest axes).
     parent, r0 : see :func:`forward_kinematics`.
     m0, h0, J0 : (B,), (B, 3), (B, 3, 3)
         Each body's mass, first and second moments about its joint in rest axes (what it carries
         rigidly — its leaves — included).
     K, D : (B, 3, 3)
         Joint stiffness (N·m/rad) and damping (N·m·s/rad) in the parent's rest axes.
-    R, P, Om, V, Q, w : the state (see :func:`forward_kinematics`); Q and w are advanced in
-        place, R, P, Om and V are left for :func:`forward_kinematics` to redo.
+    R, P, Q, w : the state (see :func:`forward_kinematics`); Q and w are advanced in place, R
+        and P are left for :func:`forward_kinematics` to redo.
     F : (B, 6)
         External spatial force on each body (moment about its joint, force), world.
     kap : (B, 6, 6)
@@ -220,6 +229,8 @@ def articulated_step(h, theta, parent, r0, m0, h0, J0, K, D, R, P, Om, V, Q, w,
     tmp = np.empty((3, 3))
     th = np.empty(3)
     Dj = np.empty((3, 3))
+    Th = np.empty((3, 3))
+    ThK = np.empty((3, 3))
     Ia = np.empty((6, 6))
     UD = np.empty((6, 3))
     pa = np.empty(6)
@@ -292,20 +303,33 @@ def articulated_step(h, theta, parent, r0, m0, h0, J0, K, D, R, P, Om, V, Q, w,
                     t += Jw[i, k] * Rm[j, k]
                 Kw[i, j] = s
                 Dw[i, j] = t
-        hth = h * theta[b]
-        # joint torque −K θ − (D + θhK) ω_rel, in world (θ = Rm·log Q)
+        # Θ = θ_b·1 + (θ_t − θ_b)·a aᵀ in world (a = Rm·axis), which commutes with K and D
+        ax = Rm[0, 0] * axis[b, 0] + Rm[0, 1] * axis[b, 1] + Rm[0, 2] * axis[b, 2]
+        ay = Rm[1, 0] * axis[b, 0] + Rm[1, 1] * axis[b, 1] + Rm[1, 2] * axis[b, 2]
+        az = Rm[2, 0] * axis[b, 0] + Rm[2, 1] * axis[b, 1] + Rm[2, 2] * axis[b, 2]
+        aw = (ax, ay, az)
+        tb, dt_ = theta[b], theta_t[b] - theta[b]
+        for i in range(3):
+            for j in range(3):
+                Th[i, j] = dt_ * aw[i] * aw[j]
+            Th[i, i] += tb
+        for i in range(3):
+            for j in range(3):
+                ThK[i, j] = Th[i, 0] * Kw[0, j] + Th[i, 1] * Kw[1, j] + Th[i, 2] * Kw[2, j]
+        # joint torque −K θ − (D + hΘK) ω_rel, in world (θ = Rm·log Q)
         tw0 = Rm[0, 0] * th[0] + Rm[0, 1] * th[1] + Rm[0, 2] * th[2]
         tw1 = Rm[1, 0] * th[0] + Rm[1, 1] * th[1] + Rm[1, 2] * th[2]
         tw2 = Rm[2, 0] * th[0] + Rm[2, 1] * th[1] + Rm[2, 2] * th[2]
         for i in range(3):
             tau = -(Kw[i, 0] * tw0 + Kw[i, 1] * tw1 + Kw[i, 2] * tw2)
-            tau -= (Dw[i, 0] + hth * Kw[i, 0]) * wr0 + (Dw[i, 1] + hth * Kw[i, 1]) * wr1 \
-                + (Dw[i, 2] + hth * Kw[i, 2]) * wr2
+            tau -= (Dw[i, 0] + h * ThK[i, 0]) * wr0 + (Dw[i, 1] + h * ThK[i, 1]) * wr1 \
+                + (Dw[i, 2] + h * ThK[i, 2]) * wr2
             u[b, i] = h * tau - pA[b, i]
-        # D = Sᵀ IA S + hθ D + h²θ² K
+        # D = Sᵀ IA S + hΘD + h²Θ²K
         for i in range(3):
             for j in range(3):
-                Dj[i, j] = IA[b, i, j] + hth * Dw[i, j] + hth * hth * Kw[i, j]
+                Dj[i, j] = IA[b, i, j] + h * (Th[i, 0] * Dw[0, j] + Th[i, 1] * Dw[1, j] + Th[i, 2] * Dw[2, j]) \
+                    + h * h * (Th[i, 0] * ThK[0, j] + Th[i, 1] * ThK[1, j] + Th[i, 2] * ThK[2, j])
         _inv3(Dj, Dinv[b])
         for i in range(6):
             for j in range(3):
@@ -358,9 +382,11 @@ def articulated_step(h, theta, parent, r0, m0, h0, J0, K, D, R, P, Om, V, Q, w,
             l2 = R[p, 0, 2] * d0 + R[p, 1, 2] * d1 + R[p, 2, 2] * d2
         else:
             l0, l1, l2 = d0, d1, d2
-        e0 = h * (w[b, 0] + theta[b] * l0)
-        e1 = h * (w[b, 1] + theta[b] * l1)
-        e2 = h * (w[b, 2] + theta[b] * l2)
+        # Θ in the parent's rest axes: θ_b + (θ_t − θ_b)·a aᵀ
+        al = (axis[b, 0] * l0 + axis[b, 1] * l1 + axis[b, 2] * l2) * (theta_t[b] - theta[b])
+        e0 = h * (w[b, 0] + theta[b] * l0 + al * axis[b, 0])
+        e1 = h * (w[b, 1] + theta[b] * l1 + al * axis[b, 1])
+        e2 = h * (w[b, 2] + theta[b] * l2 + al * axis[b, 2])
         w[b, 0] += l0
         w[b, 1] += l1
         w[b, 2] += l2
@@ -372,16 +398,30 @@ def articulated_step(h, theta, parent, r0, m0, h0, J0, K, D, R, P, Om, V, Q, w,
             for j in range(3):
                 Q[b, i, j] = tmp[i, j]
         _orthonormalize(Q[b])
+        # a joint's stop: no segment turns against its parent by more than JOINT_STOP (wood
+        # breaks first; past π the rotation vector would wrap and the spring flip)
+        rot_log(Q[b], th)
+        n = np.sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2])
+        if n > JOINT_STOP:
+            sc = JOINT_STOP / n
+            rot_exp(th[0] * sc, th[1] * sc, th[2] * sc, Q[b])
+            wn = (w[b, 0] * th[0] + w[b, 1] * th[1] + w[b, 2] * th[2]) / n
+            if wn > 0.0:
+                w[b, 0] -= wn * th[0] / n
+                w[b, 1] -= wn * th[1] / n
+                w[b, 2] -= wn * th[2] / n
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def add_point(kap, b, alpha, beta, nx, ny, nz, rx, ry, rz):
-    """kap[b] += Pᵀ C P for C = α·1 + β·n nᵀ acting at the point r (world, from b's joint)."""
+def add_point(kap, b, alpha, b1, e1x, e1y, e1z, b2, e2x, e2y, e2z, rx, ry, rz):
+    """kap[b] += Pᵀ C P for C = α·1 + β₁·e₁e₁ᵀ + β₂·e₂e₂ᵀ acting at the point r (world, from
+    b's joint)."""
     C = np.empty((3, 3))
-    n = (nx, ny, nz)
+    e1 = (e1x, e1y, e1z)
+    e2 = (e2x, e2y, e2z)
     for i in range(3):
         for j in range(3):
-            C[i, j] = beta * n[i] * n[j]
+            C[i, j] = b1 * e1[i] * e1[j] + b2 * e2[i] * e2[j]
         C[i, i] += alpha
     # M1 = C [r]×
     M1 = np.empty((3, 3))
@@ -454,8 +494,8 @@ def _leaf_rotation(E, th, G):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, R, P, Om, V, U,
-              flutter, th, thd, F, X, Nrm, kap):
+def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R, P, Om, V, U,
+              flutter, th, thd, F, X, Nrm, kap, Uh, kap2):
     """Advance every leaf's petiole joint (bend about two axes and twist) over one step, and
     give the force it passes to its twig for the next.
 
@@ -470,7 +510,8 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, R, P, Om, V, U,
     it (that would feed the leaf energy its twig never gives up): a leaf moves by the air
     relative to it, its twig's motion included — for a leaf, whose drag outweighs its
     inertia many times, the larger part. The air against the lamina's own swing damps it at
-    c·|U_rel|·r² (c = ½ρC_nA, r its lever), at least the rate of the normal force's own
+    c·|U_rel|·r² (c = ½ρC_nA of a flat plate, r its lever: the crown shelters a leaf from the
+    wind, not from the air it moves through), at least the rate of the normal force's own
     swing term, so in calm air the leaf and its twig together only ever lose energy.
 
     Parameters
@@ -480,7 +521,9 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, R, P, Om, V, U,
         lamina's centroid from the petiole's base, the lamina's rest normal.
     E : (L, 3, 3) — the leaf's axes (columns a, b₁, b₂) in rest axes.
     k, J, dstr : (L, 3) — stiffness, inertia and structural damping per axis.
-    cna : (L,) — ½ρC_nA of the lamina.
+    cna : (L,) — ½ρC_nA of the lamina in the wind (the crown's sheltered coefficient).
+    cswing : (L,) — ½ρC_nA of the lamina against its own swing (a plate's coefficient).
+    roll2 : (L,) — the lamina's mean squared distance from its axis (its width²/12).
     R, P, Om, V : the twigs' new kinematics.
     U : (L, 3) — the wind at each lamina (m/s).
     flutter : (L,) — the flutter's twist now (rad): its torque k_t·flutter drives the twist.
@@ -488,8 +531,9 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, R, P, Om, V, U,
     F : (L, 3) — written: the lamina's force (world, N) at X.
     X : (L, 3) — written: the lamina's centroid (world) relative to its twig's joint.
     Nrm : (L, 3) — written: the lamina's normal (world).
-    kap : (L,) — written: the air's implicit damping κ = h·½ρC_nA|U_rel| there, along the
-        normal (backward Euler).
+    kap, Uh, kap2 : (L,), (L, 3), (L,) — written: the air's implicit damping there, the
+        force's derivative against the velocity bounded by a symmetric one,
+        h·½ρC_n·A·(|U_rel| n nᵀ + |U_rel·n| ÛÛᵀ) (backward Euler).
     """
     G = np.empty((3, 3))
     RG = np.empty((3, 3))
@@ -524,6 +568,11 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, R, P, Om, V, U,
         F[l, 0], F[l, 1], F[l, 2] = fx, fy, fz
         Nrm[l, 0], Nrm[l, 1], Nrm[l, 2] = nx, ny, nz
         kap[l] = h * cna[l] * s
+        if s > 0.0:
+            Uh[l, 0], Uh[l, 1], Uh[l, 2] = ux / s, uy / s, uz / s
+        else:
+            Uh[l, 0] = Uh[l, 1] = Uh[l, 2] = 0.0
+        kap2[l] = h * cna[l] * abs(un)
         # torque about the petiole's base: the bends take its part about the rest axes b₁, b₂
         # (in the twig's axes, Rᵀτ), the twist its part about the lamina's axis now (Ga): nil
         # for a force at the centroid, which lies on that axis; the flutter drives it instead
@@ -532,13 +581,13 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, R, P, Om, V, U,
         tl1 = R[b, 0, 1] * t[0] + R[b, 1, 1] * t[1] + R[b, 2, 1] * t[2]
         tl2 = R[b, 0, 2] * t[0] + R[b, 1, 2] * t[1] + R[b, 2, 2] * t[2]
         lever2 = rc0[l, 0] ** 2 + rc0[l, 1] ** 2 + rc0[l, 2] ** 2
-        dair = cna[l] * s * lever2  # the air against the lamina's own swing
+        dair = cswing[l] * s * lever2  # the air against the lamina's own swing
         for i in range(3):
             kk = k[l, i]
             ka = 0.0
-            if i == 0:
+            if i == 0:  # the lamina rolling about its axis: its halves swing through the air
                 tau = kk * flutter[l]
-                d = dstr[l, i]
+                d = dstr[l, i] + cswing[l] * s * roll2[l]
             else:
                 tau = E[l, 0, i] * tl0 + E[l, 1, i] * tl1 + E[l, 2, i] * tl2
                 d = dstr[l, i] + dair

@@ -33,12 +33,15 @@ from numba import njit
 
 from ..model.geometry import lamina_frames, polygon_centroid, unit
 
-__all__ = ["Structure", "POISSON", "PETIOLE_BEND_TWIST"]
+__all__ = ["Structure", "POISSON", "PETIOLE_BEND_TWIST", "PLATE_NORMAL_DRAG"]
 
 #: Poisson's ratio of wood along the grain (G = E / 2(1 + ν)).
 POISSON = 0.3
 #: EI/GJ of a petiole (Vogel 1992: 1.5–6; grooved petioles twist readily).
 PETIOLE_BEND_TWIST = 4.0
+#: The normal-force coefficient of a flat plate across the flow (Hoerner): the air's resistance
+#: to a lamina's own swing about its petiole.
+PLATE_NORMAL_DRAG = 1.2
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -113,7 +116,9 @@ class Structure:
     leaf_k: np.ndarray      # (L, 3)
     leaf_J: np.ndarray      # (L, 3)
     leaf_d: np.ndarray      # (L, 3)
-    leaf_cna: np.ndarray    # (L,) ½ρC_nA
+    leaf_cna: np.ndarray    # (L,) ½ρC_nA in the wind
+    leaf_cswing: np.ndarray  # (L,) ½ρC_nA against the lamina's own swing
+    leaf_roll2: np.ndarray  # (L,) width²/12 of the lamina (its roll's lever²)
     leaf_mass: np.ndarray   # (L,)
     leaf_size: np.ndarray   # (L,) lamina length
     leaf_nodes: np.ndarray  # concatenated node lists of the leaves
@@ -121,6 +126,7 @@ class Structure:
     body_of_obj: np.ndarray  # (M,) the first body of each object (−1: a leaf)
     subtree_mass: np.ndarray  # (B,) everything beyond each joint
     omega_j: np.ndarray     # (B,) each joint's own bending frequency with all it carries (rad/s)
+    omega_t: np.ndarray     # (B,) and its twisting one
 
     @classmethod
     def build(cls, tree, physics, present: np.ndarray) -> "Structure":
@@ -171,10 +177,8 @@ class Structure:
         J_s = J_s + Icom
         # stiffness from beam theory
         E = np.where(is_blade, p.blade_youngs_modulus, p.wood_youngs_modulus)
-        d4 = np.where(np.abs(d1 - d0) > 1e-9 * np.maximum(d0, 1e-12),
-                      3.0 * (d1 - d0) / np.where(np.abs(d1 - d0) > 0, 1.0 / np.maximum(d0, 1e-12) ** 3
-                                                  - 1.0 / np.maximum(d1, 1e-12) ** 3, 1.0),
-                      d0**4)
+        # ℓ/∫dx/d⁴ over the linear taper = 3d₀³d₁³/(d₀² + d₀d₁ + d₁²)
+        d4 = 3.0 * d0**3 * d1**3 / np.maximum(d0 * d0 + d0 * d1 + d1 * d1, 1e-300)
         d4 = np.maximum(d4, 1e-24)
         EI = E * np.pi * d4 / 64.0
         beyond = np.zeros(B)
@@ -242,6 +246,7 @@ class Structure:
         leaf_J = np.stack([Ja, Jb, Jb], axis=1)
         leaf_d = 2.0 * p.wood_damping * np.sqrt(leaf_k * leaf_J)
         cna = 0.5 * p.air_density * p.drag_leaf * area
+        cswing = 0.5 * p.air_density * PLATE_NORMAL_DRAG * area
         # present leaves ride their twigs rigidly: their mass at their centroid
         m0, h0, J0 = mass.copy(), h_s, J_s
         if L:
@@ -259,6 +264,7 @@ class Structure:
                          np.ascontiguousarray(J0), sm, sh, sJ)
         Jperp = 0.5 * (np.trace(sJ, axis1=1, axis2=2) - np.einsum("bi,bij,bj->b", axis, sJ, axis))
         omega_j = np.sqrt(kb / np.maximum(Jperp, 1e-30))
+        omega_t = np.sqrt(kt / np.maximum(np.einsum("bi,bij,bj->b", axis, sJ, axis), 1e-30))
         D = (2.0 * p.wood_damping / omega_j)[:, None, None] * K
         leaf_first = np.r_[0, np.cumsum(count[leaves])].astype(np.int64)
         leaf_nodes = np.arange(leaf_first[-1]) - np.repeat(leaf_first[:-1] - lp, count[leaves])
@@ -266,8 +272,9 @@ class Structure:
         return cls(parent=c(parent, np.int64), r0=c(r0), node=c(node, np.int64), tip=c(k_in == count[obj] - 2),
                    tip_node=c(node + 1, np.int64), obj=obj, axis=c(axis), length=length, mid0=c(mid0),
                    m0=c(m0), h0=c(h0), J0=c(J0), K=c(K), D=c(D), cda=c(cda), diameter=d0,
-                   leaf_obj=leaves, leaf_body=c(leaf_body, np.int64), leaf_on=c(on), leaf_base0=c(base0),
+                   leaf_obj=leaves, leaf_body=c(leaf_body, np.int64), leaf_on=c(on),
+                   leaf_base0=c(base0),
                    leaf_rc0=c(rc0), leaf_n0=c(n0), leaf_E=c(Eax), leaf_k=c(leaf_k), leaf_J=c(leaf_J),
-                   leaf_d=c(leaf_d), leaf_cna=c(cna), leaf_mass=c(leaf_mass), leaf_size=Llam,
+                   leaf_d=c(leaf_d), leaf_cna=c(cna), leaf_cswing=c(cswing), leaf_roll2=c(width**2 / 12.0), leaf_mass=c(leaf_mass), leaf_size=Llam,
                    leaf_nodes=c(leaf_nodes, np.int64), leaf_first=leaf_first, body_of_obj=first_body,
-                   subtree_mass=sm, omega_j=omega_j)
+                   subtree_mass=sm, omega_j=omega_j, omega_t=omega_t)

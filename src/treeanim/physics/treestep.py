@@ -53,6 +53,8 @@ class TreeState:
     leaf_X: np.ndarray  # (L, 3) the laminas' centroids from their twig's joint (world axes)
     leaf_N: np.ndarray  # (L, 3) the laminas' normals (world)
     leaf_kap: np.ndarray  # (L,)
+    leaf_U: np.ndarray  # (L, 3) unit air-relative wind at the laminas
+    leaf_kap2: np.ndarray  # (L,)
     phase: np.ndarray   # (L,) flutter phase (rad)
     flutter: np.ndarray  # (L,) flutter amplitude (rad)
 
@@ -64,6 +66,7 @@ class TreeState:
                  P=np.empty((B, 3)), Om=np.empty((B, 3)), V=np.empty((B, 3)), acc=np.zeros((B, 6)),
                  th=np.zeros((L, 3)), thd=np.zeros((L, 3)), leaf_F=np.zeros((L, 3)),
                  leaf_X=np.zeros((L, 3)), leaf_N=np.zeros((L, 3)), leaf_kap=np.zeros(L),
+                 leaf_U=np.zeros((L, 3)), leaf_kap2=np.zeros(L),
                  phase=np.random.default_rng([int(seed), 0x1EAF]).uniform(0, 2 * np.pi, L), flutter=np.zeros(L))
         forward_kinematics(s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
         st.leaf_X[:] = s.leaf_base0 + s.leaf_rc0
@@ -110,7 +113,8 @@ def sample_points(s: Structure, st: TreeState) -> np.ndarray:
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf_N, leaf_kap, F, kap):
+def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf_N, leaf_kap, leaf_U, leaf_kap2,
+                F, kap):
     """The air's force on every segment (across it) and the leaves' forces, with their implicit
     damping terms κ as points (see :func:`~treeanim.physics.articulated.articulated_step`)."""
     B = R.shape[0]
@@ -129,13 +133,16 @@ def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf
         ux -= d * ax
         uy -= d * ay
         uz -= d * az
-        c = cda[b] * np.sqrt(ux * ux + uy * uy + uz * uz)
+        un = np.sqrt(ux * ux + uy * uy + uz * uz)
+        c = cda[b] * un
         fx, fy, fz = c * ux, c * uy, c * uz
         F[b, 0] = ry * fz - rz * fy
         F[b, 1] = rz * fx - rx * fz
         F[b, 2] = rx * fy - ry * fx
         F[b, 3], F[b, 4], F[b, 5] = fx, fy, fz
-        add_point(kap, b, h * c, -h * c, ax, ay, az, rx, ry, rz)  # C = c(1 − aaᵀ)
+        # −∂F/∂v = c_d|U⊥|(1 − aaᵀ + Û⊥Û⊥ᵀ)
+        q = 1.0 / un if un > 0.0 else 0.0
+        add_point(kap, b, h * c, -h * c, ax, ay, az, h * c, ux * q, uy * q, uz * q, rx, ry, rz)
     for l in range(leaf_body.shape[0]):
         b = leaf_body[l]
         rx, ry, rz = leaf_X[l, 0], leaf_X[l, 1], leaf_X[l, 2]
@@ -147,7 +154,8 @@ def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf
         F[b, 4] += fy
         F[b, 5] += fz
         if leaf_kap[l] > 0.0:
-            add_point(kap, b, 0.0, leaf_kap[l], leaf_N[l, 0], leaf_N[l, 1], leaf_N[l, 2], rx, ry, rz)
+            add_point(kap, b, 0.0, leaf_kap[l], leaf_N[l, 0], leaf_N[l, 1], leaf_N[l, 2],
+                      leaf_kap2[l], leaf_U[l, 0], leaf_U[l, 1], leaf_U[l, 2], rx, ry, rz)
 
 
 class Work:
@@ -161,7 +169,7 @@ class Work:
         self.Dinv = np.empty((B, 3, 3))
         self.U = np.empty((B, 6, 3))
         self.u = np.empty((B, 3))
-        self.theta = np.empty(B)
+        self.theta = None
         self.theta_h = None
 
 
@@ -194,28 +202,28 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     Ub = np.ascontiguousarray(wind[:B])
     Ul = np.ascontiguousarray(wind[B:])
     _air_forces(dt, out.R, out.Om, out.V, s.mid0, s.axis, s.cda, Ub, s.leaf_body,
-                out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, w.F, w.kap)
+                out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, w.F, w.kap)
     for b, ofs, f in pulls:
         r = out.R[b] @ ofs
         w.F[b, :3] += np.cross(r, f)
         w.F[b, 3:] += f
     if grab is not None:
         _grab_force(grab, out, dt, w)
-    articulated_step(dt, _thetas(s, dt, work), s.parent, s.r0, s.m0, s.h0, s.J0, s.K, s.D, out.R, out.P, out.Om, out.V,
-                     out.Q, out.w, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.u, out.acc)
+    tb, tt = _thetas(s, dt, work)
+    articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.K, s.D, out.R, out.P, out.Q, out.w, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.u, out.acc)
     forward_kinematics(s.parent, s.r0, out.Q, out.w, out.R, out.P, out.Om, out.V)
     if len(Ul):
         _flutter(s, out, Ul, dt, leaf_flutter)
     leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
-              s.leaf_J, s.leaf_d, s.leaf_cna, out.R, out.P, out.Om, out.V, Ul,
-              out.flutter * np.sin(out.phase), out.th, out.thd, out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap)
+              s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, out.R, out.P, out.Om, out.V, Ul,
+              out.flutter * np.sin(out.phase), out.th, out.thd, out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2)
     out.time = st.time + dt
 
 
 def _thetas(s: Structure, h: float, w: Work) -> np.ndarray:
-    """Each joint's θ at step h (kept while h is)."""
+    """Each joint's θ for its bends and its twist at step h (kept while h is)."""
     if w.theta_h != h:
-        w.theta = theta_of(h * s.omega_j)
+        w.theta = (theta_of(h * s.omega_j), theta_of(h * s.omega_t))
         w.theta_h = h
     return w.theta
 
@@ -237,7 +245,7 @@ def _grab_force(g: Grab, st: TreeState, h: float, w: Work) -> None:
     f = fs - (g.c + theta * h * k) * v
     w.F[b, :3] += np.cross(r, f)
     w.F[b, 3:] += f
-    add_point(w.kap, b, h * g.c + (h * theta) ** 2 * k, 0.0, 0.0, 0.0, 0.0, r[0], r[1], r[2])
+    add_point(w.kap, b, h * g.c + (h * theta) ** 2 * k, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, r[0], r[1], r[2])
 
 
 def _flutter(s: Structure, st: TreeState, U: np.ndarray, h: float, amp: float) -> None:
