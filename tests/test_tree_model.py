@@ -1,0 +1,152 @@
+"""The tree model (one structure, solved implicitly) measured as physics from the public API,
+against ../shared/REALISM.md."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import treeanim as ta
+from conftest import Uniform
+
+QSM = Path(__file__).resolve().parents[1] / "assets" / "qsm" / "synthetic_broadleaf.txt"
+
+
+def _release(tree, obj, force, dt, hold=4.0, seconds=12.0, node=None):
+    """Pull object ``obj``'s tip with ``force`` for ``hold`` s, release, and return the times,
+    the x displacement of ``node`` (default: the tip) and the energy after each step."""
+    sim = ta.Simulation(tree, model="tree")
+    node = tree.object_start[obj] + tree.object_count[obj] - 1 if node is None else node
+    sim.pull(obj, force)
+    for _ in range(int(round(hold / dt))):
+        sim.step(dt)
+    sim.release()
+    x, E = [], []
+    for _ in range(int(round(seconds / dt))):
+        sim.step(dt)
+        x.append(sim.positions[node, 0] - tree.rest_positions[node, 0])
+        E.append(sim.energy)
+    return np.arange(1, len(x) + 1) * dt, np.array(x), np.array(E)
+
+
+def _peak_frequency(x, dt):
+    x = x - x.mean()
+    n = len(x)
+    spec = np.abs(np.fft.rfft(x * np.hanning(n), 32 * n))
+    return np.fft.rfftfreq(32 * n, dt)[np.argmax(spec[1:]) + 1]
+
+
+def test_a_release_in_calm_air_dies_away_and_the_energy_never_rises():
+    tree = ta.load_preset("small_cherry")
+    limb = int(np.flatnonzero(tree.level == 3)[0])
+    t, x, E = _release(tree, limb, (60.0, 0.0, 0.0), 1 / 60)
+    assert np.all(np.diff(E) <= 1e-9 * E[0]), np.max(np.diff(E))
+    first, last = np.abs(x[: 60]).max(), np.abs(x[-60:]).max()
+    assert first > 1e-3  # it swung
+    assert last < 0.05 * first, (first, last)  # 12 s later it has died away (was 31 % before)
+
+
+def test_the_same_release_has_the_same_frequency_at_any_step():
+    tree = ta.load_qsm(QSM)
+    top = int(np.argmax(tree.rest_positions[:, 1]))
+    f = {dt: _peak_frequency(_release(tree, 0, (300.0, 0.0, 0.0), dt, seconds=20.0, node=top)[1], dt)
+         for dt in (1 / 120, 1 / 30, 1 / 10)}
+    assert f[1 / 30] == pytest.approx(f[1 / 120], rel=0.05), f
+    assert f[1 / 10] == pytest.approx(f[1 / 120], rel=0.05), f
+
+
+def test_a_scanned_trunk_sways_near_the_dbh_over_height_squared_guide():
+    """REALISM.md: f ≈ 390·DBH/H² for mature broadleaves (Hz, m)."""
+    tree = ta.load_qsm(QSM)
+    X = tree.rest_positions
+    top = int(np.argmax(X[:, 1]))
+    H = X[:, 1].max()
+    stem = tree.object_nodes(0)
+    dbh = float(np.interp(1.3, X[stem, 1], tree.node_diameter[stem]))
+    f = _peak_frequency(_release(tree, 0, (300.0, 0.0, 0.0), 1 / 60, seconds=20.0, node=top)[1], 1 / 60)
+    assert 0.7 < f / (390.0 * dbh / H**2) < 1.4, (f, dbh, H)
+
+
+@pytest.mark.parametrize("fps", [2, 60])
+def test_a_drag_holds_its_shape_at_any_frame_rate_above_the_ground(fps):
+    tree = ta.load_preset("small_cherry")
+    limb = int(np.flatnonzero(tree.level == 3)[0])
+    tip = tree.object_start[limb] + tree.object_count[limb] - 1
+    target = tree.rest_positions[tip] + (0.6, -1.5, 0.0)
+    held = {}
+    for f in (2, fps):
+        sim = ta.Simulation(tree)
+        sim.drag(limb, target)
+        for _ in range(int(6 * f)):
+            sim.step(1.0 / f)
+        held[f] = sim.positions.copy()
+        assert held[f][:, 1].min() > -1e-6  # never through the ground
+        assert np.isfinite(held[f]).all()
+    moved = np.linalg.norm(held[2][tip] - tree.rest_positions[tip])
+    assert moved > 0.2
+    assert np.linalg.norm(held[fps][tip] - held[2][tip]) < 0.1 * moved
+
+
+def test_in_a_gale_the_twigs_bend_far_less_than_their_leaves_turn():
+    tree = ta.load_preset("small_cherry")
+    sim = ta.Simulation(tree, wind=ta.WindField(speed=25.0, seed=2))
+    leaves = np.flatnonzero(tree.kind == "leaf")
+    tips = tree.object_start[leaves] + tree.object_count[leaves] - 1
+    attach = tree.attach_node[leaves]
+    twig, leaf = [], []
+    for k in range(240):
+        sim.step(1 / 60)
+        if k >= 120 and k % 10 == 0:
+            R = sim.rotations
+            rel = np.einsum("kji,kjl->kil", R[attach], R[tips])  # the leaf against its twig
+            leaf.append(np.degrees(np.arccos(np.clip((np.trace(rel, axis1=1, axis2=2) - 1) / 2, -1, 1))))
+            branches = np.flatnonzero((tree.kind == "branch") & (tree.parent >= 0))
+            base = tree.object_start[branches]
+            par = tree.attach_node[branches]
+            relb = np.einsum("kji,kjl->kil", R[par], R[base])  # a branch against its parent
+            twig.append(np.degrees(np.arccos(np.clip((np.trace(relb, axis1=1, axis2=2) - 1) / 2, -1, 1))))
+    twig, leaf = np.percentile(np.concatenate(twig), 95), np.percentile(np.concatenate(leaf), 95)
+    assert twig < 0.5 * leaf, (twig, leaf)
+    assert leaf > 15.0
+
+
+def test_sway_grows_at_least_as_the_speed_to_the_power_1_3():
+    tree = ta.load_preset("small_cherry")
+    branches = np.flatnonzero(tree.kind == "branch")
+    tips = tree.object_start[branches] + tree.object_count[branches] - 1
+    sway = {}
+    for U in (5.0, 20.0):
+        sim = ta.Simulation(tree, wind=Uniform((U, 0.0, 0.0)))
+        d = []
+        for k in range(300):
+            sim.step(1 / 30)
+            if k >= 150:
+                d.append(np.mean(sim.positions[tips, 0] - tree.rest_positions[tips, 0]))
+        sway[U] = np.mean(d)
+    assert sway[5.0] > 0
+    assert sway[20.0] / sway[5.0] >= 4.0**1.3, sway
+
+
+def test_the_state_is_copied_and_restored_exactly():
+    tree = ta.load_preset("small_cherry")
+    sim = ta.Simulation(tree, wind=ta.WindField(speed=8.0))
+    for _ in range(20):
+        sim.step(1 / 60)
+    st = sim.state
+    for _ in range(10):
+        sim.step(1 / 60)
+    a = sim.positions.copy()
+    sim.state = st
+    for _ in range(10):
+        sim.step(1 / 60)
+    np.testing.assert_array_equal(a, sim.positions)
+
+
+@pytest.mark.parametrize("target, s", [((np.nan, 0, 0), 1.0), ((0, 1, 0), 1.5), ((0, 1, 0), -0.1), ("up", 1.0)])
+def test_a_bad_drag_is_refused_in_one_line(target, s):
+    sim = ta.Simulation(ta.load_preset("beam"))
+    with pytest.raises(ValueError) as e:
+        sim.drag(0, target, s)
+    assert "\n" not in str(e.value)
+    with pytest.raises(ValueError, match="tree"):
+        ta.Simulation(ta.load_preset("beam"), model="paper").drag(0, (0, 1, 0))
