@@ -210,7 +210,8 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     if grab is not None:
         _grab_force(grab, out, dt, w)
     tb, tt = _thetas(s, dt, work)
-    articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.K, s.D, out.R, out.P, out.Q, out.w, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.u, out.acc)
+    articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.K, s.D, out.R, out.P, out.Q, out.w,
+                     w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.u, out.acc)
     forward_kinematics(s.parent, s.r0, out.Q, out.w, out.R, out.P, out.Om, out.V)
     if len(Ul):
         _flutter(s, out, Ul, dt, leaf_flutter)
