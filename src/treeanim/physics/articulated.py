@@ -267,6 +267,8 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, K, D, R, P
         for i in range(3):
             for j in range(3):
                 IA[b, i, 3 + j] += kap[b, i, 3 + j]
+        for i in range(3):
+            for j in range(3):
                 IA[b, 3 + i, j] = IA[b, j, 3 + i]
     # --- 2. inward: articulated inertias and bias forces, the joints' terms folded in
     for b in range(B - 1, -1, -1):

@@ -208,7 +208,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
         w.F[b, :3] += np.cross(r, f)
         w.F[b, 3:] += f
     if grab is not None:
-        _grab_force(grab, out, dt, w)
+        _grab_force(s, grab, out, dt, w)
     tb, tt = _thetas(s, dt, work)
     articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.K, s.D, out.R, out.P, out.Q, out.w,
                      w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.u, out.acc)
@@ -229,11 +229,11 @@ def _thetas(s: Structure, h: float, w: Work) -> np.ndarray:
     return w.theta
 
 
-def _grab_force(g: Grab, st: TreeState, h: float, w: Work) -> None:
+def _grab_force(s: Structure, g: Grab, st: TreeState, h: float, w: Work) -> None:
     """The grab's spring −k(x − target) − (c + θhk)v, capped at f_max, its implicit part as κ
     (θ of the spring's own frequency with the mass it moves, ``g.mass``)."""
     b = g.body
-    theta = theta_of(h * np.sqrt(g.k / g.mass))
+    theta = float(_thetas(s, h, w)[0][b])  # the θ its body moves by (a stiffer one would not match the update)
     r = st.R[b] @ g.offset
     x = st.P[b] + r
     v = st.V[b] + np.cross(st.Om[b], r)
