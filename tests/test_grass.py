@@ -38,6 +38,26 @@ def breeze_and_gale(meadow):
     return {U: _tips(tree, tips, U, 10.0) for U in (5.0, 30.0)}
 
 
+def test_blades_sway_in_a_breeze_and_lie_over_in_a_gale(meadow, breeze_and_gale):
+    tree, tips = meadow
+    rest = tree.rest_positions[tips]
+    height = rest[:, 1] - tree.rest_positions[tree.object_start, 1]
+    sway, drop, lean = {}, {}, {}
+    for U, T in breeze_and_gale.items():
+        assert np.isfinite(T).all()
+        sway[U] = np.median(np.linalg.norm(T.std(axis=0), axis=1))  # m, per blade tip
+        drop[U] = np.median((rest[:, 1] - T[..., 1].mean(axis=0)) / height)  # share of the height
+        lean[U] = np.median(T[..., 0].mean(axis=0) - rest[:, 0])  # downwind (+x), m
+    # A breeze: tips sway by centimetres, visible from a few metres, blades still upright.
+    assert sway[5.0] > 0.02, sway
+    assert drop[5.0] < 0.1, drop
+    assert lean[5.0] > 0.01, lean
+    # A gale: the meadow lies over downwind, the tips lose a third of their height or more.
+    assert drop[30.0] > 0.3, drop
+    assert lean[30.0] > 2.5 * lean[5.0], lean  # a lying blade leans at most its length: the drop says it lies
+    assert sway[30.0] > sway[5.0], sway
+
+
 def test_gusts_sweep_downwind_across_the_meadow(meadow, breeze_and_gale):
     """Strips of the meadow 2 m apart across the wind: the downwind strip repeats the upwind
     strip's motion about d/U later (Taylor's frozen turbulence), not at once nor earlier."""

@@ -22,7 +22,7 @@ from ..validate import finite_float, finite_vector3
 from .paper_sim import MAX_FREQUENCY, MAX_PULL, MAX_STEP, MAX_ZETA, PaperSim
 from .tree_sim import TreeSim
 
-__all__ = ["Simulation", "MODELS", "default_model", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
+__all__ = ["Simulation", "MODELS", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
 
 #: The models a Simulation can run, by name: each keeps its own static model and state and
 #: steps it (``step(dt)``, ``get_state()``/``set_state()``, the pose, pulls).
@@ -59,9 +59,9 @@ class Simulation:
         0 (summer) … 1 (winter): drops leaves (and, for the paper, interpolates its modal ranges).
     seed : int
         Seed of the model's random numbers (the paper's Eqs. 20–22; the leaves' flutter and fall).
-    model : {'tree', 'paper'} or None
-        The mechanics (see the module). None: :func:`default_model` ('tree', but 'paper' for
-        grass). Settable as ``model`` (restarts from rest).
+    model : {'tree', 'paper'}
+        The mechanics (see the module; None means 'tree'). Settable as ``model`` (restarts
+        from rest).
     integrator, coupling, modes :
         The paper model's options (:class:`~treeanim.physics.paper_sim.PaperSim`).
 
@@ -92,7 +92,7 @@ class Simulation:
         self._tree = tree
         self._seed = int(seed)
         self._paper_opts = {"integrator": integrator, "coupling": coupling, "modes": modes}
-        self._model = self._check_model(default_model(tree) if model is None else model)
+        self._model = self._check_model("tree" if model is None else model)
         self._impl = self._make(self._model, wind, self._check_season(season), tree.physics)
 
     def _make(self, model: str, wind, season: float, physics):
@@ -361,17 +361,6 @@ class Simulation:
             return self._impl._tip_positions(objs)
         t = self._tree
         return self._impl.positions[t.object_start[objs] + t.object_count[objs] - 1].copy()
-
-
-def default_model(tree: Tree) -> str:
-    """The model a tree runs unless told: 'tree', but 'paper' for a tree with grass blades.
-
-    A grass blade is a strip so light and soft that in a gale its drag is a hundred times its
-    springs' stiffness; the tree model takes that drag's turn with the blade explicitly, and a
-    meadow in a 30 m/s gale then diverges even at 1/120 s steps. Until the drag's stiffness is
-    taken implicitly too, meadows keep the paper's model.
-    """
-    return "paper" if np.any(np.asarray(tree.kind) == "blade") else "tree"
 
 
 def _shifted(state, time: float):

@@ -116,8 +116,10 @@ def sample_points(s: Structure, st: TreeState) -> np.ndarray:
 def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf_N, leaf_kap, leaf_U, leaf_kap2,
                 F, kap):
     """The air's force on every segment (across it) and the leaves' forces, with their implicit
-    damping terms κ as points (see :func:`~treeanim.physics.articulated.articulated_step`)."""
+    damping terms κ as points (see :func:`~treeanim.physics.articulated.articulated_step`) and
+    the segments' turn stiffness (:func:`_turn_stiffness`)."""
     B = R.shape[0]
+    Ka = np.empty((3, 3))
     for b in range(B):
         rx = R[b, 0, 0] * mid0[b, 0] + R[b, 0, 1] * mid0[b, 1] + R[b, 0, 2] * mid0[b, 2]
         ry = R[b, 1, 0] * mid0[b, 0] + R[b, 1, 1] * mid0[b, 1] + R[b, 1, 2] * mid0[b, 2]
@@ -143,6 +145,8 @@ def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf
         # −∂F/∂v = c_d|U⊥|(1 − aaᵀ + Û⊥Û⊥ᵀ)
         q = 1.0 / un if un > 0.0 else 0.0
         add_point(kap, b, h * c, -h * c, ax, ay, az, h * c, ux * q, uy * q, uz * q, rx, ry, rz)
+        if c > 0.0:
+            _turn_stiffness(b, h, cda[b], un, ux, uy, uz, d, ax, ay, az, rx, ry, rz, fx, fy, fz, Om, F, kap, Ka)
     for l in range(leaf_body.shape[0]):
         b = leaf_body[l]
         rx, ry, rz = leaf_X[l, 0], leaf_X[l, 1], leaf_X[l, 2]
@@ -156,6 +160,44 @@ def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf
         if leaf_kap[l] > 0.0:
             add_point(kap, b, 0.0, leaf_kap[l], leaf_N[l, 0], leaf_N[l, 1], leaf_N[l, 2],
                       leaf_kap2[l], leaf_U[l, 0], leaf_U[l, 1], leaf_U[l, 2], rx, ry, rz)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _turn_stiffness(b, h, cda, un, ux, uy, uz, ua, ax, ay, az, rx, ry, rz, fx, fy, fz, Om, F, kap, Ka):
+    """The drag's stiffness against the segment's own turn, taken implicitly (backward Euler).
+
+    Turning a segment by δφ turns its axis and its middle (δa = δφ × a, δr = δφ × r), so the
+    cross-flow drag F = c|U⊥|U⊥ and its moment τ = r × F change by K·δφ. A light, soft part in
+    a strong wind (a grass blade: drag a hundred times its springs) must take this implicitly:
+    its symmetric part, made positive by Gershgorin's shift, joins the body's rotational inertia
+    as h²K and its moment as −hKω. (ux, uy, uz) is U⊥ and ``ua`` the air's speed along the axis.
+    """
+    for k in range(3):
+        dx, dy, dz = (1.0 if k == 0 else 0.0), (1.0 if k == 1 else 0.0), (1.0 if k == 2 else 0.0)
+        dax, day, daz = dy * az - dz * ay, dz * ax - dx * az, dx * ay - dy * ax
+        drx, dry, drz = dy * rz - dz * ry, dz * rx - dx * rz, dx * ry - dy * rx
+        uda = ux * dax + uy * day + uz * daz
+        dnx, dny, dnz = -uda * ax - ua * dax, -uda * ay - ua * day, -uda * az - ua * daz
+        q = (ux * dnx + uy * dny + uz * dnz) / un
+        dfx, dfy, dfz = cda * (un * dnx + ux * q), cda * (un * dny + uy * q), cda * (un * dnz + uz * q)
+        Ka[0, k] = -((dry * fz - drz * fy) + (ry * dfz - rz * dfy))
+        Ka[1, k] = -((drz * fx - drx * fz) + (rz * dfx - rx * dfz))
+        Ka[2, k] = -((drx * fy - dry * fx) + (rx * dfy - ry * dfx))
+    for i in range(3):
+        for j in range(i + 1, 3):
+            m = 0.5 * (Ka[i, j] + Ka[j, i])
+            Ka[i, j] = m
+            Ka[j, i] = m
+    shift = 0.0
+    for i in range(3):
+        g = Ka[i, i] - abs(Ka[i, (i + 1) % 3]) - abs(Ka[i, (i + 2) % 3])
+        shift = max(shift, -g)
+    for i in range(3):
+        Ka[i, i] += shift
+    for i in range(3):
+        F[b, i] -= h * (Ka[i, 0] * Om[b, 0] + Ka[i, 1] * Om[b, 1] + Ka[i, 2] * Om[b, 2])
+        for j in range(3):
+            kap[b, i, j] += h * h * Ka[i, j]
 
 
 class Work:
