@@ -1,9 +1,10 @@
 """The viewer's input handlers: what the window's GLFW callbacks (and the tests) call.
 
-A left-drag on an object pulls it, elsewhere it orbits; a right or middle drag pans, the wheel
+A left-drag on an object drags it (the tree model; the paper's pulls it with a spring),
+elsewhere it orbits; a right or middle drag pans, the wheel
 zooms; keys act through the table in :mod:`treeanim.app.keys`; the panel gets the mouse and
 the keyboard while it wants them. Mixed into :class:`treeanim.app.viewer.Viewer`, whose
-camera, panel, gui, window and pulls they drive.
+camera, panel, gui, window and grabs they drive.
 """
 
 from __future__ import annotations
@@ -22,12 +23,12 @@ class ViewerInput:
     """Input handlers of a :class:`~treeanim.app.viewer.Viewer` (screen units, origin at the
     window's top left, y down)."""
 
-    _mode: str | None = None  # 'orbit', 'pan', 'pull' while a button is held
+    _mode: str | None = None  # 'orbit', 'pan', 'pull' (a grab: drag or pull) while a button is held
     _mode_button: int | None = None
     _cursor = (0.0, 0.0)
 
     def _end_drag(self) -> None:
-        """Let go of whatever a held button was doing (a pull is released)."""
+        """Let go of whatever a held button was doing (a grab is released)."""
         self.end_pull()
         self._mode = None
         self._mode_button = None
@@ -111,7 +112,7 @@ class ViewerInput:
         self._win = (max(int(width), 0), max(int(height), 0))
 
     def on_focus(self, focused: bool) -> None:
-        """Focus gained or lost; losing it ends any drag and lets go of a pull."""
+        """Focus gained or lost; losing it ends any mouse drag and lets go of a grab."""
         self.gui.focus(focused)
         if not focused:
             self._end_drag()

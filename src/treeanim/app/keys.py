@@ -50,7 +50,7 @@ BINDINGS = (
 )
 #: The mouse: (what, does).
 MOUSE = (
-    ("left-drag a branch or leaf", "pull, let go: swing"),
+    ("left-drag a branch or leaf", "drag it, let go: swing"),
     ("left-drag the sky", "orbit"),
     ("right/middle-drag", "pan"),
     ("wheel", "zoom"),

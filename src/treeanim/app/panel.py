@@ -1,5 +1,6 @@
-"""The viewer's imgui panel: preset, season, wind, modal ranges, stiffness, time, overlays,
-statistics, and saving or loading the settings as a preset.
+"""The viewer's imgui panel: preset, season, wind, the model (the tree model or the paper's, with
+its modal ranges, integrator and coupling), stiffness, time, overlays, statistics, and saving
+or loading the settings as a preset.
 
 The settings are the table :data:`treeanim.app.settings.SETTINGS`: :meth:`Panel.widget` draws
 one from it, and every change goes through :meth:`Panel.apply`, which applies it through the
@@ -115,7 +116,8 @@ class Panel:
     def apply(self, name: str, value) -> bool:
         """Apply setting ``name`` (a key of :data:`~treeanim.app.settings.SETTINGS`: ``preset``,
         ``season``, the wind's, ``ei_max``, ``f:KIND`` and ``zeta:KIND`` ((min, max) of the
-        edited season's table), ``time_scale``, ``integrator``, the switches, the light's);
+        edited season's table), ``time_scale``, ``paper_model``, the paper model's
+        ``integrator``, ``coupling`` and ``physical_modes``, the switches, the light's);
         returns whether it was accepted (a refusal is shown in the panel)."""
         v = self.viewer
         try:
@@ -182,7 +184,7 @@ class Panel:
 
     def widget(self, name: str) -> None:
         """Draw setting ``name``'s slider, checkbox or combo (as :data:`SETTINGS` describes it,
-        if it is shown for this wind) and apply a change."""
+        if it is shown for this wind and model) and apply a change."""
         st = SETTINGS[name]
         v = self.viewer
         if st.shown is not None and not st.shown(v):
@@ -213,6 +215,8 @@ class Panel:
     def _range_pair(self, name: str, speed: float, fmt: str) -> None:
         """Setting ``name``'s (min, max) pair as two linked drag fields (f or ζ of a kind)."""
         st = SETTINGS[name]
+        if st.shown is not None and not st.shown(self.viewer):
+            return
         r = st.get(self.viewer)
         if r is None:
             return
@@ -263,7 +267,8 @@ class Panel:
         msaa = f"MSAA {v.window.samples}×" if v.window.samples else "no MSAA"
         state = f"{'paused' if v.paused else f't = {sim.time:.1f} s'}   {gl}, {msaa}"
         if v.grab is not None:
-            state += f"  pulling #{v.grab.object} ({sim.tree.kind[v.grab.object]})"
+            verb = "dragging" if sim.model == "tree" else "pulling"
+            state += f"  {verb} #{v.grab.object} ({sim.tree.kind[v.grab.object]})"
         imgui.text_disabled(state)
         imgui.separator()
 
@@ -291,27 +296,28 @@ class Panel:
 
         # --- physics
         if self._header("Physics", open_=True):
-            imgui.text("ranges of")
-            imgui.same_line()
-            if imgui.radio_button("summer", self.edit_season == "summer"):
-                self.edit_season = "summer"
-            imgui.same_line()
-            if imgui.radio_button("winter", self.edit_season == "winter"):
-                self.edit_season = "winter"
-            for kind in self._kinds:
-                self._range_pair(f"f:{kind}", 0.01, "%.2f")
-                self._range_pair(f"zeta:{kind}", 0.002, "%.3f")
+            self.widget("paper_model")
+            if sim.model == "paper":  # its modal ranges (the tree model's come from beam theory)
+                imgui.text("ranges of")
+                imgui.same_line()
+                if imgui.radio_button("summer", self.edit_season == "summer"):
+                    self.edit_season = "summer"
+                imgui.same_line()
+                if imgui.radio_button("winter", self.edit_season == "winter"):
+                    self.edit_season = "winter"
+                for kind in self._kinds:
+                    self._range_pair(f"f:{kind}", 0.01, "%.2f")
+                    self._range_pair(f"zeta:{kind}", 0.002, "%.3f")
             self.widget("ei_max")
             self.widget("physical_modes")
 
         # --- time
         if self._header("Simulation", open_=True):
             self.widget("time_scale")
-            self.widget("integrator")
-            self.widget("coupling")
-            imgui.same_line()
-            self.widget("load_path")
-            imgui.same_line()
+            if sim.model == "paper":
+                self.widget("integrator")
+                self.widget("coupling")
+                imgui.same_line()
             if imgui.button("Resume" if v.paused else "Pause"):
                 self.apply("paused", not v.paused)
             self._rect("pause")

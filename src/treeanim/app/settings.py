@@ -5,7 +5,9 @@ panel's drawing (:meth:`Panel.widget <treeanim.app.panel.Panel.widget>`) and
 
 Every setter goes through a checked property (``sim.season``, ``sim.physics =
 dataclasses.replace(...)``, the wind's setters ...) and raises ValueError on a refusal, which
-the panel shows in its status line.
+the panel shows in its status line. Settings of the paper's model alone (its integrator,
+coupling and modal ranges) are shown only while it runs, and refused (ValueError) on the tree
+model.
 """
 
 from __future__ import annotations
@@ -86,6 +88,23 @@ def _paper(v) -> bool:
     return v.sim.wind.model != "physical"
 
 
+def _paper_model(v) -> bool:
+    return v.sim.model == "paper"
+
+
+def _paper_only(setting: Setting) -> Setting:
+    """``setting``, shown with the paper's model only and refused (ValueError, the façade's
+    reason) on the tree model, where its attribute does not exist."""
+
+    def put(v, x):
+        try:
+            setting.set(v, x)
+        except AttributeError as e:
+            raise ValueError(f"{setting.label}: {e}") from None
+
+    return dataclasses.replace(setting, set=put, shown=_paper_model)
+
+
 def _wind(name: str, label: str, lo: float, hi: float, fmt: str = "%.2f", **kw) -> Setting:
     """A wind field setting, through the WindField's checked setter of ``name``."""
     return Setting(label, lambda v: getattr(v.sim.wind, name), lambda v, x: v.set_wind(**{name: float(x)}),
@@ -143,8 +162,9 @@ def _modes(what: str, kind: str) -> Setting:
         new = ModeRange((lo, hi), cur.zeta) if what == "f" else ModeRange(cur.f, (lo, hi))
         v.sim.physics = dataclasses.replace(p, **{v.panel.edit_season: dataclasses.replace(table(v), **{kind: new})})
 
+    # the ranges are the preset's (saved with it) on either model; only the paper's uses them
     return Setting(f"f {kind} (Hz)" if what == "f" else f"ζ {kind}", get, put, kind="custom",
-                   lo=0.05 if what == "f" else 0.0, hi=20.0 if what == "f" else 2.0)
+                   lo=0.05 if what == "f" else 0.0, hi=20.0 if what == "f" else 2.0, shown=_paper_model)
 
 
 #: Every setting the panel shows or :meth:`Panel.apply` takes, by name.
@@ -171,16 +191,19 @@ SETTINGS: dict[str, Setting] = {
     # simulation
     "time_scale": Setting("time scale", lambda v: v.time_scale, lambda v, x: setattr(v, "time_scale", float(x)),
                           lo=0.05, hi=2.0, fmt="%.2f×", log=True, clamp=True),
-    "integrator": Setting("integrator", lambda v: v.sim.integrator, lambda v, x: setattr(v.sim, "integrator", x),
-                          kind="choice", choices=tuple(INTEGRATORS)),
-    "coupling": _flag(lambda v: v.sim, "coupling", "coupling"),
-    "load_path": _flag(lambda v: v.sim, "load_path", "load path"),
-    # the branches' modes: beam theory, or the preset's ranges (Eqs. 20–22)
-    "physical_modes": Setting("physical modes (beam theory)", lambda v: v.sim.modal == "physical", _set_modal,
-                              kind="check"),
+    # the model: the whole tree as one structure (default), or the paper's independent objects
+    "paper_model": Setting("paper's model (Hu et al. 2012)", _paper_model,
+                           lambda v, x: v.set_model("paper" if x else "tree"), kind="check"),
+    "integrator": _paper_only(Setting("integrator", lambda v: v.sim.integrator,
+                                      lambda v, x: setattr(v.sim, "integrator", x), kind="choice",
+                                      choices=tuple(INTEGRATORS))),
+    "coupling": _paper_only(_flag(lambda v: v.sim, "coupling", "coupling")),
+    # the paper's branch modes: beam theory, or the preset's ranges (Eqs. 20–22)
+    "physical_modes": _paper_only(Setting("physical modes (beam theory)", lambda v: v.sim.modal == "physical",
+                                          _set_modal, kind="check")),
     "paused": _flag(lambda v: v, "paused", "paused"),
     # overlays
-    "show_trace": _flag(lambda v: v, "show_trace", "pull trace"),
+    "show_trace": _flag(lambda v: v, "show_trace", "grab trace"),
     "show_frames": _flag(lambda v: v, "show_frames", "local frames"),
     "show_wind": _flag(lambda v: v, "show_wind", "wind slices + arrow"),
     # light

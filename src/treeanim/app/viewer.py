@@ -1,4 +1,4 @@
-"""The interactive viewer: a tree in wind in a GLFW window, pulled with the mouse, tuned from an
+"""The interactive viewer: a tree in wind in a GLFW window, dragged with the mouse, tuned from an
 imgui panel.
 
 :class:`Viewer` owns the simulation, the renderer, the camera and the panel of one window. The
@@ -19,8 +19,9 @@ import numpy as np
 
 from ..clock import STEP, StepClock
 from ..model.tree import Tree
-from ..physics.pull import SpringPull
-from ..physics.simulation import Simulation
+from ..physics.pull import SpringPull, TreeDrag
+from ..physics.pull import grab as grab_object
+from ..physics.simulation import MODELS, Simulation
 from ..physics.wind import WindField
 from ..physics.wind import wind_preset as wind_preset_kwargs
 from ..render.camera import TREE_ELEVATION, OrbitCamera, frame_tree
@@ -76,6 +77,8 @@ class Viewer(ViewerInput):
         Wind direction, degrees about +y from +x.
     seed : int
         Seed of the simulation's random numbers and of the wind.
+    model : {'tree', 'paper'}
+        The simulation's model (kept when the tree changes; the panel switches it).
     show_panel : bool
         Show the imgui panel.
     clock : callable or None
@@ -92,9 +95,13 @@ class Viewer(ViewerInput):
     gl_renderer : str
         The OpenGL renderer's name.
     show_trace, show_frames, show_wind : bool
-        Overlays: the pulled tip's trace, the local frames, the wind slices and arrow.
-    grab : SpringPull or None
-        The pull in progress (:mod:`treeanim.physics.pull`).
+        Overlays: the grabbed point's trace, the local frames, the wind slices and arrow.
+    grab : TreeDrag or SpringPull or None
+        The grab in progress (:mod:`treeanim.physics.pull`): a drag solved inside the tree
+        model's step, or the paper model's spring pull.
+    traced : (int, float) or None
+        (object, s) of the point the trace follows: the grabbed point (tree model) or the
+        object's tip (s = 1; the paper's model).
     last_sim_s, last_draw_s : float
         Wall time of the last frame's simulation sub-steps and of its drawing (pose upload,
         draw calls, panel), seconds; ``sim_ms`` and ``render_ms`` are their moving averages.
@@ -102,7 +109,7 @@ class Viewer(ViewerInput):
 
     def __init__(self, window: Window, tree: Tree, *, season: float = 0.0, wind_speed: float | None = None,
                  wind_angle_deg: float = 0.0, seed: int = 0, show_panel: bool = True, clock=None,
-                 wind_preset: str | None = None) -> None:
+                 wind_preset: str | None = None, model: str = "tree") -> None:
         self.window = window
         self.ctx = window.ctx
         self.gl_renderer = str(window.ctx.info.get("GL_RENDERER", "unknown renderer"))
@@ -114,8 +121,8 @@ class Viewer(ViewerInput):
         self.show_trace = True
         self.show_frames = False
         self.show_wind = False
-        self.grab: SpringPull | None = None
-        self.traced: int | None = None  # object whose tip the trace follows
+        self.grab: TreeDrag | SpringPull | None = None
+        self.traced: tuple[int, float] | None = None  # (object, s) of the point the trace follows
         self.trace = PullTrace(capacity=2400)
         self.camera = OrbitCamera(azimuth=20.0, elevation=TREE_ELEVATION)
         self.messages: list[str] = []  # lines for the panel's status line (newest last)
@@ -133,7 +140,7 @@ class Viewer(ViewerInput):
         self._fb = tuple(window.framebuffer_size)
         self._integrator = "exact"
         self._coupling = True
-        self._load_path = True
+        self._model = model
         self.sim: Simulation | None = None
         self.renderer: Renderer | None = None
         self.scene = Scene()  # sun, shadows and leaves' translucency, kept across trees
@@ -164,17 +171,18 @@ class Viewer(ViewerInput):
         return self.sim.wind
 
     def load_tree(self, tree: Tree) -> None:
-        """Show ``tree``: a new simulation (same wind, season, integrator, coupling and model), renderer
-        and picker; the camera frames it."""
+        """Show ``tree``: a new simulation (same wind, season and model, and the paper model's
+        integrator and coupling), renderer and picker; the camera frames it."""
         if self.sim is not None:
             self._season = self.sim.season
-            self._integrator = self.sim.integrator
-            self._coupling = self.sim.coupling
-            self._load_path = self.sim.load_path
+            self._model = self.sim.model
+            if self._model == "paper":
+                self._integrator = self.sim.integrator
+                self._coupling = self.sim.coupling
             self._wind = self.sim.wind
         self._end_drag()
-        sim = Simulation(tree, wind=_clone_wind(self._wind), season=self._season, seed=self.seed,
-                         integrator=self._integrator, coupling=self._coupling, load_path=self._load_path)
+        sim = Simulation(tree, wind=_clone_wind(self._wind), season=self._season, seed=self.seed, model=self._model,
+                         integrator=self._integrator, coupling=self._coupling)
         renderer = Renderer(self.ctx, tree, scene=self.scene)
         if self.renderer is not None:
             self.renderer.release()
@@ -191,6 +199,23 @@ class Viewer(ViewerInput):
         self._wind_arrow_anchor = (0.5 * (lo + hi), 0.65 * size)
         self.frame_camera()
         self.panel.tree_changed()
+
+    def set_model(self, name: str) -> None:
+        """Switch the simulation to model ``name`` ('tree' or 'paper'; ValueError otherwise):
+        any grab is let go and the trace cleared; the tree restarts from rest (time, wind,
+        season and physics are kept)."""
+        if name == self.sim.model:
+            return
+        if name not in MODELS:
+            raise ValueError(f"model must be one of {tuple(MODELS)}, got {name!r}")
+        if self.sim.model == "paper":
+            self._integrator, self._coupling = self.sim.integrator, self.sim.coupling
+        self._end_drag()
+        self.sim.model = name
+        self._model = self.sim.model
+        self.trace.clear()
+        self.traced = None
+        self._uploaded = None
 
     def _wind_at(self, points: np.ndarray) -> np.ndarray:
         return self.sim.wind.sample(points, self.sim.time)
@@ -244,7 +269,7 @@ class Viewer(ViewerInput):
                 self.grab.step(sim, h, exact=j == 0)
             sim.step(h)
             if self.traced is not None:
-                self.trace.push(sim.tip_position(self.traced))
+                self.trace.push(self.traced_point())
         if n:
             sim.positions, sim.rotations  # the pose is built lazily: count it as simulation
         return n
@@ -364,7 +389,7 @@ class Viewer(ViewerInput):
         self.messages.append(line)
         del self.messages[:-4]
 
-    # ------------------------------------------------------------------ picking and pulling
+    # ------------------------------------------------------------------ picking and grabbing
     def _ray(self, x: float, y: float):
         w, h = self._win
         return self.camera.ray(x, y, max(w, 1), max(h, 1))
@@ -378,24 +403,35 @@ class Viewer(ViewerInput):
                                 pixel_angle=self.camera.pixel_angle(h), min_pixels=4.0, thin_pixels=thin)
 
     def start_pull(self, x: float, y: float) -> bool:
-        """Grab the object under (x, y), if any. Returns whether something was grabbed."""
+        """Grab the object under (x, y), if any: on the tree model a drag of the point of the
+        object nearest the picked one (:class:`~treeanim.physics.pull.TreeDrag`, through
+        :meth:`Simulation.drag`), on the paper's a spring pull
+        (:class:`~treeanim.physics.pull.SpringPull`). Returns whether something was grabbed."""
         hit = self.pick(x, y)
         if hit is None:
             return False
-        self.grab = SpringPull.grab(self.sim, hit.object, hit.point, self.camera.forward)
+        self.grab = grab_object(self.sim, hit.object, hit.point, self.camera.forward)
         self.trace.clear()
-        self.traced = hit.object
-        self.trace.push(self.sim.tip_position(hit.object))
+        self.traced = (hit.object, self.grab.s if isinstance(self.grab, TreeDrag) else 1.0)
+        self.trace.push(self.traced_point())
         return True
+
+    def traced_point(self) -> np.ndarray:
+        """The point the trace follows (world): on the tree model the grabbed point of the
+        object (:meth:`Simulation.point_position`, no whole pose), on the paper's its tip."""
+        obj, s = self.traced
+        if self.sim.model == "tree":
+            return self.sim.point_position(obj, s)
+        return self.sim.tip_position(obj)
 
     def anchor_point(self) -> np.ndarray | None:
         """Where the grabbed point is now (world), or None."""
         return None if self.grab is None else self.grab.anchor(self.sim)
 
     def _grabbed_point(self, exact: bool) -> np.ndarray:
-        """The grabbed point, exact on a frame's first sub-step (whose pose the last frame
-        drew, so it is built already), else followed through the tip
-        (:meth:`SpringPull.grabbed_point`)."""
+        """The grabbed point: a drag's from the tree model's bodies; a spring pull's exact on a
+        frame's first sub-step (whose pose the last frame drew, so it is built already), else
+        followed through the tip (:meth:`SpringPull.grabbed_point`)."""
         return self.grab.grabbed_point(self.sim, exact)
 
     def end_pull(self) -> None:
@@ -432,7 +468,7 @@ class Viewer(ViewerInput):
         self.window.request_close()
 
     def reset(self) -> None:
-        """Back to rest: the simulation at time 0, no pull, no trace."""
+        """Back to rest: the simulation at time 0, no grab, no trace."""
         self._end_drag()
         self.sim.reset()
         self.trace.clear()

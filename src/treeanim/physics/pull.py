@@ -1,7 +1,12 @@
-"""The mouse's pull: a spring from a grabbed point of an object to a target (the cursor's
-point), its force low-passed and capped, applied through :meth:`Simulation.pull`.
+"""The mouse's grab: on the tree model a :class:`TreeDrag` (the target handed to
+:meth:`Simulation.drag`, whose stiff spring is solved inside the step); on the paper's model a
+:class:`SpringPull` (a spring from a grabbed point of an object to a target (the cursor's
+point), its force low-passed and capped, applied through :meth:`Simulation.pull`).
 
-The spring's stiffness comes from the simulation's own compliance at the grabbed point
+Both have the same interface for the viewer: ``object``, ``target``, ``aim``, ``step``,
+``anchor``, ``grabbed_point``, ``release``; :func:`grab` makes the one ``sim.model`` takes.
+
+The SpringPull's stiffness comes from the simulation's own compliance at the grabbed point
 (:meth:`Simulation.compliance`, the stiffness the bending uses), so the grabbed point covers a
 set share of the way to the target (:data:`GAIN`) on any object, trunk or leaf. No GL, no
 window: the viewer turns the cursor into a target (:meth:`SpringPull.aim`) and steps it.
@@ -15,7 +20,7 @@ import numpy as np
 
 from .simulation import MAX_PULL
 
-__all__ = ["SpringPull", "TAU", "GAIN", "MAX_LENGTHS"]
+__all__ = ["grab", "TreeDrag", "SpringPull", "TAU", "GAIN", "MAX_LENGTHS"]
 
 #: Time constant (s, simulated) of the low-pass on the pull force: it damps the loop between
 #: the spring and the beam's static deflection, so the grabbed point settles without ringing.
@@ -25,6 +30,116 @@ TAU = 0.04
 GAIN = 1.5
 #: The pull force saturates at the spring force of a drag this many object lengths long.
 MAX_LENGTHS = 2.0
+
+
+def _aim(plane_point: np.ndarray, plane_normal: np.ndarray, origin, direction) -> np.ndarray | None:
+    """Where the ray from ``origin`` along ``direction`` meets the plane (never behind the
+    origin), or None where the ray runs along the plane."""
+    o, d = np.asarray(origin, float), np.asarray(direction, float)
+    denom = float(d @ plane_normal)
+    if abs(denom) < 1e-9:
+        return None
+    t = float((plane_point - o) @ plane_normal) / denom
+    return o + max(t, 0.0) * d
+
+
+def _nearest(P: np.ndarray, nodes: np.ndarray, point: np.ndarray) -> tuple[int, float, np.ndarray]:
+    """(segment k, fraction along it, nearest point) of the polyline ``P[nodes]`` to ``point``."""
+    a, b = P[nodes[:-1]], P[nodes[1:]]
+    e = b - a
+    s = np.clip(np.einsum("ij,ij->i", point - a, e) / np.maximum(np.einsum("ij,ij->i", e, e), 1e-30), 0, 1)
+    near = a + s[:, None] * e
+    k = int(np.argmin(np.linalg.norm(near - point, axis=1)))
+    return k, float(s[k]), near[k]
+
+
+def grab(sim, obj: int, point, plane_normal):
+    """The mouse's grab of object ``obj`` at world ``point`` for ``sim``'s model: a
+    :class:`TreeDrag` on the tree model, a :class:`SpringPull` on the paper's."""
+    cls = TreeDrag if sim.model == "tree" else SpringPull
+    return cls.grab(sim, obj, point, plane_normal)
+
+
+@dataclass
+class TreeDrag:
+    """A drag in progress on the tree model (make one with :meth:`grab`): the point at fraction
+    :attr:`s` of the object's length is held by :meth:`Simulation.drag`, its target moved with
+    the cursor.
+
+    Attributes
+    ----------
+    object : int
+        The grabbed object.
+    s : float
+        Fraction of the object's length (from its base) of the held point, 0 … 1 (a leaf is
+        held where it hangs from its twig, whatever ``s``).
+    offset : (3,) float
+        Picked point minus the held point at grab time (the picked point lies on the bark or
+        on a leaf's lamina): the held point is dragged to the target less this, so the picked
+        point follows the cursor without a jump at the press.
+    plane_point, plane_normal : (3,) float
+        The plane the target moves in (facing the camera through the picked point).
+    target : (3,) float
+        The cursor's point in that plane.
+    sent : (3,) float or None
+        The target last handed to :meth:`Simulation.drag` (the held point's).
+    """
+
+    object: int
+    s: float
+    offset: np.ndarray
+    plane_point: np.ndarray
+    plane_normal: np.ndarray
+    target: np.ndarray
+    sent: np.ndarray | None = None
+
+    @classmethod
+    def grab(cls, sim, obj: int, point, plane_normal) -> "TreeDrag":
+        """Grab object ``obj`` of ``sim`` (model 'tree') at world ``point``: ``s`` is the
+        fraction of its length at the point of its current pose nearest ``point`` (measured on
+        the rest lengths, as :meth:`Simulation.drag` takes it). The drag starts at once, its
+        target where the held point is (nothing moves until the cursor does)."""
+        tree = sim.tree
+        nodes = tree.object_nodes(obj)
+        point = np.asarray(point, float)
+        L = np.linalg.norm(np.diff(tree.rest_positions[nodes], axis=0), axis=1)
+        if len(nodes) < 2 or L.sum() <= 0:
+            s = 1.0
+        else:
+            k, t, _ = _nearest(sim.positions, nodes, point)
+            s = float(min(max((L[:k].sum() + t * L[k]) / L.sum(), 0.0), 1.0))
+        held = np.asarray(sim.point_position(obj, s), float)
+        d = cls(object=int(obj), s=s, offset=point - held, plane_point=point.copy(),
+                plane_normal=np.asarray(plane_normal, float).copy(), target=point.copy())
+        d.step(sim, 0.0)
+        return d
+
+    def aim(self, origin, direction) -> None:
+        """Move the target to where the ray from ``origin`` along ``direction`` meets the
+        plane (kept where the ray runs along the plane; never behind the origin)."""
+        t = _aim(self.plane_point, self.plane_normal, origin, direction)
+        if t is not None:
+            self.target = t
+
+    def anchor(self, sim) -> np.ndarray:
+        """Where the grabbed (picked) point is now (world): the held point plus the offset."""
+        return np.asarray(sim.point_position(self.object, self.s), float) + self.offset
+
+    def grabbed_point(self, sim, exact: bool = True) -> np.ndarray:
+        """Where the grabbed point is (the held point needs no whole pose: ``exact`` is moot)."""
+        return self.anchor(sim)
+
+    def step(self, sim, h: float, exact: bool = True) -> None:
+        """Before a step: hand a moved target to :meth:`Simulation.drag` (the spring itself is
+        solved inside the step)."""
+        want = self.target - self.offset
+        if self.sent is None or not np.array_equal(want, self.sent):
+            sim.drag(self.object, want, self.s)
+            self.sent = want
+
+    def release(self, sim) -> None:
+        """Let go: the object swings freely from where it is."""
+        sim.release(self.object)
 
 
 @dataclass
@@ -84,31 +199,24 @@ class SpringPull:
         """
         tree = sim.tree
         nodes = tree.object_nodes(obj)
-        P = sim.positions
-        a, b = P[nodes[:-1]], P[nodes[1:]]
-        e = b - a
         point = np.asarray(point, float)
-        s = np.clip(np.einsum("ij,ij->i", point - a, e) / np.maximum(np.einsum("ij,ij->i", e, e), 1e-30), 0, 1)
-        k = int(np.argmin(np.linalg.norm(a + s[:, None] * e - point, axis=1)))
-        offset = point - (a[k] + s[k] * e[k])
-        G = max(sim.compliance(obj, k, float(s[k]), offset), 1e-12)
+        k, s, near = _nearest(sim.positions, nodes, point)
+        offset = point - near
+        G = max(sim.compliance(obj, k, s, offset), 1e-12)
         G_tip = max(sim.compliance(obj, len(nodes) - 2, 1.0), 1e-12)
         spring = GAIN / G
         length = float(np.sum(np.linalg.norm(np.diff(tree.rest_positions[nodes], axis=0), axis=1)))
         length += float(tree.lamina_length[obj])
-        return cls(object=int(obj), node=int(nodes[k]), s=float(s[k]), offset=offset, plane_point=point.copy(),
+        return cls(object=int(obj), node=int(nodes[k]), s=s, offset=offset, plane_point=point.copy(),
                    plane_normal=np.asarray(plane_normal, float).copy(), target=point.copy(), k=spring,
                    f_max=spring * MAX_LENGTHS * length, force=np.zeros(3), ratio=G / G_tip)
 
     def aim(self, origin, direction) -> None:
         """Move the target to where the ray from ``origin`` along ``direction`` meets the
         plane (kept where the ray runs along the plane; never behind the origin)."""
-        o, d = np.asarray(origin, float), np.asarray(direction, float)
-        denom = float(d @ self.plane_normal)
-        if abs(denom) < 1e-9:
-            return
-        t = float((self.plane_point - o) @ self.plane_normal) / denom
-        self.target = o + max(t, 0.0) * d
+        t = _aim(self.plane_point, self.plane_normal, origin, direction)
+        if t is not None:
+            self.target = t
 
     def anchor(self, sim) -> np.ndarray:
         """Where the grabbed point is now (world), from ``sim``'s pose."""
