@@ -26,13 +26,12 @@ def make_simulation(args):
 
     tree = load_any(args.preset, args)
     try:
-        check_pulls(args.pull, tree.n_objects)
+        check_pulls(opt.scheduled(args), tree.n_objects, opt.model(args))
         wind = None
         kw = opt.wind_settings(args)
         if kw["speed"] > 0:
             wind = ta.WindField(**kw)
-        sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed,
-                            load_path=not getattr(args, "paper", False))
+        sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed, model=opt.model(args))
     except ValueError as e:
         raise UsageError(str(e)) from None
     return tree, sim
@@ -68,7 +67,7 @@ def cmd_export(args) -> int:
     if fade >= n:
         raise UsageError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
     try:
-        keys = export.bake(sim, skel, n + fade, args.fps, args.pull, quiet=args.quiet)
+        keys = export.bake(sim, skel, n + fade, args.fps, opt.scheduled(args), quiet=args.quiet)
     except ValueError as e:
         raise UsageError(str(e)) from None
     doc, data = export.build_gltf(tree, export.crossfade_loop(keys, fade), args.fps, season=args.season,
@@ -106,7 +105,8 @@ def cmd_render(args) -> int:
     seconds = args.seconds if args.seconds is not None else (
         render.STILL_SECONDS if target.kind == "still" else 5.0)
     w, h = args.size
-    job = render.RenderJob(target, w, h, args.fps, seconds, start=args.start, season=args.season, pulls=args.pull,
+    job = render.RenderJob(target, w, h, args.fps, seconds, start=args.start, season=args.season,
+                           pulls=opt.scheduled(args),
                            azimuth=args.azimuth, elevation=args.elevation, distance=args.distance,
                            samples=args.samples, quiet=args.quiet)
     opt.check_frames(args.start + seconds, args.fps)
@@ -140,7 +140,7 @@ def cmd_render(args) -> int:
 
 
 def cmd_trace(args) -> int:
-    """Pull one object's tip, let go, and record the tip's free swing as CSV (and a plot)."""
+    """Pull (or drag) one object's tip, let go, and record the tip's free swing as CSV (and a plot)."""
     import numpy as np
 
     from treeanim.offline import trace
@@ -152,28 +152,32 @@ def cmd_trace(args) -> int:
             import matplotlib  # noqa: F401
         except ImportError:
             raise UsageError(f"--plot {trace.PLOTS_HINT}") from None
+    if args.drag is not None and args.paper:
+        raise UsageError("--drag needs the tree model, not --paper (the paper's objects are independent: use --pull)")
     scene = argparse.Namespace(**vars(args))
-    scene.pull = []
+    scene.pull, scene.drag = [], []
     tree, sim = make_simulation(scene)
     if not 0 <= args.object < tree.n_objects:
         raise UsageError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
     opt.check_frames(args.hold + args.seconds, args.rate, step_rate=0.0)  # a trace steps once a sample
-    tr = trace.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate)
+    tr = trace.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate, drag=args.drag)
     trace.write_trace_csv(out, tr)
     if plot is not None:
-        trace.plot_trace(plot, tr, title=f"{tree.name}: pull {','.join(f'{v:g}' for v in args.pull)} N, "
-                                         f"released after {args.hold:g} s")
+        held = (f"pull {','.join(f'{v:g}' for v in args.pull)} N" if args.drag is None
+                else f"drag to {','.join(f'{v:g}' for v in args.drag)} m")
+        trace.plot_trace(plot, tr, title=f"{tree.name}: {held}, released after {args.hold:g} s")
     d = tr.tips - tr.rest
-    f, z = tr.f, tr.zeta
     fx = trace.zero_crossing_frequency(tr.times, d[:, 0] - d[-len(d) // 4:, 0].mean())
     fz = trace.zero_crossing_frequency(tr.times, d[:, 2] - d[-len(d) // 4:, 2].mean())
     print(f"wrote {out}: {len(tr.times)} samples of object {args.object} ({tr.kind})'s tip over {args.seconds:g} s "
           f"after release at {args.rate:g} Hz" + (f"; plot {plot}" if plot else ""))
     crossing = ", ".join(f"{axis} {hz:.3f} Hz" if np.isfinite(hz) else f"{axis} too few to tell"
                          for axis, hz in (("x", fx), ("z", fz)))
-    print(f"held deflection {np.linalg.norm(tr.held - tr.rest) * 100:.1f} cm; modes f u,v,w = "
-          f"{f[0]:.3f}, {f[1]:.3f}, {f[2]:.3f} Hz, ζ = {z[0]:.3f}, {z[1]:.3f}, {z[2]:.3f}; "
-          f"zero crossings: {crossing}")
+    modes = ""
+    if tr.f is not None:  # the paper's model: the object's own modes
+        f, z = tr.f, tr.zeta
+        modes = f"modes f u,v,w = {f[0]:.3f}, {f[1]:.3f}, {f[2]:.3f} Hz, ζ = {z[0]:.3f}, {z[1]:.3f}, {z[2]:.3f}; "
+    print(f"held deflection {np.linalg.norm(tr.held - tr.rest) * 100:.1f} cm; {modes}zero crossings: {crossing}")
     return 0
 
 
@@ -249,7 +253,7 @@ def cmd_info(args) -> int:
     key = tree.name + ("@winter" if args.season >= 1.0 and tree.name == "large_cherry" else "")
     paper = {row[0]: row for row in TABLE1.get(key, [])}
     params = tree.physics
-    modal = ta.Simulation(tree, season=args.season).modes if tree.modes == "physical" else None
+    modal = ta.Simulation(tree, season=args.season, model="paper").modes if tree.modes == "physical" else None
     print(f"{tree.name} (season {args.season:g}, seed {tree.seed}) — {tree.source}")
     print(f"{'object type':<12}{'objects':>16}{'nodes':>18}{'triangles':>22}   f range      ζ range")
     print(f"{'':<12}{'ours / paper':>16}{'ours / paper':>18}{'ours / paper':>22}")
@@ -332,14 +336,18 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_render)
 
     p = sub.add_parser(
-        "trace", help="pull one object's tip, let go, and record its trace (CSV, optional plot)",
-        description="Pull object OBJECT's tip with a constant world force until it sits at its static "
-        "deflection, let go, and record the tip's position (t, x, y, z) for --seconds at --rate samples per "
-        "second: the Lissajous / harmonograph trace of the paper's Figs. 1 and 4.")
+        "trace", help="pull (or drag) one object's tip, let go, and record its trace (CSV, optional plot)",
+        description="Pull object OBJECT's tip with a constant world force (or drag it toward a world point, "
+        "the tree model only) until it sits at its static deflection, let go, and record the tip's position "
+        "(t, x, y, z) for --seconds at --rate samples per second: the Lissajous / harmonograph trace of the "
+        "paper's Figs. 1 and 4.")
     p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
     p.add_argument("--object", type=int, default=0, metavar="I", help="object index (default 0, e.g. the beam)")
-    p.add_argument("--pull", type=opt.vector("force", force=True), required=True, metavar="FX,FY,FZ",
-                   help="world force on the tip in newtons, e.g. 1.5,0,1.2 for the beam")
+    held = p.add_mutually_exclusive_group(required=True)
+    held.add_argument("--pull", type=opt.vector("force", force=True), metavar="FX,FY,FZ",
+                      help="world force on the tip in newtons, e.g. 1.5,0,1.2 for the beam")
+    held.add_argument("--drag", type=opt.vector("target"), metavar="X,Y,Z",
+                      help="drag the tip toward this world point (m) instead (the tree model only)")
     p.add_argument("--hold", type=opt.positive(float), default=2.0, metavar="SECONDS",
                    help="how long the pull is held before release (default 2)")
     p.add_argument("--seconds", type=opt.positive(float), default=10.0, help="seconds recorded after release (default 10)")
@@ -349,6 +357,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--plot", default=None, metavar="FILE",
                    help="also plot the horizontal (x-z) trace: .png, .svg or .pdf (needs matplotlib)")
     opt.add_wind_options(p, wind=0.0)  # calm by default: a free swing
+    opt.add_model_option(p)
     p.set_defaults(func=cmd_trace)
 
     p = sub.add_parser(

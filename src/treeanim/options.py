@@ -80,6 +80,13 @@ def pull(text: str):
     return checked(parse_pull)(text)
 
 
+def drag(text: str):
+    """An argparse type: ``OBJECT[@S]:X,Y,Z@T0-T1`` (:func:`treeanim.scripted.parse_drag`)."""
+    from treeanim.scripted import parse_drag
+
+    return checked(parse_drag)(text)
+
+
 def wind_speed(text: str) -> float:
     """An argparse type: a wind speed from 0 to the wind field's largest, m/s."""
     from treeanim.physics.wind import MAX_SPEED
@@ -96,8 +103,8 @@ def add_season_option(p: argparse.ArgumentParser) -> None:
                    help=f"a TreeQSM model's leaves along its twigs: none (default) or {', '.join(SPECIES)}, "
                    "optionally with leaves per metre of twig (e.g. cherry:80)")
     p.add_argument("--modes", choices=["paper", "physical"], default=None,
-                   help="modal f and zeta: paper (Eqs. 20-22; the presets' default) or physical (beam theory; "
-                   "TreeQSM models' default)")
+                   help="the paper's model's modal f and zeta: paper (Eqs. 20-22; the presets' default) or "
+                   "physical (beam theory; TreeQSM models' default)")
 
 
 def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
@@ -159,9 +166,28 @@ def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, f
     add_wind_options(p)
     p.add_argument("--pull", type=pull, action="append", default=[], metavar="OBJECT:FX,FY,FZ@T0-T1",
                    help="pull OBJECT's tip with a world force in newtons from T0 to T1 s, then let go; repeatable")
+    p.add_argument("--drag", type=drag, action="append", default=[], metavar="OBJECT[@S]:X,Y,Z@T0-T1",
+                   help="drag OBJECT's tip (or the point at fraction S of its length) toward the world point "
+                   "X,Y,Z (m) from T0 to T1 s, then let go; repeatable, one at a time; the tree model only")
+    add_model_option(p)
+
+
+def add_model_option(p: argparse.ArgumentParser) -> None:
+    """--paper: the simulation's model (the tree model by default)."""
     p.add_argument("--paper", action="store_true",
-                   help="the paper's model: every object on its own, linear drag, the paper's wind field "
-                   "(default: the load path in the physical wind)")
+                   help="the paper's model (Hu, Chiba & He 2012): every object on its own, driven by modal "
+                   "oscillators, in the paper's wind field (default: the tree model, the whole tree as one "
+                   "structure, in the physical wind)")
+
+
+def model(args) -> str:
+    """The Simulation's ``model`` from :func:`add_model_option`."""
+    return "paper" if getattr(args, "paper", False) else "tree"
+
+
+def scheduled(args) -> list:
+    """The --pull and --drag items of :func:`add_scene_options`, for :func:`treeanim.scripted.frames`."""
+    return [*getattr(args, "pull", []), *getattr(args, "drag", [])]
 
 
 def check_frames(seconds: float, fps: float, step_rate: float = 60.0) -> int:

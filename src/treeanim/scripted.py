@@ -1,7 +1,12 @@
-"""Scripted runs for the offline commands: scheduled pulls and fixed-rate frames.
+"""Scripted runs for the offline commands: scheduled pulls and drags, and fixed-rate frames.
 
 ``--pull OBJECT:FX,FY,FZ@T0-T1`` pulls object OBJECT's tip with a world force (newtons) from
-time T0 and lets go at T1; several pulls may be given.
+time T0 and lets go at T1; several pulls may be given (either model).
+
+``--drag OBJECT[@S]:X,Y,Z@T0-T1`` drags the point at fraction S of object OBJECT's length (its
+tip, S = 1, by default) toward the world point X,Y,Z (metres) from T0 and lets go at T1, through
+:meth:`Simulation.drag <treeanim.physics.simulation.Simulation.drag>` (the tree model only);
+several drags may be given, one at a time.
 """
 
 from __future__ import annotations
@@ -16,6 +21,7 @@ import numpy as np
 from .clock import STEP, StepClock
 
 _PULL = re.compile(r"^\s*(\d+)\s*:\s*([^@]+?)\s*@\s*([^-]+?)\s*-\s*(.+?)\s*$")
+_DRAG = re.compile(r"^\s*(\d+)\s*(?:@\s*([^:]+?)\s*)?:\s*([^@]+?)\s*@\s*([^-]+?)\s*-\s*(.+?)\s*$")
 
 
 @dataclass(frozen=True)
@@ -26,6 +32,18 @@ class Pull:
     force: tuple[float, float, float]
     start: float
     end: float
+
+
+@dataclass(frozen=True)
+class Drag:
+    """A drag of the point at fraction ``s`` of ``obj``'s length toward world ``target`` (m)
+    from ``start`` to ``end`` seconds (the tree model's :meth:`Simulation.drag`)."""
+
+    obj: int
+    target: tuple[float, float, float]
+    start: float
+    end: float
+    s: float = 1.0
 
 
 def parse_vector(text: str, what: str) -> tuple[float, float, float]:
@@ -73,36 +91,83 @@ def parse_pull(text: str) -> Pull:
     return Pull(int(m.group(1)), force, t0, t1)
 
 
-def check_pulls(pulls: list[Pull], n_objects: int) -> None:
-    """Refuse a pull on an object the tree does not have."""
+def parse_drag(text: str) -> Drag:
+    """Parse ``OBJECT[@S]:X,Y,Z@T0-T1`` (S, the fraction of the object's length held, in
+    [0, 1]; default 1, the tip).
+
+    Raises
+    ------
+    ValueError
+        With a message that repeats the expected form.
+    """
+    form = "expected OBJECT[@S]:X,Y,Z@T0-T1, e.g. 0:0.3,1.2,0@0.5-2 or 0@0.5:0.3,1.2,0@0.5-2"
+    m = _DRAG.match(text)
+    if not m:
+        raise ValueError(f"--drag {text!r}: {form}")
+    target = parse_vector(m.group(3), f"--drag {text!r}")
+    try:
+        s = 1.0 if m.group(2) is None else float(m.group(2))
+        t0, t1 = float(m.group(4)), float(m.group(5))
+    except ValueError:
+        raise ValueError(f"--drag {text!r}: {form}") from None
+    if not 0.0 <= s <= 1.0:
+        raise ValueError(f"--drag {text!r}: expected S in [0, 1] (the fraction of the object's length)")
+    if not (math.isfinite(t0) and math.isfinite(t1) and 0 <= t0 < t1):
+        raise ValueError(f"--drag {text!r}: expected times 0 <= T0 < T1")
+    return Drag(int(m.group(1)), target, t0, t1, s)
+
+
+def check_pulls(pulls: list, n_objects: int, model: str = "tree") -> None:
+    """Refuse a pull or drag on an object the tree does not have, a drag on a model other than
+    the tree model, and drags whose intervals overlap (the tree holds one drag at a time)."""
+    drags = sorted((p for p in pulls if isinstance(p, Drag)), key=lambda d: d.start)
     for p in pulls:
+        option = "--drag" if isinstance(p, Drag) else "--pull"
         if not 0 <= p.obj < n_objects:
-            raise ValueError(f"--pull on object {p.obj}: the tree has objects 0 to {n_objects - 1}")
+            raise ValueError(f"{option} on object {p.obj}: the tree has objects 0 to {n_objects - 1}")
+    if drags and model != "tree":
+        raise ValueError("--drag needs the tree model, not --paper (the paper's objects are independent: "
+                         "use --pull)")
+    for a, b in zip(drags, drags[1:]):
+        if b.start < a.end:
+            raise ValueError(f"--drag: the drags at {a.start:g}-{a.end:g} s and {b.start:g}-{b.end:g} s overlap; "
+                             f"the tree holds one drag at a time")
 
 
-def frames(sim, seconds: float, fps: float, pulls: list[Pull] = (), step: float = STEP) -> Iterator[int]:
+def frames(sim, seconds: float, fps: float, pulls: list = (), step: float = STEP) -> Iterator[int]:
     """Advance ``sim`` to each frame time k / fps for k = 0 .. round(seconds * fps) - 1.
 
     Yields the frame index once the simulation is within half a ``step`` of that frame's time:
     it steps by ``step`` on the viewer's clock (:class:`~treeanim.clock.StepClock`).
-    Before every step, exactly the pulls whose interval [T0, T1) holds the step's start time
-    are held (pulls on different objects may overlap); the others are let go.
+    ``pulls`` holds :class:`Pull` and :class:`Drag` items. Before every step, exactly the
+    pulls and the drag whose interval [T0, T1) holds the step's start time are held (pulls on
+    different objects may overlap; drags may not, see :func:`check_pulls`); the others are let
+    go.
     """
     n = int(round(seconds * fps))
     clock = StepClock(step)
+    forces = [p for p in pulls if not isinstance(p, Drag)]
+    drags = [p for p in pulls if isinstance(p, Drag)]
     held: dict[int, tuple[float, float, float]] = {}
+    dragged: Drag | None = None
     t = 0.0
     for k in range(n):
         for _ in range(clock.advance(1.0 / fps if k else 0.0)):
-            want = {p.obj: p.force for p in pulls if p.start <= t < p.end}
-            for obj in held.keys() - want.keys():
+            want = {p.obj: p.force for p in forces if p.start <= t < p.end}
+            drag = next((d for d in drags if d.start <= t < d.end), None)
+            gone = held.keys() - want.keys()  # release() lets go of an object's pull and drag
+            if dragged is not None and (drag is None or drag.obj != dragged.obj):
+                gone |= {dragged.obj}
+            for obj in sorted(gone):
                 sim.release(obj)
             for obj, force in want.items():
-                if held.get(obj) != force:
+                if obj in gone or held.get(obj) != force:
                     sim.pull(obj, np.asarray(force, float))
-            held = want
+            if drag is not None and (drag != dragged or drag.obj in gone):
+                sim.drag(drag.obj, np.asarray(drag.target, float), drag.s)
+            held, dragged = want, drag
             sim.step(step)
             t += step
         yield k
-    for obj in held:
+    for obj in sorted(held.keys() | ({dragged.obj} if dragged is not None else set())):
         sim.release(obj)

@@ -1,5 +1,5 @@
-"""``treeanim trace``: pull one object's tip, let go, and record its free swing (the paper's
-Figs. 1 and 4) as CSV and, with matplotlib, a plot."""
+"""``treeanim trace``: pull (or drag) one object's tip, let go, and record its free swing (the
+paper's Figs. 1 and 4) as CSV and, with matplotlib, a plot."""
 
 from __future__ import annotations
 
@@ -18,7 +18,9 @@ PLOTS_HINT = "needs matplotlib: .venv/bin/pip install -e '.[plots]' (from the re
 
 @dataclass
 class TraceResult:
-    """A tip trace after release: ``times`` (T,) from 0 at release, ``tips`` (T, 3) world."""
+    """A tip trace after release: ``times`` (T,) from 0 at release, ``tips`` (T, 3) world;
+    ``f`` and ``zeta`` the object's modes (u, v, w) on the paper's model, None on the tree model
+    (whose frequencies are the whole structure's)."""
 
     times: np.ndarray
     tips: np.ndarray
@@ -26,14 +28,15 @@ class TraceResult:
     held: np.ndarray
     obj: int
     kind: str
-    f: np.ndarray
-    zeta: np.ndarray
+    f: np.ndarray | None
+    zeta: np.ndarray | None
 
 
-def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float) -> TraceResult:
-    """Pull object ``obj``'s tip with ``force`` (N, world) for ``hold`` seconds (the held object
-    sits at its static deflection; the rest of the tree settles), let go, and record the tip
-    for ``seconds`` at ``rate`` samples per second.
+def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float, drag=None) -> TraceResult:
+    """Pull object ``obj``'s tip with ``force`` (N, world) — or, with ``drag`` (a world point,
+    the tree model), drag the tip toward it (:meth:`Simulation.drag`) — for ``hold`` seconds
+    (the held object sits at its static deflection; the rest of the tree settles), let go, and
+    record the tip for ``seconds`` at ``rate`` samples per second.
 
     Raises
     ------
@@ -54,14 +57,20 @@ def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float) ->
     dt = 1.0 / rate
     tree = sim.tree
     tip = int(tree.object_start[obj] + tree.object_count[obj] - 1)
-    sim.pull(obj, np.asarray(force, float))
+    if drag is not None:
+        sim.drag(obj, np.asarray(drag, float), 1.0)
+    else:
+        sim.pull(obj, np.asarray(force, float))
     for _ in range(max(1, int(round(hold / dt)))):
         sim.step(dt)
     held = sim.tip_position(obj)
     sim.release()
     times, tips = trace_tips(sim, [obj], seconds, dt)
+    f = zeta = None
+    if sim.model == "paper":
+        f, zeta = np.array(sim.modes.f[obj], float), np.array(sim.modes.zeta[obj], float)
     return TraceResult(times - times[0], tips[:, 0], np.asarray(tree.rest_positions[tip], float), held, obj,
-                       str(tree.kind[obj]), np.array(sim.modes.f[obj], float), np.array(sim.modes.zeta[obj], float))
+                       str(tree.kind[obj]), f, zeta)
 
 
 def write_trace_csv(path: Path, trace: TraceResult) -> None:
@@ -106,9 +115,10 @@ def plot_trace(path: Path, trace: TraceResult, title: str = "") -> None:
     ax.legend(loc="upper right", frameon=False, fontsize=8)
     sm = plt.cm.ScalarMappable(cmap=cmap, norm=plt.Normalize(0, t[-1]))
     fig.colorbar(sm, ax=ax, fraction=0.046, pad=0.04, label="time after release (s)")
-    f, z_ = trace.f, trace.zeta
-    sub = (f"object {trace.obj} ({trace.kind}): f u,v,w = {f[0]:.3f}, {f[1]:.3f}, {f[2]:.3f} Hz; "
-           f"ζ = {z_[0]:.3f}, {z_[1]:.3f}, {z_[2]:.3f}")
+    sub = f"object {trace.obj} ({trace.kind})"
+    if trace.f is not None:
+        f, z_ = trace.f, trace.zeta
+        sub += f": f u,v,w = {f[0]:.3f}, {f[1]:.3f}, {f[2]:.3f} Hz; ζ = {z_[0]:.3f}, {z_[1]:.3f}, {z_[2]:.3f}"
     ax.set_title((title + "\n" if title else "") + sub, fontsize=9)
     fig.tight_layout()
     suffix = Path(path).suffix.lower()
