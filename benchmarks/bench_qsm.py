@@ -72,7 +72,7 @@ def trunk(table, leaves=None) -> tuple[float, float]:
     import treeanim as ta
     from treeanim.model.qsm import build_tree
 
-    sim = ta.Simulation(build_tree(table, leaves=leaves))
+    sim = ta.Simulation(build_tree(table, leaves=leaves), model="paper")  # its modes (beam theory)
     return float(sim.modes.f[0, 0]), float(sim.modes.zeta[0, 0])
 
 
@@ -123,7 +123,7 @@ def main() -> None:
           f"{t_leaf:.3f} s")
     t0 = time.perf_counter()
     ta.Simulation(bare)
-    print(f"Simulation set-up (physical modes): {time.perf_counter() - t0:.3f} s")
+    print(f"Simulation set-up (tree model): {time.perf_counter() - t0:.3f} s")
     print(f"step, 1/60 s, 5 m/s: leafless {step_ms(bare, args.steps):.2f} ms, in leaf "
           f"{step_ms(leafy, args.steps // 4):.2f} ms (real time: under 16.7 ms)")
 
@@ -132,7 +132,7 @@ def main() -> None:
         w = WOOD_TYPES[wood]
         pts = np.column_stack([np.zeros(n + 1), np.linspace(0, L, n + 1), np.zeros(n + 1)])
         tree = assemble([ObjectSpec(pts, np.full(n + 1, D))], name="c", physics=PhysicsParams(**w))
-        f = ta.Simulation(tree, modes="physical").modes.f[0, 0]
+        f = ta.Simulation(tree, model="paper", modes="physical").modes.f[0, 0]
         E, rho = w["wood_youngs_modulus"], w["wood_density"]
         f_th = 1.875104**2 / (2 * np.pi) * np.sqrt(E * (np.pi * D**4 / 64) / (rho * (np.pi * D**2 / 4) * L**4))
         print(f"  L {L:g} m, D {D:g} m, {n} segments, {wood}: {f:.4f} Hz / {f_th:.4f} Hz = {f / f_th:.4f}")
@@ -152,7 +152,7 @@ def main() -> None:
     for leaves in ("cherry", "cherry:120", "cherry:200", "tulip_poplar"):
         f, z = trunk(table, leaves)
         print(f"  --leaves {leaves:<15} f {f:.3f} Hz ({100 * (f / f0 - 1):+.1f} %)  zeta {z:.3f} ({z / z0:.2f}x)")
-    print("\nmeasured in the simulation: the trunk pulled and released in calm air (whole tree, load path)")
+    print("\nmeasured in the simulation: the trunk pulled and released in calm air (the tree model)")
     from treeanim.model.qsm import build_tree
 
     f0, z0 = released(build_tree(table))

@@ -15,10 +15,11 @@ For each preset it runs ``--warmup`` steps, then times ``--steps`` steps of 1/60
 Each is reported as the median wall time, its 90th percentile, and the median CPU time of the
 thread (``cpu``), which a busy shared machine disturbs much less than the wall clock.
 
-Each preset is timed twice: with the paper's model (``load_path=False``, each object on its
-own) and with the load path (the default, DESIGN §12), whose ratio to the paper's step is the
-last column (issue #10: at most 1.3). ``--falling`` adds a row for the load path while the
-leaves fall after the season jumps to winter (issue #12), timed from the moment they let go.
+Each preset is timed twice: with the paper's model (``model="paper"``, each object on its own)
+and with the tree model (``model="tree"``, the default: the whole tree as one implicit
+structure, docs/design.md §12), whose ratio to the paper's step is the last column.
+``--falling`` adds a row for the tree model while the leaves fall after the season jumps to
+winter (issue #12), timed from the moment they let go.
 
 Targets (issue #4): large_cherry <= 3 ms, grassland <= 2 ms, small_cherry <= 1 ms per step.
 Where a preset cannot be loaded (presets not installed) a synthetic tree of the same size is
@@ -91,12 +92,12 @@ def load(name: str):
         return synthetic(name), True
 
 
-def bench(tree, steps: int, warmup: int, speed: float, dt: float, load_path: bool = True,
+def bench(tree, steps: int, warmup: int, speed: float, dt: float, model: str = "tree",
           falling: bool = False) -> dict:
     from treeanim.physics.simulation import Simulation
     from treeanim.physics.wind import WindField
 
-    sim = Simulation(tree, wind=WindField(speed=speed, seed=1), load_path=load_path)
+    sim = Simulation(tree, wind=WindField(speed=speed, seed=1), model=model)
     for _ in range(warmup):
         sim.step(dt)
     if falling:  # the season slider to winter: the leaves let go (each timing loop starts so)
@@ -137,7 +138,7 @@ def main(argv=None) -> None:
     ap.add_argument("--speed", type=float, default=5.0, help="wind speed at the tree top (m/s)")
     ap.add_argument("--dt", type=float, default=1 / 60)
     ap.add_argument("--falling", action="store_true",
-                    help="also time the load path while the leaves fall (season set to winter after the "
+                    help="also time the tree model while the leaves fall (season set to winter after the "
                          "warm-up; use --steps of about 2 s, while they are in the air)")
     args = ap.parse_args(argv)
     print(f"# {platform.processor() or platform.machine()}, Python {platform.python_version()}, "
@@ -148,9 +149,9 @@ def main(argv=None) -> None:
     for name in args.presets:
         tree, synth = load(name)
         paper_cpu = None
-        models = ("paper", "load path") + (("leaves falling",) if args.falling and (tree.kind == "leaf").any() else ())
+        models = ("paper", "tree") + (("leaves falling",) if args.falling and (tree.kind == "leaf").any() else ())
         for model in models:
-            r = bench(tree, args.steps, args.warmup, args.speed, args.dt, load_path=model != "paper",
+            r = bench(tree, args.steps, args.warmup, args.speed, args.dt, model="paper" if model == "paper" else "tree",
                       falling=model == "leaves falling")
             label = f"{name}{' (synthetic)' if synth else ''}, {model}"
             target = TARGETS_MS.get(name)

@@ -70,7 +70,7 @@ def pull_and_release(f_u: float, f_w: float, zeta_u: float, zeta_w: float, angle
     sim : Simulation
     """
     tree = beam_tree()
-    sim = Simulation(tree)
+    sim = Simulation(tree, model="paper")  # the paper's modal oscillators, set per object
     sim.modes.f[0] = (f_u, f_u, f_w)
     sim.modes.zeta[0] = (zeta_u, zeta_u, zeta_w)
     frame = rest_frames(tree)[0]  # the beam's rest (u, v, w), Eq. 1
