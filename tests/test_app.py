@@ -448,6 +448,46 @@ def test_panel_slider_and_checkbox_change_the_scene(viewer):
     v.show_wind = False
 
 
+def test_the_model_switch_shows_the_papers_settings_and_survives_a_new_tree(viewer):
+    """The panel's 'paper's model' checkbox: the integrator, the coupling and the modal ranges
+    are drawn (and taken) with the paper's model only; a new tree keeps the model and the
+    paper's settings."""
+    v, p = viewer, viewer.panel
+    v.show_panel = True
+    v.frame(DT)
+    v.frame(DT)
+    assert v.sim.model == "tree"
+    rects = v.panel.item_rects
+    assert "paper's model (Hu et al. 2012)" in rects, sorted(rects)
+    for label in ("integrator", "coupling", "f branch", "zeta branch", "physical modes (beam theory)"):
+        assert label not in rects, label
+    for name, value in (("integrator", "euler"), ("coupling", False), ("physical_modes", True)):
+        assert not p.apply(name, value)  # refused on the tree model: one line, nothing raised
+        assert v.messages[-1].startswith("error:") and "model='paper'" in v.messages[-1], v.messages[-1]
+        assert "\n" not in v.messages[-1]
+    _click(v, *_reveal(v, "paper's model (Hu et al. 2012)"))  # the checkbox itself
+    assert v.sim.model == "paper"
+    v.frame(DT)
+    for label in ("integrator", "coupling", "f branch", "zeta branch", "physical modes (beam theory)"):
+        assert label in v.panel.item_rects, label
+    assert p.apply("integrator", "euler") and p.apply("coupling", False)
+    v.set_wind(speed=4.0)
+    assert p.apply("preset", "beam")
+    assert v.sim.model == "paper" and v.sim.integrator == "euler" and not v.sim.coupling and v.sim.wind.speed == 4.0
+    assert p.apply("paper_model", False) and v.sim.model == "tree"
+    assert p.apply("preset", "small_cherry") and v.sim.model == "tree"
+    assert p.apply("paper_model", True) and v.sim.integrator == "euler" and not v.sim.coupling  # remembered
+    assert v.frame(DT) and v.ctx.error == "GL_NO_ERROR"
+    p.apply("integrator", "exact")
+    p.apply("coupling", True)
+    p.apply("paper_model", False)
+    v.on_cursor_pos(150, H / 2)  # the panel back at its top
+    v.frame(DT)
+    v.on_scroll(0.0, 30.0)
+    v.frame(DT)
+    v.frame(DT)
+
+
 def test_panel_light_moves_the_sun_and_its_shadow_and_survives_a_new_tree(viewer):
     v = viewer
     v.show_panel = True
@@ -531,46 +571,6 @@ def test_panel_apply_sets_physics_season_and_time(viewer):
     for _ in range(2):
         assert v.frame(DT)
     p.apply("season", 0.0)
-
-
-def test_the_model_switch_shows_the_papers_settings_and_survives_a_new_tree(viewer):
-    """The panel's 'paper's model' checkbox: the integrator, the coupling and the modal ranges
-    are drawn (and taken) with the paper's model only; a new tree keeps the model and the
-    paper's settings."""
-    v, p = viewer, viewer.panel
-    v.show_panel = True
-    v.frame(DT)
-    v.frame(DT)
-    assert v.sim.model == "tree"
-    rects = v.panel.item_rects
-    assert "paper's model (Hu et al. 2012)" in rects, sorted(rects)
-    for label in ("integrator", "coupling", "f branch", "zeta branch", "physical modes (beam theory)"):
-        assert label not in rects, label
-    for name, value in (("integrator", "euler"), ("coupling", False), ("physical_modes", True)):
-        assert not p.apply(name, value)  # refused on the tree model: one line, nothing raised
-        assert v.messages[-1].startswith("error:") and "model='paper'" in v.messages[-1], v.messages[-1]
-        assert "\n" not in v.messages[-1]
-    _click(v, *_reveal(v, "paper's model (Hu et al. 2012)"))  # the checkbox itself
-    assert v.sim.model == "paper"
-    v.frame(DT)
-    for label in ("integrator", "coupling", "f branch", "zeta branch", "physical modes (beam theory)"):
-        assert label in v.panel.item_rects, label
-    assert p.apply("integrator", "euler") and p.apply("coupling", False)
-    v.set_wind(speed=4.0)
-    assert p.apply("preset", "beam")
-    assert v.sim.model == "paper" and v.sim.integrator == "euler" and not v.sim.coupling and v.sim.wind.speed == 4.0
-    assert p.apply("paper_model", False) and v.sim.model == "tree"
-    assert p.apply("preset", "small_cherry") and v.sim.model == "tree"
-    assert p.apply("paper_model", True) and v.sim.integrator == "euler" and not v.sim.coupling  # remembered
-    assert v.frame(DT) and v.ctx.error == "GL_NO_ERROR"
-    p.apply("integrator", "exact")
-    p.apply("coupling", True)
-    p.apply("paper_model", False)
-    v.on_cursor_pos(150, H / 2)  # the panel back at its top
-    v.frame(DT)
-    v.on_scroll(0.0, 30.0)
-    v.frame(DT)
-    v.frame(DT)
 
 
 def test_switching_the_model_mid_drag_lets_go(viewer):

@@ -1,6 +1,7 @@
 """Offline output (issue #6): `treeanim render` videos, frames and stills read back, Ctrl-C
-keeping a playable file, `treeanim trace` carrying the beam's modal frequencies, `treeanim
-bench` reporting every preset, and bad input refused with one line and no file.
+keeping a playable file, `treeanim trace --paper` carrying the beam's modal frequencies (and a
+trace of the tree model, pulled or dragged), `treeanim bench` reporting every preset, and bad
+input refused with one line and no file.
 
 Everything renders for real through EGL (Mesa llvmpipe in CI), at small sizes.
 """
@@ -159,17 +160,18 @@ def test_ctrl_c_keeps_a_playable_video(tmp_path):
 
 # ------------------------------------------------------------------------------ trace
 def test_trace_after_release_has_the_beams_modal_frequencies(tmp_path):
+    """The paper's model (--paper): the beam swings at its own modes."""
     tree = ta.load_preset("beam")
     rest_tip = tree.rest_positions[tree.object_nodes(0)[-1]]
     # A diagonal pull bending the tip by ~8 % of the beam's length (the linear range), sized
     # from the preset's own stiffness by a small probe pull.
-    probe = ta.Simulation(tree)
+    probe = ta.Simulation(tree, model="paper")
     probe.pull(0, (1.0, 0.0, 0.8))
     probe.step(30.0)  # a held pull settles (critically damped): one long step reaches it
     length = np.linalg.norm(np.diff(tree.rest_positions[tree.object_nodes(0)], axis=0), axis=1).sum()
     force = np.array([1.0, 0.0, 0.8]) * 0.08 * length / np.linalg.norm(probe.tip_position(0) - rest_tip)
-    res = treeanim("trace", "beam", "--pull", ",".join(f"{v:.6g}" for v in force), "--seconds", 8, "--out", "trace.csv",
-                   "--plot", "trace.png", cwd=tmp_path)
+    res = treeanim("trace", "beam", "--paper", "--pull", ",".join(f"{v:.6g}" for v in force), "--seconds", 8,
+                   "--out", "trace.csv", "--plot", "trace.png", cwd=tmp_path)
     assert res.returncode == 0, res.stderr
     with open(tmp_path / "trace.csv") as fh:
         assert fh.readline().strip() == "t,x,y,z"
@@ -177,7 +179,7 @@ def test_trace_after_release_has_the_beams_modal_frequencies(tmp_path):
     t, tip = data[:, 0], data[:, 1:]
     assert t[0] == 0 and np.allclose(np.diff(t), 1 / 240, atol=2e-6) and t[-1] == pytest.approx(8, abs=1e-3)
 
-    sim = ta.Simulation(tree)
+    sim = ta.Simulation(tree, model="paper")
     f, zeta = sim.modes.f[0], sim.modes.zeta[0]  # columns u, v, w
     d = tip - rest_tip
     assert 0.04 * length < np.hypot(d[0, 0], d[0, 2]) < 0.15 * length, "released from the pull's static deflection"
@@ -199,6 +201,30 @@ def test_trace_after_release_has_the_beams_modal_frequencies(tmp_path):
     png = iio.imread(tmp_path / "trace.png")
     assert png.shape[0] > 400 and png.shape[1] > 400 and png[..., :3].std() > 10
     assert f"{f[0]:.3f}" in res.stdout
+
+
+#: The tree model's drag diverges at steps shorter than about 1/100 s (physics/treestep.py's
+#: grab; found while porting the command line): the trace's default 240 Hz.
+DRAG_DIVERGES = pytest.mark.xfail(strict=True, reason="the tree model's Simulation.drag diverges at short steps")
+
+
+@pytest.mark.parametrize("held", [["--pull", "10,0,5"], ["--drag=-0.25,1.97,0.1", "--rate", "60"],
+                                  pytest.param(["--drag=-0.25,1.97,0.1"], marks=DRAG_DIVERGES)],
+                         ids=["pull", "drag", "drag-240Hz"])
+def test_trace_of_the_tree_model_pulled_or_dragged(tmp_path, capsys, held):
+    """The tree model (the default) traces a pull or a drag of the tip toward a world point; it
+    has no per-object modes to print."""
+    out = tmp_path / "t.csv"
+    assert cli.main(["trace", "beam", *held, "--seconds", "2", "--out", str(out), "--plot", str(tmp_path / "t.png")]) == 0
+    text = capsys.readouterr().out
+    assert "modes f" not in text and "held deflection" in text and (tmp_path / "t.png").stat().st_size > 0
+    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    rest = ta.load_preset("beam").rest_positions[-1]
+    assert np.all(np.isfinite(data))
+    d0 = data[0, 1:] - rest
+    if held[0].startswith("--drag"):  # released from near the target, 10 cm beside the tip
+        assert d0[0] > 0.05 and d0[2] > 0.05
+    assert np.linalg.norm(data[-1, 1:] - rest) < np.linalg.norm(d0), "it swings back towards rest"
 
 
 def test_trace_with_fewer_than_two_samples_is_refused():

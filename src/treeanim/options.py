@@ -103,8 +103,8 @@ def add_season_option(p: argparse.ArgumentParser) -> None:
                    help=f"a TreeQSM model's leaves along its twigs: none (default) or {', '.join(SPECIES)}, "
                    "optionally with leaves per metre of twig (e.g. cherry:80)")
     p.add_argument("--modes", choices=["paper", "physical"], default=None,
-                   help="modal f and zeta: paper (Eqs. 20-22; the presets' default) or physical (beam theory; "
-                   "TreeQSM models' default)")
+                   help="the paper's model's modal f and zeta: paper (Eqs. 20-22; the presets' default) or "
+                   "physical (beam theory; TreeQSM models' default)")
 
 
 def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:

@@ -21,7 +21,7 @@ from ..clock import STEP, StepClock
 from ..model.tree import Tree
 from ..physics.pull import SpringPull, TreeDrag
 from ..physics.pull import grab as grab_object
-from ..physics.simulation import Simulation
+from ..physics.simulation import MODELS, Simulation
 from ..physics.wind import WindField
 from ..physics.wind import wind_preset as wind_preset_kwargs
 from ..render.camera import TREE_ELEVATION, OrbitCamera, frame_tree
@@ -200,17 +200,14 @@ class Viewer(ViewerInput):
         self.frame_camera()
         self.panel.tree_changed()
 
-    @property
-    def model(self) -> str:
-        """The simulation's model, 'tree' or 'paper'."""
-        return self.sim.model
-
     def set_model(self, name: str) -> None:
         """Switch the simulation to model ``name`` ('tree' or 'paper'; ValueError otherwise):
         any grab is let go and the trace cleared; the tree restarts from rest (time, wind,
         season and physics are kept)."""
         if name == self.sim.model:
             return
+        if name not in MODELS:
+            raise ValueError(f"model must be one of {tuple(MODELS)}, got {name!r}")
         if self.sim.model == "paper":
             self._integrator, self._coupling = self.sim.integrator, self.sim.coupling
         self._end_drag()
