@@ -168,10 +168,9 @@ def _branch_on_screen(v):
 
 #: The tree model's drag diverges (NaN within a few steps) on the small cherry's branches:
 #: physics/treestep.py's grab, found while porting the viewer.
-DRAG_DIVERGES = pytest.mark.xfail(strict=True, reason="the tree model's Simulation.drag diverges")
 
 
-@pytest.mark.parametrize("model", [pytest.param("tree", marks=DRAG_DIVERGES), "paper"])
+@pytest.mark.parametrize("model", ["tree", "paper"])
 def test_dragging_a_branch_moves_it_to_the_cursor_and_it_swings_back_after_release(viewer, model):
     v = viewer
     v.set_model(model)

@@ -205,11 +205,10 @@ def test_trace_after_release_has_the_beams_modal_frequencies(tmp_path):
 
 #: The tree model's drag diverges at steps shorter than about 1/100 s (physics/treestep.py's
 #: grab; found while porting the command line): the trace's default 240 Hz.
-DRAG_DIVERGES = pytest.mark.xfail(strict=True, reason="the tree model's Simulation.drag diverges at short steps")
 
 
 @pytest.mark.parametrize("held", [["--pull", "10,0,5"], ["--drag=-0.25,1.97,0.1", "--rate", "60"],
-                                  pytest.param(["--drag=-0.25,1.97,0.1"], marks=DRAG_DIVERGES)],
+                                  ["--drag=-0.25,1.97,0.1"]],
                          ids=["pull", "drag", "drag-240Hz"])
 def test_trace_of_the_tree_model_pulled_or_dragged(tmp_path, capsys, held):
     """The tree model (the default) traces a pull or a drag of the tip toward a world point; it

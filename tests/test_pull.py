@@ -31,7 +31,6 @@ def test_a_small_pull_settles_at_the_spring_share_of_the_way_on_the_paper_model(
 
 #: The tree model's drag diverges when it holds a point short of the tip (found while porting
 #: the viewer; physics/treestep.py's grab, not this controller).
-DRAG_DIVERGES = pytest.mark.xfail(strict=True, reason="the tree model's Simulation.drag diverges at s < 1")
 
 
 def _bark_point(sim, k):
@@ -61,7 +60,7 @@ def test_a_drag_on_the_tree_model_holds_the_picked_point_where_it_was_picked():
     assert sim.dragging is None
 
 
-@pytest.mark.parametrize("segment", [9, pytest.param(4, marks=DRAG_DIVERGES)], ids=["tip", "middle"])
+@pytest.mark.parametrize("segment", [9, 4], ids=["tip", "middle"])
 def test_a_drag_on_the_tree_model_brings_the_grabbed_point_to_the_cursor(segment):
     sim = ta.Simulation(ta.load_preset("beam"), wind=None)
     picked = _bark_point(sim, segment)
