@@ -343,7 +343,7 @@ def test_pick_axis_runs_through_the_rings_the_mesh_draws():
 
     tree = small_tree()
     twig = int(np.flatnonzero(tree.level == tree.level.max())[0])
-    sim = Simulation(tree)
+    sim = Simulation(tree, model="paper")  # a hard bend from a pull
     sim.pull(twig, (0.0, -40.0, 20.0))
     for _ in range(10):
         sim.step(1 / 60)

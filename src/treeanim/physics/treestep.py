@@ -21,7 +21,8 @@ from dataclasses import dataclass, fields
 import numpy as np
 from numba import njit
 
-from .articulated import add_point, articulated_step, forward_kinematics, leaf_step, pose_nodes, rot_log, theta_of
+from .articulated import add_point, articulated_step, forward_kinematics, rot_log, theta_of
+from .leafjoint import leaf_step, pose_nodes
 from .structure import Structure
 
 __all__ = ["TreeState", "Grab", "step", "pose", "energy", "sample_points", "FLUTTER_STROUHAL"]

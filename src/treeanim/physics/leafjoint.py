@@ -1,0 +1,238 @@
+"""The leaves' petiole joints on top of the articulated tree (docs/design.md §12), and the
+pose of every node: compiled passes (numba, ``cache=True``)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .articulated import _cross, rot_exp, theta_of
+
+__all__ = ["leaf_step", "pose_nodes"]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _leaf_rotation(E, th, G):
+    """G (3, 3) = exp([θ₁b₁ + θ₂b₂]×)·exp(θ₀[a]×), the leaf against its twig (E: columns a, b₁, b₂)."""
+    T = np.empty((3, 3))
+    Bm = np.empty((3, 3))
+    rot_exp(E[0, 0] * th[0], E[1, 0] * th[0], E[2, 0] * th[0], T)
+    rot_exp(E[0, 1] * th[1] + E[0, 2] * th[2], E[1, 1] * th[1] + E[1, 2] * th[2],
+            E[2, 1] * th[1] + E[2, 2] * th[2], Bm)
+    for i in range(3):
+        for j in range(3):
+            G[i, j] = Bm[i, 0] * T[0, j] + Bm[i, 1] * T[1, j] + Bm[i, 2] * T[2, j]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R, P, Om, V, U,
+              flutter, th, thd, F, X, Nrm, kap, Uh, kap2):
+    """Advance every leaf's petiole joint (bend about two axes and twist) over one step, and
+    give the force it passes to its twig for the next.
+
+    A leaf is a lamina on a petiole, its rotation against its twig exp(E·θ) (θ in the leaf's
+    own axes E = [a, b₁, b₂], a along the lever from the petiole's base to the lamina's
+    centroid: θ_a twists it, θ_b bends it). Its inertia is small next to its twig's and rides
+    on it rigidly in the articulated step; here it turns on top, driven by the normal force
+    ½ρC_nA|U_rel|(U_rel·n)n on the lamina and the twig's acceleration, held by its petiole's
+    spring and damped by the petiole and the air, by the same θ-method per axis.
+
+    The lamina's inertia rides its twig rigidly, so the twig's acceleration is not passed to
+    it (that would feed the leaf energy its twig never gives up): a leaf moves by the air
+    relative to it, its twig's motion included — for a leaf, whose drag outweighs its
+    inertia many times, the larger part. The air against the lamina's own swing damps it at
+    c·|U_rel|·r² (c = ½ρC_nA of a flat plate, r its lever: the crown shelters a leaf from the
+    wind, not from the air it moves through), at least the rate of the normal force's own
+    swing term, so in calm air the leaf and its twig together only ever lose energy.
+
+    Parameters
+    ----------
+    on : (L,) bool — leaves on the tree; body : (L,) int — the twig body each sits on.
+    base0, rc0, n0 : (L, 3) — rest offset of the petiole's base from its twig's joint, of the
+        lamina's centroid from the petiole's base, the lamina's rest normal.
+    E : (L, 3, 3) — the leaf's axes (columns a, b₁, b₂) in rest axes.
+    k, J, dstr : (L, 3) — stiffness, inertia and structural damping per axis.
+    cna : (L,) — ½ρC_nA of the lamina in the wind (the crown's sheltered coefficient).
+    cswing : (L,) — ½ρC_nA of the lamina against its own swing (a plate's coefficient).
+    roll2 : (L,) — the lamina's mean squared distance from its axis (its width²/12).
+    R, P, Om, V : the twigs' new kinematics.
+    U : (L, 3) — the wind at each lamina (m/s).
+    flutter : (L,) — the flutter's twist now (rad): its torque k_t·flutter drives the twist.
+    th, thd : (L, 3) — the state, advanced in place.
+    F : (L, 3) — written: the lamina's force (world, N) at X.
+    X : (L, 3) — written: the lamina's centroid (world) relative to its twig's joint.
+    Nrm : (L, 3) — written: the lamina's normal (world).
+    kap, Uh, kap2 : (L,), (L, 3), (L,) — written: the air's implicit damping there, the
+        force's derivative against the velocity bounded by a symmetric one,
+        h·½ρC_n·A·(|U_rel| n nᵀ + |U_rel·n| ÛÛᵀ) (backward Euler).
+    """
+    G = np.empty((3, 3))
+    RG = np.empty((3, 3))
+    for l in range(body.shape[0]):
+        if not on[l]:
+            F[l, 0] = F[l, 1] = F[l, 2] = 0.0
+            kap[l] = 0.0
+            continue
+        b = body[l]
+        _leaf_rotation(E[l], th[l], G)
+        for i in range(3):
+            for j in range(3):
+                RG[i, j] = R[b, i, 0] * G[0, j] + R[b, i, 1] * G[1, j] + R[b, i, 2] * G[2, j]
+        bx = R[b, 0, 0] * base0[l, 0] + R[b, 0, 1] * base0[l, 1] + R[b, 0, 2] * base0[l, 2]
+        by = R[b, 1, 0] * base0[l, 0] + R[b, 1, 1] * base0[l, 1] + R[b, 1, 2] * base0[l, 2]
+        bz = R[b, 2, 0] * base0[l, 0] + R[b, 2, 1] * base0[l, 1] + R[b, 2, 2] * base0[l, 2]
+        cx = RG[0, 0] * rc0[l, 0] + RG[0, 1] * rc0[l, 1] + RG[0, 2] * rc0[l, 2]
+        cy = RG[1, 0] * rc0[l, 0] + RG[1, 1] * rc0[l, 1] + RG[1, 2] * rc0[l, 2]
+        cz = RG[2, 0] * rc0[l, 0] + RG[2, 1] * rc0[l, 1] + RG[2, 2] * rc0[l, 2]
+        nx = RG[0, 0] * n0[l, 0] + RG[0, 1] * n0[l, 1] + RG[0, 2] * n0[l, 2]
+        ny = RG[1, 0] * n0[l, 0] + RG[1, 1] * n0[l, 1] + RG[1, 2] * n0[l, 2]
+        nz = RG[2, 0] * n0[l, 0] + RG[2, 1] * n0[l, 1] + RG[2, 2] * n0[l, 2]
+        xx, xy, xz = bx + cx, by + cy, bz + cz  # the centroid from the twig's joint
+        X[l, 0], X[l, 1], X[l, 2] = xx, xy, xz
+        # the twig's velocity and acceleration there
+        o = _cross(Om[b, 0], Om[b, 1], Om[b, 2], xx, xy, xz)
+        ux, uy, uz = U[l, 0] - V[b, 0] - o[0], U[l, 1] - V[b, 1] - o[1], U[l, 2] - V[b, 2] - o[2]
+        s = np.sqrt(ux * ux + uy * uy + uz * uz)
+        un = ux * nx + uy * ny + uz * nz
+        fn = cna[l] * s * un
+        fx, fy, fz = fn * nx, fn * ny, fn * nz
+        F[l, 0], F[l, 1], F[l, 2] = fx, fy, fz
+        Nrm[l, 0], Nrm[l, 1], Nrm[l, 2] = nx, ny, nz
+        kap[l] = h * cna[l] * s
+        if s > 0.0:
+            Uh[l, 0], Uh[l, 1], Uh[l, 2] = ux / s, uy / s, uz / s
+        else:
+            Uh[l, 0] = Uh[l, 1] = Uh[l, 2] = 0.0
+        kap2[l] = h * cna[l] * abs(un)
+        # torque about the petiole's base: the bends take its part about the rest axes b₁, b₂
+        # (in the twig's axes, Rᵀτ), the twist its part about the lamina's axis now (Ga): nil
+        # for a force at the centroid, which lies on that axis; the flutter drives it instead
+        t = _cross(cx, cy, cz, fx, fy, fz)
+        tl0 = R[b, 0, 0] * t[0] + R[b, 1, 0] * t[1] + R[b, 2, 0] * t[2]
+        tl1 = R[b, 0, 1] * t[0] + R[b, 1, 1] * t[1] + R[b, 2, 1] * t[2]
+        tl2 = R[b, 0, 2] * t[0] + R[b, 1, 2] * t[1] + R[b, 2, 2] * t[2]
+        lever2 = rc0[l, 0] ** 2 + rc0[l, 1] ** 2 + rc0[l, 2] ** 2
+        dair = cswing[l] * s * lever2  # the air against the lamina's own swing
+        for i in range(3):
+            kk = k[l, i]
+            ka = 0.0
+            if i == 0:  # the lamina rolling about its axis: its halves swing through the air
+                tau = kk * flutter[l]
+                d = dstr[l, i] + cswing[l] * s * roll2[l]
+            else:
+                tau = E[l, 0, i] * tl0 + E[l, 1, i] * tl1 + E[l, 2, i] * tl2
+                d = dstr[l, i] + dair
+                # the air's stiffness against a turn about this axis e (world), taken implicitly
+                # where it restores (a lamina weathervaning into the flow): −e·∂τ/∂θ with
+                # ∂r = e × r, ∂n = e × n
+                ex = R[b, 0, 0] * E[l, 0, i] + R[b, 0, 1] * E[l, 1, i] + R[b, 0, 2] * E[l, 2, i]
+                ey = R[b, 1, 0] * E[l, 0, i] + R[b, 1, 1] * E[l, 1, i] + R[b, 1, 2] * E[l, 2, i]
+                ez = R[b, 2, 0] * E[l, 0, i] + R[b, 2, 1] * E[l, 1, i] + R[b, 2, 2] * E[l, 2, i]
+                dr = _cross(ex, ey, ez, cx, cy, cz)
+                dn = _cross(ex, ey, ez, nx, ny, nz)
+                udn = ux * dn[0] + uy * dn[1] + uz * dn[2]
+                g0 = cna[l] * s * (udn * nx + un * dn[0])
+                g1 = cna[l] * s * (udn * ny + un * dn[1])
+                g2 = cna[l] * s * (udn * nz + un * dn[2])
+                t1 = _cross(dr[0], dr[1], dr[2], fx, fy, fz)
+                t2 = _cross(cx, cy, cz, g0, g1, g2)
+                ka = max(0.0, -(ex * (t1[0] + t2[0]) + ey * (t1[1] + t2[1]) + ez * (t1[2] + t2[2])))
+            kt = kk + ka
+            tl = theta_of(h * np.sqrt(kt / J[l, i]))
+            hth = h * tl
+            num = h * (tau - kk * th[l, i] - (d + hth * kt) * thd[l, i])
+            dd = num / (J[l, i] + hth * d + hth * hth * kt)
+            th[l, i] += h * (thd[l, i] + tl * dd)
+            thd[l, i] += dd
+        # a petiole bends at most to a right angle (its lamina then lies in the flow)
+        bend = np.sqrt(th[l, 1] ** 2 + th[l, 2] ** 2)
+        if bend > 0.5 * np.pi:
+            sc = 0.5 * np.pi / bend
+            th[l, 1] *= sc
+            th[l, 2] *= sc
+            thd[l, 1] *= sc
+            thd[l, 2] *= sc
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _matmul_into(A, B, out):
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf_first, leaf_body, leaf_E,
+               leaf_th, leaf_on, pos, rot):
+    """Posed node positions ``pos`` (N, 3) and rest-relative rotations ``rot`` (N, 3, 3).
+
+    Bodies: the node at each joint takes the body's rotation and position; an object's tip
+    node the last body's rotation and its end. Leaves: the petiole's k segments curl evenly,
+    segment i turning by (i + 1)/k of the leaf's bend and twist against its twig; its tip
+    node (the lamina) the whole turn.
+    """
+    G = np.empty((3, 3))
+    T1 = np.empty((3, 3))
+    B1 = np.empty((3, 3))
+    Tq = np.empty((3, 3))
+    Bq = np.empty((3, 3))
+    tmp = np.empty((3, 3))
+    for b in range(body_node.shape[0]):
+        j = body_node[b]
+        for i in range(3):
+            pos[j, i] = P[b, i]
+            for c in range(3):
+                rot[j, i, c] = R[b, i, c]
+        if body_tip[b]:
+            t = body_tip_node[b]
+            for i in range(3):
+                s = P[b, i]
+                for c in range(3):
+                    s += R[b, i, c] * (Xrest[t, c] - Xrest[j, c])
+                    rot[t, i, c] = R[b, i, c]
+                pos[t, i] = s
+    for l in range(leaf_body.shape[0]):
+        b = leaf_body[l]
+        a = leaf_first[l]
+        e = leaf_first[l + 1]
+        k = e - a - 1
+        jb = body_node[b]
+        # the petiole's base on its twig
+        for i in range(3):
+            s = P[b, i]
+            for c in range(3):
+                s += R[b, i, c] * (Xrest[leaf_nodes[a], c] - Xrest[jb, c])
+            pos[leaf_nodes[a], i] = s
+        # segment q turns by G_q = B^((q+1)/k)·T^((q+1)/k): powers of one k-th of the bend B
+        # and of the twist T (each about one axis), so two exponentials a leaf
+        f = 1.0 / k if leaf_on[l] else 0.0
+        rot_exp(f * leaf_E[l, 0, 0] * leaf_th[l, 0], f * leaf_E[l, 1, 0] * leaf_th[l, 0],
+                f * leaf_E[l, 2, 0] * leaf_th[l, 0], T1)
+        rot_exp(f * (leaf_E[l, 0, 1] * leaf_th[l, 1] + leaf_E[l, 0, 2] * leaf_th[l, 2]),
+                f * (leaf_E[l, 1, 1] * leaf_th[l, 1] + leaf_E[l, 1, 2] * leaf_th[l, 2]),
+                f * (leaf_E[l, 2, 1] * leaf_th[l, 1] + leaf_E[l, 2, 2] * leaf_th[l, 2]), B1)
+        for i in range(3):
+            for c in range(3):
+                Bq[i, c] = B1[i, c]
+                Tq[i, c] = T1[i, c]
+        for q in range(k):
+            if q > 0:
+                _matmul_into(Bq, B1, tmp)
+                Bq[:, :] = tmp
+                _matmul_into(Tq, T1, tmp)
+                Tq[:, :] = tmp
+            _matmul_into(Bq, Tq, G)
+            n0 = leaf_nodes[a + q]
+            n1 = leaf_nodes[a + q + 1]
+            for i in range(3):
+                for c in range(3):
+                    rot[n0, i, c] = R[b, i, 0] * G[0, c] + R[b, i, 1] * G[1, c] + R[b, i, 2] * G[2, c]
+            for i in range(3):
+                s = pos[n0, i]
+                for c in range(3):
+                    s += rot[n0, i, c] * (Xrest[n1, c] - Xrest[n0, c])
+                pos[n1, i] = s
+            if q == k - 1:
+                for i in range(3):
+                    for c in range(3):
+                        rot[n1, i, c] = rot[n0, i, c]
