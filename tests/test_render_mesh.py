@@ -343,9 +343,10 @@ def test_pick_axis_runs_through_the_rings_the_mesh_draws():
 
     tree = small_tree()
     twig = int(np.flatnonzero(tree.level == tree.level.max())[0])
-    sim = Simulation(tree, model="paper")  # a hard bend from a pull
-    sim.pull(twig, (0.0, -40.0, 20.0))
-    for _ in range(10):
+    sim = Simulation(tree)
+    tip = tree.object_start[twig] + tree.object_count[twig] - 1
+    sim.drag(twig, tree.rest_positions[tip] + (0.0, -0.3, 0.15))  # a hard bend
+    for _ in range(60):
         sim.step(1 / 60)
     P, R = sim.positions, sim.rotations
     picker = Picker(tree)
@@ -366,7 +367,7 @@ def test_pick_axis_runs_through_the_rings_the_mesh_draws():
     # ... which lie off the chords in this pose.
     j, t = picker.node[inside], picker.t[inside, None]
     off = np.linalg.norm(axis[inside] - ((1 - t) * P[j] + t * P[j + 1]), axis=1)
-    assert off.max() > 0.005, off.max()
+    assert off.max() > 0.002, off.max()  # millimetres: the control that this pose bends off the chords
 
 
 def test_pick_thin_twigs_as_drawn_a_pixel_wider_and_behind_solid_surfaces():
