@@ -26,7 +26,7 @@ def _leaf_rotation(E, th, G):
 
 @njit(cache=True, fastmath=True, error_model="numpy")
 def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R, P, Om, V, U,
-              flutter, th, thd, F, X, Nrm, kap, Uh, kap2):
+              flutter, th, thd, F, X, Nrm, kap, Uh, kap2, speed):
     """Advance every leaf's petiole joint (bend about two axes and twist) over one step, and
     give the force it passes to its twig for the next.
 
@@ -65,6 +65,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
     kap, Uh, kap2 : (L,), (L, 3), (L,) — written: the air's implicit damping there, the
         force's derivative against the velocity bounded by a symmetric one,
         h·½ρC_n·A·(|U_rel| n nᵀ + |U_rel·n| ÛÛᵀ) (backward Euler).
+    speed : (L,) — written: |U_rel| at the lamina.
     """
     G = np.empty((3, 3))
     RG = np.empty((3, 3))
@@ -104,6 +105,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
         else:
             Uh[l, 0] = Uh[l, 1] = Uh[l, 2] = 0.0
         kap2[l] = h * cna[l] * abs(un)
+        speed[l] = s
         # torque about the petiole's base: the bends take its part about the rest axes b₁, b₂
         # (in the twig's axes, Rᵀτ), the twist its part about the lamina's axis now (Ga): nil
         # for a force at the centroid, which lies on that axis; the flutter drives it instead

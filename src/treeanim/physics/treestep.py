@@ -56,6 +56,7 @@ class TreeState:
     leaf_kap: np.ndarray  # (L,)
     leaf_U: np.ndarray  # (L, 3) unit air-relative wind at the laminas
     leaf_kap2: np.ndarray  # (L,)
+    leaf_speed: np.ndarray  # (L,) |U_rel| at the laminas
     phase: np.ndarray   # (L,) flutter phase (rad)
     flutter: np.ndarray  # (L,) flutter amplitude (rad)
 
@@ -67,7 +68,7 @@ class TreeState:
                  P=np.empty((B, 3)), Om=np.empty((B, 3)), V=np.empty((B, 3)), acc=np.zeros((B, 6)),
                  th=np.zeros((L, 3)), thd=np.zeros((L, 3)), leaf_F=np.zeros((L, 3)),
                  leaf_X=np.zeros((L, 3)), leaf_N=np.zeros((L, 3)), leaf_kap=np.zeros(L),
-                 leaf_U=np.zeros((L, 3)), leaf_kap2=np.zeros(L),
+                 leaf_U=np.zeros((L, 3)), leaf_kap2=np.zeros(L), leaf_speed=np.zeros(L),
                  phase=np.random.default_rng([int(seed), 0x1EAF]).uniform(0, 2 * np.pi, L), flutter=np.zeros(L))
         forward_kinematics(s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
         st.leaf_X[:] = s.leaf_base0 + s.leaf_rc0
@@ -115,7 +116,7 @@ def sample_points(s: Structure, st: TreeState) -> np.ndarray:
 
 @njit(cache=True, fastmath=True, error_model="numpy")
 def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf_N, leaf_kap, leaf_U, leaf_kap2,
-                F, kap):
+                leaf_speed, F, kap):
     """The air's force on every segment (across it) and the leaves' forces, with their implicit
     damping terms κ as points (see :func:`~treeanim.physics.articulated.articulated_step`) and
     the segments' turn stiffness (:func:`_turn_stiffness`)."""
@@ -161,6 +162,9 @@ def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf
         if leaf_kap[l] > 0.0:
             add_point(kap, b, 0.0, leaf_kap[l], leaf_N[l, 0], leaf_N[l, 1], leaf_N[l, 2],
                       leaf_kap2[l], leaf_U[l, 0], leaf_U[l, 1], leaf_U[l, 2], rx, ry, rz)
+            _leaf_turn_stiffness(b, h, leaf_kap[l] * leaf_speed[l] / h, leaf_U[l], leaf_N[l], rx, ry, rz,
+                                 fx, fy, fz, Ka)
+            _add_turn(b, h, Ka, Om, F, kap)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -169,9 +173,8 @@ def _turn_stiffness(b, h, cda, un, ux, uy, uz, ua, ax, ay, az, rx, ry, rz, fx, f
 
     Turning a segment by δφ turns its axis and its middle (δa = δφ × a, δr = δφ × r), so the
     cross-flow drag F = c|U⊥|U⊥ and its moment τ = r × F change by K·δφ. A light, soft part in
-    a strong wind (a grass blade: drag a hundred times its springs) must take this implicitly:
-    its symmetric part, made positive by Gershgorin's shift, joins the body's rotational inertia
-    as h²K and its moment as −hKω. (ux, uy, uz) is U⊥ and ``ua`` the air's speed along the axis.
+    a strong wind (a grass blade: drag a hundred times its springs) must take this implicitly
+    (:func:`_add_turn`). (ux, uy, uz) is U⊥ and ``ua`` the air's speed along the axis.
     """
     for k in range(3):
         dx, dy, dz = (1.0 if k == 0 else 0.0), (1.0 if k == 1 else 0.0), (1.0 if k == 2 else 0.0)
@@ -184,6 +187,32 @@ def _turn_stiffness(b, h, cda, un, ux, uy, uz, ua, ax, ay, az, rx, ry, rz, fx, f
         Ka[0, k] = -((dry * fz - drz * fy) + (ry * dfz - rz * dfy))
         Ka[1, k] = -((drz * fx - drx * fz) + (rz * dfx - rx * dfz))
         Ka[2, k] = -((drx * fy - dry * fx) + (rx * dfy - ry * dfx))
+    _add_turn(b, h, Ka, Om, F, kap)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _leaf_turn_stiffness(b, h, cs2, Uh, n, rx, ry, rz, fx, fy, fz, Ka):
+    """Ka = −∂τ/∂φ of a lamina's normal force F = c|U|²(Û·n)n at r on its twig, the twig
+    turning by δφ (δr = δφ × r, δn = δφ × n): the leaves' pull on a twig as it turns."""
+    un = Uh[0] * n[0] + Uh[1] * n[1] + Uh[2] * n[2]
+    for k in range(3):
+        dx, dy, dz = (1.0 if k == 0 else 0.0), (1.0 if k == 1 else 0.0), (1.0 if k == 2 else 0.0)
+        drx, dry, drz = dy * rz - dz * ry, dz * rx - dx * rz, dx * ry - dy * rx
+        dnx, dny, dnz = dy * n[2] - dz * n[1], dz * n[0] - dx * n[2], dx * n[1] - dy * n[0]
+        udn = Uh[0] * dnx + Uh[1] * dny + Uh[2] * dnz
+        dfx = cs2 * (udn * n[0] + un * dnx)
+        dfy = cs2 * (udn * n[1] + un * dny)
+        dfz = cs2 * (udn * n[2] + un * dnz)
+        Ka[0, k] = -((dry * fz - drz * fy) + (ry * dfz - rz * dfy))
+        Ka[1, k] = -((drz * fx - drx * fz) + (rz * dfx - rx * dfz))
+        Ka[2, k] = -((drx * fy - dry * fx) + (rx * dfy - ry * dfx))
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _add_turn(b, h, Ka, Om, F, kap):
+    """Take a turn stiffness Ka of body b implicitly (backward Euler): its symmetric part,
+    made positive by Gershgorin's shift, joins the body's rotational inertia as h²K and its
+    moment as −hKω."""
     for i in range(3):
         for j in range(i + 1, 3):
             m = 0.5 * (Ka[i, j] + Ka[j, i])
@@ -245,7 +274,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     Ub = np.ascontiguousarray(wind[:B])
     Ul = np.ascontiguousarray(wind[B:])
     _air_forces(dt, out.R, out.Om, out.V, s.mid0, s.axis, s.cda, Ub, s.leaf_body,
-                out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, w.F, w.kap)
+                out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, out.leaf_speed, w.F, w.kap)
     for b, ofs, f in pulls:
         r = out.R[b] @ ofs
         w.F[b, :3] += np.cross(r, f)
@@ -260,7 +289,8 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
         _flutter(s, out, Ul, dt, leaf_flutter)
     leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
               s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, out.R, out.P, out.Om, out.V, Ul,
-              out.flutter * np.sin(out.phase), out.th, out.thd, out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2)
+              out.flutter * np.sin(out.phase), out.th, out.thd, out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2,
+              out.leaf_speed)
     out.time = st.time + dt
 
 
