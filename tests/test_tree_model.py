@@ -203,3 +203,26 @@ def test_the_articulated_step_solves_the_implicit_system_exactly():
                      st.R, st.P, st.Q, st.w, F, kap, *work, np.zeros((B, 6)))
     aba = np.concatenate([Rp[b] @ (st.w[b] - w0[b]) for b in range(B)])
     np.testing.assert_allclose(aba, dense, atol=1e-10 * np.abs(dense).max())
+
+
+def test_a_held_scanned_stem_leans_along_the_pull_and_comes_back():
+    """Issue 26: a scan's held stem leaned against the pull and swung wider after release."""
+    tree = ta.load_qsm(QSM)
+    top = tree.object_start[0] + tree.object_count[0] - 1  # the stem's tip
+    pull = np.array([0.0, 0.0, 500.0])
+    sim = ta.Simulation(tree)
+    sim.pull(0, pull)
+    held = []
+    for _ in range(240):
+        sim.step(1 / 30)
+        held.append(sim.positions[top] - tree.rest_positions[top])
+    mean = np.mean(held[-60:], axis=0)  # the swing about the held shape, averaged out
+    assert mean @ pull / np.linalg.norm(pull) > 0.95 * np.linalg.norm(mean) > 0.01  # along the pull
+    widest = max(np.linalg.norm(d) for d in held)
+    sim.release()
+    after = []
+    for _ in range(600):
+        sim.step(1 / 30)
+        after.append(np.linalg.norm(sim.positions[top] - tree.rest_positions[top]))
+    assert max(after) < 1.01 * widest  # never wider than it swung while held
+    assert np.mean(after[-60:]) < 0.5 * np.linalg.norm(mean)  # and it dies away
