@@ -6,22 +6,36 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .articulated import _cross, rot_exp, theta_of
+from .articulated import _cross, theta_of
 
 __all__ = ["leaf_step", "pose_nodes"]
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
 def _leaf_rotation(E, th, G):
-    """G (3, 3) = exp([θ₁b₁ + θ₂b₂]×)·exp(θ₀[a]×), the leaf against its twig (E: columns a, b₁, b₂)."""
-    T = np.empty((3, 3))
-    Bm = np.empty((3, 3))
-    rot_exp(E[0, 0] * th[0], E[1, 0] * th[0], E[2, 0] * th[0], T)
-    rot_exp(E[0, 1] * th[1] + E[0, 2] * th[2], E[1, 1] * th[1] + E[1, 2] * th[2],
-            E[2, 1] * th[1] + E[2, 2] * th[2], Bm)
-    for i in range(3):
-        for j in range(3):
-            G[i, j] = Bm[i, 0] * T[0, j] + Bm[i, 1] * T[1, j] + Bm[i, 2] * T[2, j]
+    """G (3, 3) = exp([θ₁b₁ + θ₂b₂]×)·exp(θ₀[a]×), the leaf against its twig (E: columns a, b₁, b₂),
+    composed as quaternions."""
+    ax, ay, az = E[0, 0], E[1, 0], E[2, 0]
+    vx = E[0, 1] * th[1] + E[0, 2] * th[2]
+    vy = E[1, 1] * th[1] + E[1, 2] * th[2]
+    vz = E[2, 1] * th[1] + E[2, 2] * th[2]
+    beta = np.sqrt(vx * vx + vy * vy + vz * vz)
+    cb, ct, st = np.cos(0.5 * beta), np.cos(0.5 * th[0]), np.sin(0.5 * th[0])
+    sb = np.sin(0.5 * beta) / beta if beta > 1e-12 else 0.5  # times the unnormalised axis v
+    qw = cb * ct - sb * st * (vx * ax + vy * ay + vz * az)
+    cx, cy, cz = _cross(vx, vy, vz, ax, ay, az)
+    qx = cb * st * ax + ct * sb * vx + sb * st * cx
+    qy = cb * st * ay + ct * sb * vy + sb * st * cy
+    qz = cb * st * az + ct * sb * vz + sb * st * cz
+    G[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
+    G[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
+    G[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
+    G[0, 1] = 2.0 * (qx * qy - qw * qz)
+    G[1, 0] = 2.0 * (qx * qy + qw * qz)
+    G[0, 2] = 2.0 * (qx * qz + qw * qy)
+    G[2, 0] = 2.0 * (qx * qz - qw * qy)
+    G[1, 2] = 2.0 * (qy * qz - qw * qx)
+    G[2, 1] = 2.0 * (qy * qz + qw * qx)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -157,13 +171,6 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _matmul_into(A, B, out):
-    for i in range(3):
-        for j in range(3):
-            out[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
-
-
-@njit(cache=True, fastmath=True, error_model="numpy")
 def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf_first, leaf_body, leaf_E,
                leaf_th, leaf_on, pos, rot):
     """Posed node positions ``pos`` (N, 3) and rest-relative rotations ``rot`` (N, 3, 3).
@@ -174,11 +181,6 @@ def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf
     node (the lamina) the whole turn.
     """
     G = np.empty((3, 3))
-    T1 = np.empty((3, 3))
-    B1 = np.empty((3, 3))
-    Tq = np.empty((3, 3))
-    Bq = np.empty((3, 3))
-    tmp = np.empty((3, 3))
     for b in range(body_node.shape[0]):
         j = body_node[b]
         for i in range(3):
@@ -205,25 +207,41 @@ def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf
             for c in range(3):
                 s += R[b, i, c] * (Xrest[leaf_nodes[a], c] - Xrest[jb, c])
             pos[leaf_nodes[a], i] = s
-        # segment q turns by G_q = B^((q+1)/k)·T^((q+1)/k): powers of one k-th of the bend B
-        # and of the twist T (each about one axis), so two exponentials a leaf
-        f = 1.0 / k if leaf_on[l] else 0.0
-        rot_exp(f * leaf_E[l, 0, 0] * leaf_th[l, 0], f * leaf_E[l, 1, 0] * leaf_th[l, 0],
-                f * leaf_E[l, 2, 0] * leaf_th[l, 0], T1)
-        rot_exp(f * (leaf_E[l, 0, 1] * leaf_th[l, 1] + leaf_E[l, 0, 2] * leaf_th[l, 2]),
-                f * (leaf_E[l, 1, 1] * leaf_th[l, 1] + leaf_E[l, 1, 2] * leaf_th[l, 2]),
-                f * (leaf_E[l, 2, 1] * leaf_th[l, 1] + leaf_E[l, 2, 2] * leaf_th[l, 2]), B1)
-        for i in range(3):
-            for c in range(3):
-                Bq[i, c] = B1[i, c]
-                Tq[i, c] = T1[i, c]
+        # segment q turns by G_q = B^((q+1)/k)·T^((q+1)/k), the bend B and twist T each about
+        # one axis: as quaternions whose half angles grow by one k-th a segment (angle addition)
+        on = 1.0 if leaf_on[l] else 0.0
+        ax, ay, az = leaf_E[l, 0, 0], leaf_E[l, 1, 0], leaf_E[l, 2, 0]
+        vx = on * (leaf_E[l, 0, 1] * leaf_th[l, 1] + leaf_E[l, 0, 2] * leaf_th[l, 2])
+        vy = on * (leaf_E[l, 1, 1] * leaf_th[l, 1] + leaf_E[l, 1, 2] * leaf_th[l, 2])
+        vz = on * (leaf_E[l, 2, 1] * leaf_th[l, 1] + leaf_E[l, 2, 2] * leaf_th[l, 2])
+        beta = np.sqrt(vx * vx + vy * vy + vz * vz)
+        if beta > 1e-12:
+            bx, by, bz = vx / beta, vy / beta, vz / beta
+        else:
+            bx, by, bz = 1.0, 0.0, 0.0
+        cb1, sb1 = np.cos(0.5 * beta / k), np.sin(0.5 * beta / k)
+        psi = on * leaf_th[l, 0]
+        ct1, st1 = np.cos(0.5 * psi / k), np.sin(0.5 * psi / k)
+        cb, sb, ct, st = cb1, sb1, ct1, st1
+        ba = bx * ax + by * ay + bz * az
+        cx_, cy_, cz_ = _cross(bx, by, bz, ax, ay, az)
         for q in range(k):
             if q > 0:
-                _matmul_into(Bq, B1, tmp)
-                Bq[:, :] = tmp
-                _matmul_into(Tq, T1, tmp)
-                Tq[:, :] = tmp
-            _matmul_into(Bq, Tq, G)
+                cb, sb = cb * cb1 - sb * sb1, sb * cb1 + cb * sb1
+                ct, st = ct * ct1 - st * st1, st * ct1 + ct * st1
+            qw = cb * ct - sb * st * ba
+            qx = cb * st * ax + ct * sb * bx + sb * st * cx_
+            qy = cb * st * ay + ct * sb * by + sb * st * cy_
+            qz = cb * st * az + ct * sb * bz + sb * st * cz_
+            G[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
+            G[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
+            G[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
+            G[0, 1] = 2.0 * (qx * qy - qw * qz)
+            G[1, 0] = 2.0 * (qx * qy + qw * qz)
+            G[0, 2] = 2.0 * (qx * qz + qw * qy)
+            G[2, 0] = 2.0 * (qx * qz - qw * qy)
+            G[1, 2] = 2.0 * (qy * qz - qw * qx)
+            G[2, 1] = 2.0 * (qy * qz + qw * qx)
             n0 = leaf_nodes[a + q]
             n1 = leaf_nodes[a + q + 1]
             for i in range(3):
