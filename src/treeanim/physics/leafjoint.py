@@ -76,9 +76,9 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
     F : (L, 3) — written: the lamina's force (world, N) at X.
     X : (L, 3) — written: the lamina's centroid (world) relative to its twig's joint.
     Nrm : (L, 3) — written: the lamina's normal (world).
-    kap, Uh, kap2 : (L,), (L, 3), (L,) — written: the air's implicit damping there, the
-        force's derivative against the velocity bounded by a symmetric one,
-        h·½ρC_n·A·(|U_rel| n nᵀ + |U_rel·n| ÛÛᵀ) (backward Euler).
+    kap, Uh, kap2 : (L,), (L, 3), (L,) — written: the air's damping there, the force's
+        derivative against the velocity bounded by a symmetric one,
+        ½ρC_n·A·(|U_rel| n nᵀ + |U_rel·n| ÛÛᵀ) (N·s/m; the next step takes it implicitly).
     speed : (L,) — written: |U_rel| at the lamina.
     """
     G = np.empty((3, 3))
@@ -113,12 +113,12 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
         fx, fy, fz = fn * nx, fn * ny, fn * nz
         F[l, 0], F[l, 1], F[l, 2] = fx, fy, fz
         Nrm[l, 0], Nrm[l, 1], Nrm[l, 2] = nx, ny, nz
-        kap[l] = h * cna[l] * s
+        kap[l] = cna[l] * s
         if s > 0.0:
             Uh[l, 0], Uh[l, 1], Uh[l, 2] = ux / s, uy / s, uz / s
         else:
             Uh[l, 0] = Uh[l, 1] = Uh[l, 2] = 0.0
-        kap2[l] = h * cna[l] * abs(un)
+        kap2[l] = cna[l] * abs(un)
         speed[l] = s
         # torque about the petiole's base: the bends take its part about the rest axes b₁, b₂
         # (in the twig's axes, Rᵀτ), the twist its part about the lamina's axis now (Ga): nil

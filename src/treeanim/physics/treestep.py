@@ -53,7 +53,7 @@ class TreeState:
     leaf_F: np.ndarray  # (L, 3) the laminas' forces of the last step (world)
     leaf_X: np.ndarray  # (L, 3) the laminas' centroids from their twig's joint (world axes)
     leaf_N: np.ndarray  # (L, 3) the laminas' normals (world)
-    leaf_kap: np.ndarray  # (L,)
+    leaf_kap: np.ndarray  # (L,) the laminas' air damping rates c|U| (N·s/m), along their normals
     leaf_U: np.ndarray  # (L, 3) unit air-relative wind at the laminas
     leaf_kap2: np.ndarray  # (L,)
     leaf_speed: np.ndarray  # (L,) |U_rel| at the laminas
@@ -160,9 +160,9 @@ def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf
         F[b, 4] += fy
         F[b, 5] += fz
         if leaf_kap[l] > 0.0:
-            add_point(kap, b, 0.0, leaf_kap[l], leaf_N[l, 0], leaf_N[l, 1], leaf_N[l, 2],
-                      leaf_kap2[l], leaf_U[l, 0], leaf_U[l, 1], leaf_U[l, 2], rx, ry, rz)
-            _leaf_turn_stiffness(b, h, leaf_kap[l] * leaf_speed[l] / h, leaf_U[l], leaf_N[l], rx, ry, rz,
+            add_point(kap, b, 0.0, h * leaf_kap[l], leaf_N[l, 0], leaf_N[l, 1], leaf_N[l, 2],
+                      h * leaf_kap2[l], leaf_U[l, 0], leaf_U[l, 1], leaf_U[l, 2], rx, ry, rz)
+            _leaf_turn_stiffness(b, h, leaf_kap[l] * leaf_speed[l], leaf_U[l], leaf_N[l], rx, ry, rz,
                                  fx, fy, fz, Ka)
             _add_turn(b, h, Ka, Om, F, kap)
 
