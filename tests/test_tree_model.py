@@ -197,9 +197,9 @@ def test_the_articulated_step_solves_the_implicit_system_exactly():
     F[5, :3] = np.cross(r, F[5, 3:])
     dense = np.linalg.solve(J.T @ I @ J, h * J.T @ F.ravel())
     w0 = st.w.copy()
-    zero = np.zeros_like(s.K)
+    zero = np.zeros(B)
     work = [np.empty((B, 6, 6)), np.empty((B, 6)), np.empty((B, 3, 3)), np.empty((B, 6, 3)), np.empty((B, 3))]
-    articulated_step(h, np.full(B, 0.5), np.full(B, 0.5), s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, zero, zero,
+    articulated_step(h, np.full(B, 0.5), np.full(B, 0.5), s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, zero, zero, zero,
                      st.R, st.P, st.Q, st.w, F, kap, *work, np.zeros((B, 6)))
     aba = np.concatenate([Rp[b] @ (st.w[b] - w0[b]) for b in range(B)])
     np.testing.assert_allclose(aba, dense, atol=1e-10 * np.abs(dense).max())

@@ -41,6 +41,8 @@ __all__ = ["theta_of", "forward_kinematics", "articulated_step", "rot_log", "rot
 #: The most a joint turns against its parent (rad): beyond it a segment stops, its outward
 #: speed taken away (a soft grass blade can fold; no joint wraps past π).
 JOINT_STOP = 0.6 * np.pi
+#: tr Q below which a joint has turned past the stop (tr Q = 1 + 2 cos angle).
+STOP_TRACE = 1.0 + 2.0 * np.cos(JOINT_STOP)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -190,7 +192,7 @@ def _inv3(A, out):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, K, D, R, P, Q, w,
+def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dkk, R, P, Q, w,
                      F, kap, IA, pA, Dinv, Ucol, u, acc):
     """One implicit step of every body (the articulated-body algorithm, three passes).
 
@@ -207,8 +209,9 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, K, D, R, P
     m0, h0, J0 : (B,), (B, 3), (B, 3, 3)
         Each body's mass, first and second moments about its joint in rest axes (what it carries
         rigidly — its leaves — included).
-    K, D : (B, 3, 3)
-        Joint stiffness (N·m/rad) and damping (N·m·s/rad) in the parent's rest axes.
+    kb, kt, dkk : (B,)
+        Each joint's bending and twisting stiffness (N·m/rad) and its damping per unit of
+        stiffness (s): K = k_b(1 − aaᵀ) + k_t·aaᵀ about the segment's axis a, D = dkk·K.
     R, P, Q, w : the state (see :func:`forward_kinematics`); Q and w are advanced in place, R
         and P are left for :func:`forward_kinematics` to redo.
     F : (B, 6)
@@ -224,13 +227,9 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, K, D, R, P
     B = parent.shape[0]
     Rm = np.empty((3, 3))
     Jw = np.empty((3, 3))
-    Kw = np.empty((3, 3))
-    Dw = np.empty((3, 3))
     tmp = np.empty((3, 3))
     th = np.empty(3)
     Dj = np.empty((3, 3))
-    Th = np.empty((3, 3))
-    ThK = np.empty((3, 3))
     Ia = np.empty((6, 6))
     UD = np.empty((6, 3))
     pa = np.empty(6)
@@ -286,52 +285,34 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, K, D, R, P
         wr0 = Rm[0, 0] * w[b, 0] + Rm[0, 1] * w[b, 1] + Rm[0, 2] * w[b, 2]
         wr1 = Rm[1, 0] * w[b, 0] + Rm[1, 1] * w[b, 1] + Rm[1, 2] * w[b, 2]
         wr2 = Rm[2, 0] * w[b, 0] + Rm[2, 1] * w[b, 1] + Rm[2, 2] * w[b, 2]
-        # Kw = Rm K Rmᵀ, Dw likewise
-        for i in range(3):
-            for j in range(3):
-                s = 0.0
-                t = 0.0
-                for k in range(3):
-                    s += Rm[i, k] * K[b, k, j]
-                    t += Rm[i, k] * D[b, k, j]
-                tmp[i, j] = s
-                Jw[i, j] = t
-        for i in range(3):
-            for j in range(3):
-                s = 0.0
-                t = 0.0
-                for k in range(3):
-                    s += tmp[i, k] * Rm[j, k]
-                    t += Jw[i, k] * Rm[j, k]
-                Kw[i, j] = s
-                Dw[i, j] = t
-        # Θ = θ_b·1 + (θ_t − θ_b)·a aᵀ in world (a = Rm·axis), which commutes with K and D
+        # K = k_b(1 − aaᵀ) + k_t·aaᵀ, D = d·K and Θ = θ_b(1 − aaᵀ) + θ_t·aaᵀ share the axis
+        # a (world: Rm·axis), so every product of them is α·1 + β·aaᵀ
         ax = Rm[0, 0] * axis[b, 0] + Rm[0, 1] * axis[b, 1] + Rm[0, 2] * axis[b, 2]
         ay = Rm[1, 0] * axis[b, 0] + Rm[1, 1] * axis[b, 1] + Rm[1, 2] * axis[b, 2]
         az = Rm[2, 0] * axis[b, 0] + Rm[2, 1] * axis[b, 1] + Rm[2, 2] * axis[b, 2]
         aw = (ax, ay, az)
-        tb, dt_ = theta[b], theta_t[b] - theta[b]
-        for i in range(3):
-            for j in range(3):
-                Th[i, j] = dt_ * aw[i] * aw[j]
-            Th[i, i] += tb
-        for i in range(3):
-            for j in range(3):
-                ThK[i, j] = Th[i, 0] * Kw[0, j] + Th[i, 1] * Kw[1, j] + Th[i, 2] * Kw[2, j]
-        # joint torque −K θ − (D + hΘK) ω_rel, in world (θ = Rm·log Q)
+        k1, k2, dk = kb[b], kt[b], dkk[b]
+        t1, t2 = theta[b], theta_t[b]
         tw0 = Rm[0, 0] * th[0] + Rm[0, 1] * th[1] + Rm[0, 2] * th[2]
         tw1 = Rm[1, 0] * th[0] + Rm[1, 1] * th[1] + Rm[1, 2] * th[2]
         tw2 = Rm[2, 0] * th[0] + Rm[2, 1] * th[1] + Rm[2, 2] * th[2]
+        tw = (tw0, tw1, tw2)
+        wr = (wr0, wr1, wr2)
+        at = ax * tw0 + ay * tw1 + az * tw2
+        aq = ax * wr0 + ay * wr1 + az * wr2
+        # joint torque −K θ − (D + hΘK) ω_rel, in world (θ = Rm·log Q)
+        c1 = (dk + h * t1) * k1  # (D + hΘK) = c1·1 + (c2 − c1)·aaᵀ
+        c2 = (dk + h * t2) * k2
         for i in range(3):
-            tau = -(Kw[i, 0] * tw0 + Kw[i, 1] * tw1 + Kw[i, 2] * tw2)
-            tau -= (Dw[i, 0] + h * ThK[i, 0]) * wr0 + (Dw[i, 1] + h * ThK[i, 1]) * wr1 \
-                + (Dw[i, 2] + h * ThK[i, 2]) * wr2
+            tau = -(k1 * tw[i] + (k2 - k1) * at * aw[i]) - (c1 * wr[i] + (c2 - c1) * aq * aw[i])
             u[b, i] = h * tau - pA[b, i]
         # D = Sᵀ IA S + hΘD + h²Θ²K
+        al = h * t1 * k1 * (dk + h * t1)
+        be = h * t2 * k2 * (dk + h * t2) - al
         for i in range(3):
             for j in range(3):
-                Dj[i, j] = IA[b, i, j] + h * (Th[i, 0] * Dw[0, j] + Th[i, 1] * Dw[1, j] + Th[i, 2] * Dw[2, j]) \
-                    + h * h * (Th[i, 0] * ThK[0, j] + Th[i, 1] * ThK[1, j] + Th[i, 2] * ThK[2, j])
+                Dj[i, j] = IA[b, i, j] + be * aw[i] * aw[j]
+            Dj[i, i] += al
         _inv3(Dj, Dinv[b])
         for i in range(6):
             for j in range(3):
@@ -402,9 +383,9 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, K, D, R, P
         _orthonormalize(Q[b])
         # a joint's stop: no segment turns against its parent by more than JOINT_STOP (wood
         # breaks first; past π the rotation vector would wrap and the spring flip)
-        rot_log(Q[b], th)
-        n = np.sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2])
-        if n > JOINT_STOP:
+        if Q[b, 0, 0] + Q[b, 1, 1] + Q[b, 2, 2] < STOP_TRACE:  # turned past the stop
+            rot_log(Q[b], th)
+            n = np.sqrt(th[0] * th[0] + th[1] * th[1] + th[2] * th[2])
             sc = JOINT_STOP / n
             rot_exp(th[0] * sc, th[1] * sc, th[2] * sc, Q[b])
             wn = (w[b, 0] * th[0] + w[b, 1] * th[1] + w[b, 2] * th[2]) / n

@@ -102,7 +102,9 @@ class Structure:
     h0: np.ndarray          # (B, 3)
     J0: np.ndarray          # (B, 3, 3)
     K: np.ndarray           # (B, 3, 3)
-    D: np.ndarray           # (B, 3, 3)
+    kb: np.ndarray          # (B,) bending stiffness (N·m/rad): K = k_b(1 − aaᵀ) + k_t·aaᵀ
+    kt: np.ndarray          # (B,) twisting stiffness
+    dk: np.ndarray          # (B,) damping per unit of stiffness (s): D = dk·K
     cda: np.ndarray         # (B,) ½ρC_d·d·ℓ of the segment across the flow
     diameter: np.ndarray    # (B,) at the joint
     # leaves
@@ -265,13 +267,13 @@ class Structure:
         Jperp = 0.5 * (np.trace(sJ, axis1=1, axis2=2) - np.einsum("bi,bij,bj->b", axis, sJ, axis))
         omega_j = np.sqrt(kb / np.maximum(Jperp, 1e-30))
         omega_t = np.sqrt(kt / np.maximum(np.einsum("bi,bij,bj->b", axis, sJ, axis), 1e-30))
-        D = (2.0 * p.wood_damping / omega_j)[:, None, None] * K
+        dk = 2.0 * p.wood_damping / omega_j
         leaf_first = np.r_[0, np.cumsum(count[leaves])].astype(np.int64)
         leaf_nodes = np.arange(leaf_first[-1]) - np.repeat(leaf_first[:-1] - lp, count[leaves])
         c = np.ascontiguousarray
         return cls(parent=c(parent, np.int64), r0=c(r0), node=c(node, np.int64), tip=c(k_in == count[obj] - 2),
                    tip_node=c(node + 1, np.int64), obj=obj, axis=c(axis), length=length, mid0=c(mid0),
-                   m0=c(m0), h0=c(h0), J0=c(J0), K=c(K), D=c(D), cda=c(cda), diameter=d0,
+                   m0=c(m0), h0=c(h0), J0=c(J0), K=c(K), kb=c(kb), kt=c(kt), dk=c(dk), cda=c(cda), diameter=d0,
                    leaf_obj=leaves, leaf_body=c(leaf_body, np.int64), leaf_on=c(on),
                    leaf_base0=c(base0),
                    leaf_rc0=c(rc0), leaf_n0=c(n0), leaf_E=c(Eax), leaf_k=c(leaf_k), leaf_J=c(leaf_J),

@@ -282,7 +282,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     if grab is not None:
         _grab_force(s, grab, out, dt, w)
     tb, tt = _thetas(s, dt, work)
-    articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.K, s.D, out.R, out.P, out.Q, out.w,
+    articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.kb, s.kt, s.dk, out.R, out.P, out.Q, out.w,
                      w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.u, out.acc)
     forward_kinematics(s.parent, s.r0, out.Q, out.w, out.R, out.P, out.Om, out.V)
     if len(Ul):
