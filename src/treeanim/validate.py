@@ -5,6 +5,7 @@ one line, exit status 2). No dependency but numpy: every layer may use them."""
 from __future__ import annotations
 
 import math
+import numbers
 
 import numpy as np
 
@@ -106,3 +107,18 @@ def float_within(name: str, value, lo: float, hi: float, unit: str = "") -> floa
     if not lo <= x <= hi:
         raise ValueError(f"{name} must be from {lo:g} to {hi:g}{unit}, got {value!r}")
     return x
+
+
+def object_index(i, n: int) -> int:
+    """``i`` as an object index of a tree of ``n`` objects (an integer in [0, n)).
+
+    Raises
+    ------
+    ValueError
+        Not an integer (booleans included) or out of range.
+    """
+    if isinstance(i, bool) or not isinstance(i, numbers.Integral):
+        raise ValueError(f"object index i must be an integer, got {i!r}")
+    if not 0 <= int(i) < n:
+        raise ValueError(f"object index i={i} is out of range: the tree has {n} objects")
+    return int(i)

@@ -11,6 +11,20 @@ from .articulated import _cross, theta_of
 __all__ = ["leaf_step", "pose_nodes"]
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _quat_matrix(qw, qx, qy, qz, G):
+    """G (3, 3): the rotation of the unit quaternion (qw, qx, qy, qz)."""
+    G[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
+    G[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
+    G[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
+    G[0, 1] = 2.0 * (qx * qy - qw * qz)
+    G[1, 0] = 2.0 * (qx * qy + qw * qz)
+    G[0, 2] = 2.0 * (qx * qz + qw * qy)
+    G[2, 0] = 2.0 * (qx * qz - qw * qy)
+    G[1, 2] = 2.0 * (qy * qz - qw * qx)
+    G[2, 1] = 2.0 * (qy * qz + qw * qx)
+
+
 @njit(cache=True, fastmath=True, error_model="numpy")
 def _leaf_rotation(E, th, G):
     """G (3, 3) = exp([θ₁b₁ + θ₂b₂]×)·exp(θ₀[a]×), the leaf against its twig (E: columns a, b₁, b₂),
@@ -27,15 +41,7 @@ def _leaf_rotation(E, th, G):
     qx = cb * st * ax + ct * sb * vx + sb * st * cx
     qy = cb * st * ay + ct * sb * vy + sb * st * cy
     qz = cb * st * az + ct * sb * vz + sb * st * cz
-    G[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
-    G[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
-    G[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
-    G[0, 1] = 2.0 * (qx * qy - qw * qz)
-    G[1, 0] = 2.0 * (qx * qy + qw * qz)
-    G[0, 2] = 2.0 * (qx * qz + qw * qy)
-    G[2, 0] = 2.0 * (qx * qz - qw * qy)
-    G[1, 2] = 2.0 * (qy * qz - qw * qx)
-    G[2, 1] = 2.0 * (qy * qz + qw * qx)
+    _quat_matrix(qw, qx, qy, qz, G)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -233,15 +239,7 @@ def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf
             qx = cb * st * ax + ct * sb * bx + sb * st * cx_
             qy = cb * st * ay + ct * sb * by + sb * st * cy_
             qz = cb * st * az + ct * sb * bz + sb * st * cz_
-            G[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
-            G[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
-            G[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
-            G[0, 1] = 2.0 * (qx * qy - qw * qz)
-            G[1, 0] = 2.0 * (qx * qy + qw * qz)
-            G[0, 2] = 2.0 * (qx * qz + qw * qy)
-            G[2, 0] = 2.0 * (qx * qz - qw * qy)
-            G[1, 2] = 2.0 * (qy * qz - qw * qx)
-            G[2, 1] = 2.0 * (qy * qz + qw * qx)
+            _quat_matrix(qw, qx, qy, qz, G)
             n0 = leaf_nodes[a + q]
             n1 = leaf_nodes[a + q + 1]
             for i in range(3):

@@ -9,7 +9,7 @@ import numpy as np
 
 from ..model.params import PhysicsParams, check_physics
 from ..model.tree import KINDS, Tree
-from ..validate import finite_float, finite_vector3
+from ..validate import finite_float, finite_vector3, float_within, object_index
 from .derived import Derived
 from .modal import ModalDraws, ModalParameters
 from .oscillator import INTEGRATORS
@@ -17,7 +17,7 @@ from .paper_state import PaperState, Snapshot
 from .physical import MODAL_MODELS
 from .pose import Pose
 from .stages import Stages
-from .wind import DEFAULT_BOUNDS
+from .wind import fit_to_tree
 
 __all__ = ["PaperSim", "PaperState", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
 
@@ -165,17 +165,10 @@ class PaperSim(Derived, Stages, Pose, Snapshot):
 
     @staticmethod
     def _check_season(season) -> float:
-        s = finite_float("season", season)
-        if not 0.0 <= s <= 1.0:
-            raise ValueError(f"season must be in [0, 1], got {season!r}")
-        return s
+        return float_within("season", season, 0.0, 1.0)
 
     def _check_object(self, i) -> int:
-        if isinstance(i, bool) or not isinstance(i, numbers.Integral):
-            raise ValueError(f"object index i must be an integer, got {i!r}")
-        if not 0 <= int(i) < self._M:
-            raise ValueError(f"object index i={i} is out of range: the tree has {self._M} objects")
-        return int(i)
+        return object_index(i, self._M)
 
     def _modes_arrays(self) -> tuple[np.ndarray, np.ndarray]:
         """Validated (3, M) copies of modes.f and modes.zeta (cached while unchanged)."""
@@ -318,27 +311,8 @@ class PaperSim(Derived, Stages, Pose, Snapshot):
         if wind is not None:
             if not callable(getattr(wind, "sample", None)):
                 raise ValueError(f"wind must have a sample(points, t) method, got {type(wind).__name__}")
-            self._fit_wind(wind)
+            fit_to_tree(wind, self._tree.rest_positions)
         self._wind = wind
-
-    def _fit_wind(self, wind) -> None:
-        """Fit a wind that has no bounds of its own (None or the default) to the rest box."""
-        if not (hasattr(wind, "fit") or hasattr(wind, "bounds")):
-            return  # a field that needs no bounds
-        b = getattr(wind, "bounds", None)
-        if b is not None:
-            try:
-                own = not np.allclose(np.asarray(b, float), DEFAULT_BOUNDS)
-            except (TypeError, ValueError):
-                own = True
-            if own:
-                return
-        lo, hi = self._rest_bounds
-        box = (tuple(map(float, lo)), tuple(map(float, hi)))
-        if hasattr(wind, "fit"):
-            wind.fit(box)
-        else:
-            wind.bounds = box
 
     def compliance(self, i: int, k: int, s: float, offset=(0.0, 0.0, 0.0)) -> float:
         """Metres a point of object ``i`` moves per newton of a force on it (small bends, rest

@@ -18,9 +18,10 @@ import numbers
 import numpy as np
 
 from ..model.tree import Tree
-from ..validate import finite_float, finite_vector3
+from ..validate import finite_float, finite_vector3, float_within, object_index
 from .paper_sim import MAX_FREQUENCY, MAX_PULL, MAX_STEP, MAX_ZETA, PaperSim
 from .tree_sim import TreeSim
+from .wind import fit_to_tree
 
 __all__ = ["Simulation", "MODELS", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
 
@@ -113,18 +114,10 @@ class Simulation:
 
     @staticmethod
     def _check_season(season) -> float:
-        s = finite_float("season", season)
-        if not 0.0 <= s <= 1.0:
-            raise ValueError(f"season must be in [0, 1], got {season!r}")
-        return s
+        return float_within("season", season, 0.0, 1.0)
 
     def _check_object(self, i) -> int:
-        if isinstance(i, bool) or not isinstance(i, numbers.Integral):
-            raise ValueError(f"object index i must be an integer, got {i!r}")
-        M = self._tree.n_objects
-        if not 0 <= int(i) < M:
-            raise ValueError(f"object index i={i} is out of range: the tree has {M} objects")
-        return int(i)
+        return object_index(i, self._tree.n_objects)
 
     def _fit_wind(self, wind) -> None:
         """Check ``wind`` and fit one still on its default bounds to the tree's rest box."""
@@ -132,22 +125,7 @@ class Simulation:
             return
         if not callable(getattr(wind, "sample", None)):
             raise ValueError(f"wind must have a sample(points, t) method, got {type(wind).__name__}")
-        from .wind import DEFAULT_BOUNDS
-        if not (hasattr(wind, "fit") or hasattr(wind, "bounds")):
-            return
-        b = getattr(wind, "bounds", None)
-        if b is not None:
-            try:
-                if not np.allclose(np.asarray(b, float), DEFAULT_BOUNDS):
-                    return
-            except (TypeError, ValueError):
-                return
-        X = self._tree.rest_positions
-        box = (tuple(map(float, X.min(axis=0))), tuple(map(float, X.max(axis=0))))
-        if hasattr(wind, "fit"):
-            wind.fit(box)
-        else:
-            wind.bounds = box
+        fit_to_tree(wind, self._tree.rest_positions)
 
     # ------------------------------------------------------------------ the model
     @property

@@ -57,10 +57,38 @@ Named winds by Beaufort number (:data:`WIND_PRESETS`, :func:`wind_preset`,
 ``WindField.from_preset``): calm, breeze, windy, gale, storm.
 """
 
+import numpy as np
+
 from .field import WindField
 from .paper import fbm_noise
 from .physical import SIGMA_RATIOS
 from .settings import DEFAULT_BOUNDS, MAX_SPEED, MODELS, WIND_PRESETS, wind_preset
 
-__all__ = ["fbm_noise", "WindField", "WIND_PRESETS", "wind_preset", "MODELS", "DEFAULT_BOUNDS", "MAX_SPEED",
+
+def fit_to_tree(wind, rest_positions) -> None:
+    """Fit ``wind`` to a tree's rest box if it has no bounds of its own (None or
+    :data:`DEFAULT_BOUNDS`); a field with neither ``fit`` nor ``bounds`` needs none.
+
+    Parameters
+    ----------
+    wind : object with ``sample`` (and ``fit`` or ``bounds``)
+    rest_positions : (N, 3) float
+    """
+    if not (hasattr(wind, "fit") or hasattr(wind, "bounds")):
+        return
+    b = getattr(wind, "bounds", None)
+    if b is not None:
+        try:
+            if not np.allclose(np.asarray(b, float), DEFAULT_BOUNDS):
+                return
+        except (TypeError, ValueError):
+            return
+    X = np.asarray(rest_positions, float)
+    box = (tuple(map(float, X.min(axis=0))), tuple(map(float, X.max(axis=0))))
+    if hasattr(wind, "fit"):
+        wind.fit(box)
+    else:
+        wind.bounds = box
+
+__all__ = ["fit_to_tree", "fbm_noise", "WindField", "WIND_PRESETS", "wind_preset", "MODELS", "DEFAULT_BOUNDS", "MAX_SPEED",
            "SIGMA_RATIOS"]
