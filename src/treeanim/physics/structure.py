@@ -74,6 +74,63 @@ def _subtree_inertia(parent, r0, m, h, J, out_m, out_h, out_J):
                 out_J[p, i, j] += out_J[b, i, j] + 2.0 * rh * d - r[i] * hb[j] - hb[i] * r[j] + mb * (rr * d - r[i] * r[j])
 
 
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _flexible_frequency(parent, child_start, children, P, C, m, sh, kb, axis, out):
+    """Each joint's own bending frequency with everything beyond it flexible: Rayleigh's
+    quotient ω² = Σ m δ·e / Σ m |δ|² of the static deflection δ of its subtree, clamped at the
+    joint, under a unit acceleration e across the joint's axis (the lower of two such e); each
+    joint i beyond turns by (Σ m(c − p_i)) × e / k_b,i."""
+    B = m.shape[0]
+    stack = np.empty(B, np.int64)
+    Th = np.empty((B, 3))
+    S = np.empty((B, 3))
+    for j in range(B):
+        ax, ay, az = axis[j, 0], axis[j, 1], axis[j, 2]
+        e1x, e1y, e1z = -az, 0.0, ax  # a × ŷ
+        n = np.sqrt(e1x * e1x + e1z * e1z)
+        if n < 1e-6:
+            e1x, e1y, e1z, n = 0.0, az, -ay, np.sqrt(ay * ay + az * az)  # a × x̂
+        e1x, e1y, e1z = e1x / n, e1y / n, e1z / n
+        e2x, e2y, e2z = ay * e1z - az * e1y, az * e1x - ax * e1z, ax * e1y - ay * e1x
+        best = np.inf
+        for d in range(2):
+            ex, ey, ez = (e1x, e1y, e1z) if d == 0 else (e2x, e2y, e2z)
+            num = 0.0
+            den = 0.0
+            top = 0
+            stack[0] = j
+            while top >= 0:
+                i = stack[top]
+                top -= 1
+                tx = (sh[i, 1] * ez - sh[i, 2] * ey) / kb[i]
+                ty = (sh[i, 2] * ex - sh[i, 0] * ez) / kb[i]
+                tz = (sh[i, 0] * ey - sh[i, 1] * ex) / kb[i]
+                sx = ty * P[i, 2] - tz * P[i, 1]
+                sy = tz * P[i, 0] - tx * P[i, 2]
+                sz = tx * P[i, 1] - ty * P[i, 0]
+                if i != j:  # add the parent's accumulated turns
+                    q = parent[i]
+                    tx += Th[q, 0]
+                    ty += Th[q, 1]
+                    tz += Th[q, 2]
+                    sx += S[q, 0]
+                    sy += S[q, 1]
+                    sz += S[q, 2]
+                Th[i, 0], Th[i, 1], Th[i, 2] = tx, ty, tz
+                S[i, 0], S[i, 1], S[i, 2] = sx, sy, sz
+                dx = ty * C[i, 2] - tz * C[i, 1] - sx
+                dy = tz * C[i, 0] - tx * C[i, 2] - sy
+                dz = tx * C[i, 1] - ty * C[i, 0] - sz
+                num += m[i] * (dx * ex + dy * ey + dz * ez)
+                den += m[i] * (dx * dx + dy * dy + dz * dz)
+                for c in range(child_start[i], child_start[i + 1]):
+                    top += 1
+                    stack[top] = children[c]
+            if den > 0.0 and num > 0.0:
+                best = min(best, num / den)
+        out[j] = np.sqrt(best)
+
+
 def _point_moments(mass: np.ndarray, r: np.ndarray):
     """First and second moments of point masses at offsets r (K, 3)."""
     rr = np.einsum("ij,ij->i", r, r)
@@ -266,8 +323,19 @@ class Structure:
                          np.ascontiguousarray(J0), sm, sh, sJ)
         Jperp = 0.5 * (np.trace(sJ, axis1=1, axis2=2) - np.einsum("bi,bij,bj->b", axis, sJ, axis))
         omega_j = np.sqrt(kb / np.maximum(Jperp, 1e-30))
+        # the wood damps each joint at ζ in the lowest swing of everything beyond it, flexible,
+        kids = np.flatnonzero(parent >= 0)
+        children = np.ascontiguousarray(kids[np.argsort(parent[kids], kind="stable")], np.int64)
+        child_start = np.r_[0, np.cumsum(np.bincount(parent[kids], minlength=B))].astype(np.int64)
+        com = X0 + h0 / np.maximum(m0, 1e-30)[:, None]
+        omega_flex = np.empty(B)
+        _flexible_frequency(np.asarray(parent, np.int64), child_start, children, np.ascontiguousarray(X0),
+                            np.ascontiguousarray(com), m0, np.ascontiguousarray(sh), np.maximum(kb, 1e-30),
+                            np.ascontiguousarray(axis), omega_flex)
+        omega_flex = np.where(np.isfinite(omega_flex), np.minimum(omega_flex, omega_j), omega_j)
         omega_t = np.sqrt(kt / np.maximum(np.einsum("bi,bij,bj->b", axis, sJ, axis), 1e-30))
-        dk = 2.0 * p.wood_damping / omega_j
+        # ... of its branch: a branch sways mostly as a whole, in its base joint's swing
+        dk = 2.0 * p.wood_damping / omega_flex[first_body[obj]]
         leaf_first = np.r_[0, np.cumsum(count[leaves])].astype(np.int64)
         leaf_nodes = np.arange(leaf_first[-1]) - np.repeat(leaf_first[:-1] - lp, count[leaves])
         c = np.ascontiguousarray

@@ -303,23 +303,30 @@ def _thetas(s: Structure, h: float, w: Work) -> np.ndarray:
 
 
 def _grab_force(s: Structure, g: Grab, st: TreeState, h: float, w: Work) -> None:
-    """The grab's spring −k(x − target) − (c + θhk)v, capped at f_max, its implicit part as κ
-    (θ of the spring's own frequency with the mass it moves, ``g.mass``)."""
+    """The grab's spring −k(x − target) − (c + θhK)v, capped at f_max (then a pull of f_max
+    toward the target, stiff only across its direction, as f_max/|x − target|), its implicit
+    part as κ (θ of the joint the body moves by)."""
     b = g.body
     theta = float(_thetas(s, h, w)[0][b])  # the θ its body moves by (a stiffer one would not match the update)
     r = st.R[b] @ g.offset
     x = st.P[b] + r
     v = st.V[b] + np.cross(st.Om[b], r)
-    fs = -g.k * (x - g.target)
+    gap = x - g.target
+    fs = -g.k * gap
     n = float(np.linalg.norm(fs))
-    k = g.k
-    if n > g.f_max:  # beyond what the wood bears: a constant pull
-        fs *= g.f_max / n
-        k = 0.0
-    f = fs - (g.c + theta * h * k) * v
+    # the spring's stiffness K = α·1 + β·ddᵀ, taken implicitly
+    alpha, beta, d = g.k, 0.0, np.zeros(3)
+    if n > g.f_max:  # beyond what the wood bears: a pull of f_max toward the target, whose
+        fs *= g.f_max / n  # direction still turns as the point moves across it
+        d = gap / np.linalg.norm(gap)
+        alpha = g.f_max / float(np.linalg.norm(gap))
+        beta = -alpha
+    Kv = alpha * v + beta * (d @ v) * d
+    f = fs - g.c * v - theta * h * Kv
     w.F[b, :3] += np.cross(r, f)
     w.F[b, 3:] += f
-    add_point(w.kap, b, h * g.c + (h * theta) ** 2 * k, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, r[0], r[1], r[2])
+    q = (h * theta) ** 2
+    add_point(w.kap, b, h * g.c + q * alpha, q * beta, d[0], d[1], d[2], 0.0, 0.0, 0.0, 0.0, r[0], r[1], r[2])
 
 
 def _flutter(s: Structure, st: TreeState, U: np.ndarray, h: float, amp: float) -> None:
