@@ -15,9 +15,9 @@ modulus, ν = 0.3):
   the joint: the springs of a chain of segments then give a uniform cantilever's exact tip
   compliance L³/3EI (a single segment: k = 3EI/ℓ; a short segment low on a long branch EI/ℓ);
 * twist spring k_t = GJ/ℓ = EI/((1 + ν)ℓ);
-* damping D = (2ζ/ω_j)·K (stiffness-proportional), ζ the wood's damping ratio and
-  ω_j = √(k_b/J_j) the joint's own frequency with everything beyond it (J_j its moment of
-  inertia about the joint), so each joint's own swing is damped at ζ.
+* damping D = (2ζ/ω)·K (stiffness-proportional), ζ the wood's damping ratio and ω the lowest
+  swing of the joint's branch (Rayleigh's quotient of everything beyond the branch's base,
+  flexible: :func:`_flexible_frequency`), so each branch sways damped at ζ.
 
 Petioles are cantilevers of the leaf's modulus loaded at the lamina's centroid (lever r):
 k_b = EI·r/(ℓ(r − ℓ/2)), and twist k_t = k_b·ℓ/(r·EI/GJ) with a petiole's EI/GJ of 4
