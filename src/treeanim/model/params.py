@@ -62,44 +62,38 @@ class PhysicsParams:
     wind_gain_branch, wind_gain_leaf, wind_gain_blade : float
         Drag gain per kind (N·s/m³): load = gain × exposed area × wind velocity.
     wood_density, leaf_density : float
-        kg/m³, for the base-excitation inertia (docs/design.md §6 step 3) and, in the load path, the
-        modal mass that sets a branch's stiffness (K = m·ω²).
+        kg/m³: the paper's base-excitation inertia (docs/design.md §6 step 3) and the tree
+        model's masses (segments, petioles, laminas).
     lamina_thickness : float
         Thickness of a leaf lamina (and of a grass blade) in metres, for its mass.
     leaf_twist_c0 : float
         ``twist_c0`` for leaves (their petioles twist more readily than wood).
     leaf_youngs_modulus : float
-        Load path only (docs/design.md §12): Young's modulus E (Pa) of petioles; a section of
-        diameter D has EI = E π D⁴/64 (with ``stiffness_exponent`` m:
-        EI = E π D_max⁴/64 · (D/D_max)^m). Branches need no modulus: their stiffness follows
-        from their modal frequency and the mass they carry.
+        The tree model (docs/design.md §12): Young's modulus E (Pa) of petioles (EI = EπD⁴/64).
     blade_youngs_modulus : float
-        Load path only: the same for grass blades, an effective modulus, since the model
+        The tree model: the same for grass blades, an effective modulus, since the model
         bends a blade as a round rod as wide as the blade: 5e5 Pa gives a 12 mm blade
         EI ≈ 5e-4 N·m² at its base, that of a keeled blade with its midrib, so a meadow
         bends visibly in a 5 m/s breeze and lies over in a 30 m/s gale.
     air_density : float
-        ρ of the air (kg/m³), for the drag ½ρ C A |U_rel| U_rel (load path).
+        ρ of the air (kg/m³), for the drag ½ρ C A |U_rel| U_rel (the tree model).
     drag_branch, drag_leaf, drag_blade : float
-        Drag coefficients (load path): C_d of a branch across the flow, C_n of a lamina's normal
+        Drag coefficients (the tree model; the paper's ``modes="physical"`` damping): C_d of a
+        branch across the flow, C_n of a lamina's normal
         force, C_d of a grass blade. Effective values for objects inside a crown: summed
         one by one, twigs and leaves that shelter each other would catch 3–5 times the drag of
         the crown they form (leaf area index), so branches and leaves take a quarter to a
         third of an isolated cylinder's (1.2) and plate's (1.0) coefficient.
-    reconfiguration, reconfiguration_speed : float
-        Foliage streamlining (load path): above ``reconfiguration_speed`` U₀ (m/s) the drag of
-        leaves and blades grows as U^(2 − r) with r = ``reconfiguration`` (Vogel's exponent
-        b = −r).
     leaf_flutter : float
-        Load path: the largest twist (rad) of a leaf's flutter about its petiole, reached by a
-        lamina edge-on to a strong wind (:mod:`treeanim.physics.leaves`).
+        The tree model: the largest twist (rad) of a leaf's flutter about its petiole in a
+        strong wind (:mod:`treeanim.physics.treestep`).
     wood_youngs_modulus : float
-        ``modes="physical"`` only (:mod:`treeanim.physics.physical`): the effective Young's
-        modulus E (Pa) of the branches' wood in the beam-theory frequencies (see
+        The effective Young's modulus E (Pa) of the branches' wood: the tree model's joints and
+        the paper's ``modes="physical"`` (:mod:`treeanim.physics.physical`) (see
         :data:`WOOD_TYPES`).
     wood_damping : float
-        ``modes="physical"`` only: the damping ratio of the wood and the stem's structure, to
-        which the drag of the crown adds.
+        The damping ratio of the wood and the stem's structure (the tree model's joints, the
+        paper's ``modes="physical"``), to which the drag of the crown adds.
 
     Notes
     -----
@@ -135,8 +129,6 @@ class PhysicsParams:
     drag_branch: float = 0.3
     drag_leaf: float = 0.15
     drag_blade: float = 1.0
-    reconfiguration: float = 0.7
-    reconfiguration_speed: float = 4.0
     leaf_flutter: float = 0.35
     wood_youngs_modulus: float = 6.0e9
     wood_damping: float = 0.03
@@ -162,7 +154,7 @@ SCALAR_MAX = {
     "leaf_zeta_v_scale": 100.0, "wind_gain_branch": 1e3, "wind_gain_leaf": 1e3, "wind_gain_blade": 1e3,
     "wood_density": 1e4, "leaf_density": 1e4, "lamina_thickness": 0.05, "leaf_twist_c0": 100.0,
     "leaf_youngs_modulus": 1e12, "blade_youngs_modulus": 1e12, "air_density": 10.0, "drag_branch": 10.0,
-    "drag_leaf": 10.0, "drag_blade": 10.0, "reconfiguration": 2.0, "reconfiguration_speed": 100.0,
+    "drag_leaf": 10.0, "drag_blade": 10.0,
     "leaf_flutter": 1.5, "wood_youngs_modulus": 1e12, "wood_damping": 10.0,
 }
 assert set(SCALAR_MAX) == set(SCALAR_KEYS)
@@ -190,7 +182,7 @@ def check_physics(p: PhysicsParams, kinds: Iterable[str]) -> None:
     if not isinstance(p, PhysicsParams):
         raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
     positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness",
-                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density", "reconfiguration_speed",
+                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density",
                 "wood_youngs_modulus")
     for name in SCALAR_KEYS:
         x = finite_float(f"physics.{name}", getattr(p, name))

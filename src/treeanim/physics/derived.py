@@ -12,7 +12,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.geometry import lamina_frames, object_lengths, polygon_centroid, segment_lengths
-from .aero import Drag
 from .bending import BendingPlan, rest_frames
 from .hierarchy import CompositionPlan
 from .modal import derive_modes, mean_diameters
@@ -77,7 +76,7 @@ class Derived:
         self._neg_half_pi_over_n_ord = -0.5 * np.pi / self._nseg[o]
         self._rest_bounds = (X.min(axis=0), X.max(axis=0))
         # Drag constants, for the modes of ``modes='physical'`` (:mod:`~treeanim.physics.physical`).
-        self._drag = Drag(kind, np.where(leaf, lam_area, length * dmean))
+        self._frontal_area = np.where(leaf, lam_area, length * dmean)  # for the physical modes' air damping
 
     def _derive_physics(self) -> None:
         """Stiffness, gains, masses and twist constants from ``self._physics``."""
@@ -104,8 +103,10 @@ class Derived:
         or the physical ones (``modes='physical'``), into ``self._modes`` (in place when possible)."""
         m = derive_modes(self._tree, self._physics, self._season, self._draws)
         if self._modal == "physical":
-            self._drag.derive(self._physics, self._present)
-            m = physical_modes(self._tree, self._physics, m, self._mass * self._present, self._drag.half_rho_cda)
+            p, kind = self._physics, self._tree.kind
+            cd = np.select([kind == "branch", kind == "leaf"], [p.drag_branch, p.drag_leaf], p.drag_blade)
+            half_rho_cda = 0.5 * p.air_density * cd * self._frontal_area * self._present
+            m = physical_modes(self._tree, p, m, self._mass * self._present, half_rho_cda)
         if hasattr(self, "_modes"):
             # Keep the user's references valid: overwrite in place when possible.
             cur = self._modes

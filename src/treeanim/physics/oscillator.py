@@ -153,13 +153,6 @@ def euler_step(p: np.ndarray, pd: np.ndarray, g: np.ndarray, f: np.ndarray, zeta
         p += h * pd
 
 
-def exact_response(coeffs, p: np.ndarray, pd: np.ndarray) -> tuple[np.ndarray, ...]:
-    """The exact step as a linear function of the load g held over it:
-    L′ = p_free + c·g, L̇′ = pd_free + c_d·g. Returns (p_free, pd_free, c, c_d)."""
-    A, B, C, D = coeffs  # y(dt) = A·y + B·ẏ, ẏ(dt) = C·y + D·ẏ with y = p − g
-    return A * p + B * pd, C * p + D * pd, 1.0 - A, -C
-
-
 class Exact:
     """The closed-form step; its coefficients are cached per step length until :meth:`clear`
     (the modes changed)."""
@@ -184,10 +177,6 @@ class Exact:
         """Advance (p, pd) in place under the load g (:func:`exact_step`)."""
         exact_step(p, pd, g, self.coefficients(f, zeta, dt))
 
-    def response(self, p, pd, f, zeta, dt) -> tuple[np.ndarray, ...]:
-        """(p_free, pd_free, c, c_d) of the step (:func:`exact_response`)."""
-        return exact_response(self.coefficients(f, zeta, dt), p, pd)
-
 
 class Euler:
     """The paper's Euler steps (semi-implicit, sub-stepped; see the module notes)."""
@@ -198,13 +187,6 @@ class Euler:
     def step(self, p, pd, g, f, zeta, dt) -> None:
         """Advance (p, pd) in place under the load g (:func:`euler_step`)."""
         euler_step(p, pd, g, f, zeta, dt)
-
-    def response(self, p, pd, f, zeta, dt) -> tuple[np.ndarray, ...]:
-        """(p_free, pd_free, c, c_d): the free response, and the response to a unit load from rest."""
-        out = p.copy(), pd.copy(), np.zeros_like(p), np.zeros_like(pd)
-        euler_step(out[0], out[1], np.zeros_like(p), f, zeta, dt)
-        euler_step(out[2], out[3], np.ones_like(p), f, zeta, dt)
-        return out
 
 
 #: The integrators by name (``Simulation(integrator=...)``).

@@ -15,14 +15,12 @@ Damping: ζ = ``wood_damping`` (the wood's internal damping) plus the drag of ev
 mode moves, linearised about a light air speed :data:`U_REF` (the calm in which field
 pull-and-release tests are made): c = ρ C A U_REF per object, ζ_air = Σc·y² / (2 ω Σm·y²)
 with y the mode shape over the branch's own elements and its children's bases. Leaves add
-mass (the frequency falls) and a large drag area for their mass (ζ rises). The simulation's
-own air damping, which grows with the wind (:mod:`.aero`), comes on top, as on real trees.
+mass (the frequency falls) and a large drag area for their mass (ζ rises).
 
-Modes above :data:`QUASI_STATIC_F` are critically damped (ζ = 1): they keep their frequency,
-so their stiffness and lean are the beam's, but do not ring. A short stout twig rings at tens of
-hertz, invisible at any frame rate, and the load path couples objects once a step: stepped at
-60 Hz, lightly damped modes that fast feed energy into what they carry (the presets' stub twigs,
-5–150 Hz, made the cherries explode).
+These modes drive the paper's oscillators (``model="paper"``, ``modes="physical"``); the tree
+model takes its stiffness from beam theory itself. Modes above :data:`QUASI_STATIC_F` are
+critically damped (ζ = 1): they keep their frequency, so their stiffness is the beam's, but a
+short stout twig ringing at tens of hertz is invisible at any frame rate.
 
 Leaves and grass blades keep the paper's mapping: a petiole modelled as a cantilever would ring
 at tens of hertz, while a leaf's visible motion comes from its twig and its flutter.
