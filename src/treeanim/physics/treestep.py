@@ -108,10 +108,10 @@ class Grab:
 
 
 def sample_points(s: Structure, st: TreeState) -> np.ndarray:
-    """(B + L, 3) world points where the wind is sampled: segment middles, then laminas."""
-    mid = st.P + np.einsum("bij,bj->bi", st.R, s.mid0)
-    lam = st.P[s.leaf_body] + st.leaf_X
-    return np.concatenate([mid, lam])
+    """(B, 3) world points where the wind is sampled: the segments' middles. A leaf takes its
+    twig segment's wind: the wind varies over metres (its integral scale is the canopy's
+    height), a leaf sits centimetres from its twig."""
+    return st.P + np.einsum("bij,bj->bi", st.R, s.mid0)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -255,7 +255,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     s : Structure
     st, out : TreeState
     wind : (B + L, 3) float
-        The wind at :func:`sample_points` of ``st`` (m/s).
+        (B, 3): the wind at :func:`sample_points` of ``st`` (m/s).
     dt : float
         Step length (s), any length: the step is implicit.
     work : Work
@@ -267,12 +267,11 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     """
     if out is not st:
         out.assign(st)
-    B = len(s.parent)
     w = work
     w.F[:] = 0.0
     w.kap[:] = 0.0
-    Ub = np.ascontiguousarray(wind[:B])
-    Ul = np.ascontiguousarray(wind[B:])
+    Ub = np.ascontiguousarray(wind)
+    Ul = Ub[s.leaf_body]
     _air_forces(dt, out.R, out.Om, out.V, s.mid0, s.axis, s.cda, Ub, s.leaf_body,
                 out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, out.leaf_speed, w.F, w.kap)
     for b, ofs, f in pulls:
@@ -289,8 +288,8 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
         _flutter(s, out, Ul, dt, leaf_flutter)
     leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
               s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, out.R, out.P, out.Om, out.V, Ul,
-              out.flutter * np.sin(out.phase), out.th, out.thd, out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2,
-              out.leaf_speed)
+              out.flutter * np.sin(out.phase), out.th, out.thd, out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap,
+              out.leaf_U, out.leaf_kap2, out.leaf_speed)
     out.time = st.time + dt
 
 
