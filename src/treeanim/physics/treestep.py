@@ -4,7 +4,7 @@
 :class:`~treeanim.physics.structure.Structure` is the static model; :func:`step` reads a state
 and writes the next one. One step:
 
-1. the wind at every segment's middle and every lamina's centroid (the pose at the start);
+1. the wind at every segment's middle (the pose at the start), a leaf taking its twig's;
 2. the air's force on every segment, ½ρC_d·d·ℓ|U⊥|U⊥ of the wind normal to it relative to the
    segment's own motion, and the leaves' forces of the last step, with the damping of both
    implicit; pulls (constant forces) and a grab (a stiff spring to a target, implicit);
