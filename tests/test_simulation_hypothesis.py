@@ -88,3 +88,29 @@ def test_same_inputs_same_result(name, seed, speed, steps):
             sim.step(1 / 60)
         runs.append(sim.positions)
     np.testing.assert_array_equal(runs[0], runs[1])
+
+
+# ---------------------------------------------------------------------------- the tree model
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(name=st.sampled_from(PRESETS[:4]), azimuth=st.floats(0, 2 * np.pi), speed=st.floats(0, 60),
+       seed=st.integers(0, 2**16), dts=st.lists(st.sampled_from([1e-3, 1 / 240, 1 / 60, 1 / 10, 0.5, 4.0]),
+                                                min_size=1, max_size=5),
+       season=st.floats(0, 1), obj_frac=st.floats(0, 1), s=st.floats(0, 1),
+       reach=st.lists(st.floats(-20, 20), min_size=3, max_size=3), force=st.floats(0, 1e5))
+def test_the_tree_model_stays_finite_keeps_lengths_and_the_ground(name, azimuth, speed, seed, dts, season, obj_frac,
+                                                                  s, reach, force):
+    """Any wind, any step, any drag (far targets included) and pull: a finite tree of rigid
+    segments, held above the ground where it is dragged."""
+    tree, within, rest_len = preset(name)
+    wind = ta.WindField(direction=(np.cos(azimuth), 0.0, np.sin(azimuth)), speed=speed, seed=seed)
+    sim = ta.Simulation(tree, wind=wind, seed=seed, season=season)
+    obj = min(int(obj_frac * tree.n_objects), tree.n_objects - 1)
+    sim.drag(obj, tree.rest_positions[tree.object_start[obj]] + np.asarray(reach), s)
+    sim.pull(tree.n_objects - 1 - obj, (force, -force, 0.0))
+    for dt in dts:
+        sim.step(dt)
+    check_pose(sim, within, rest_len)
+    sim.release()
+    for dt in dts:
+        sim.step(dt)
+    check_pose(sim, within, rest_len)
