@@ -1,4 +1,4 @@
-"""Invariants of the paper model (PaperSim) under hypothesis: any wind, any step, any preset.
+"""Invariants of both models under hypothesis: any wind, any step, any preset.
 
 Segment lengths are kept (only rotations are applied, docs/design.md §5), everything stays finite,
 rotations stay rotations, and the same inputs give the same result.
