@@ -372,3 +372,17 @@ def test_refuses_a_zero_length_segment(tmp_path, where):
         t[2, 1] = 1e-12  # the stem's last cylinder (too short for the text table's 6 decimals)
         with pytest.raises(QSMError, match=r"^stem: row 3: a zero-length segment"):
             build_tree(t, name="stem")
+
+
+def test_a_stiff_stub_twig_is_just_stiff_in_either_model():
+    """Issue 26: three Wytham scans were refused, their stub twigs computing to 14–20 kHz."""
+    stem = np.outer(np.linspace(0.0, 3.0, 4), (0.0, 1.0, 0.0))
+    stub = stem[2] + np.outer(np.linspace(0.0, 0.004, 2), (1.0, 0.0, 0.0))
+    tree = assemble([ObjectSpec(stem, np.linspace(0.2, 0.1, 4), "branch", 1),
+                     ObjectSpec(stub, np.array([0.06, 0.05]), "branch", 2, parent=0, attach=2)], name="stub")
+    for model in ("tree", "paper"):
+        sim = ta.Simulation(tree, wind=ta.WindField(speed=20.0), model=model,
+                            **({"modes": "physical"} if model == "paper" else {}))
+        for _ in range(30):
+            sim.step(1 / 60)
+        assert np.isfinite(sim.positions).all()

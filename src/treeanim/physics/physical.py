@@ -35,7 +35,7 @@ from ..model.params import PhysicsParams
 from ..model.tree import Tree
 from .modal import ModalParameters, subtree_sums
 
-__all__ = ["MODAL_MODELS", "MIN_ELEMENTS", "QUASI_STATIC_F", "U_REF", "branch_modes", "physical_modes", "subtree_sums"]
+__all__ = ["MODAL_MODELS", "MIN_ELEMENTS", "QUASI_STATIC_F", "MAX_PHYSICAL_F", "U_REF", "branch_modes", "physical_modes", "subtree_sums"]
 
 #: The sources of modal parameters a Simulation accepts.
 MODAL_MODELS = ("paper", "physical")
@@ -46,6 +46,9 @@ MIN_ELEMENTS = 32
 U_REF = 1.0
 #: Frequency (Hz) above which a branch's mode is critically damped (see the module notes).
 QUASI_STATIC_F = 5.0
+#: The highest frequency given (Hz; the paper's oscillators accept up to 10⁴): a scan's stub
+#: twig computes to 14–20 kHz, and is just as stiff, critically damped, at this one.
+MAX_PHYSICAL_F = 1.0e4
 #: Stodola iterations (from the static deflection under the beam's own weight).
 ITERATIONS = 6
 
@@ -254,13 +257,13 @@ def physical_modes(tree: Tree, params: PhysicsParams, paper: ModalParameters, ma
     Returns
     -------
     ModalParameters
-        New arrays: branches' three modes all at their beam frequency and damping (1 above
-        :data:`QUASI_STATIC_F`).
+        New arrays: branches' three modes all at their beam frequency (at most
+        :data:`MAX_PHYSICAL_F`) and damping (1 above :data:`QUASI_STATIC_F`).
     """
     F, Z = paper.f.copy(), paper.zeta.copy()
     branches = np.flatnonzero(tree.kind == "branch")
     f, zeta_air = branch_modes(tree, params.wood_youngs_modulus, np.asarray(mass, float),
                                np.asarray(air, float), branches)
-    F[branches] = f[:, None]
+    F[branches] = np.minimum(f, MAX_PHYSICAL_F)[:, None]
     Z[branches] = np.where(f > QUASI_STATIC_F, 1.0, params.wood_damping + zeta_air)[:, None]
     return ModalParameters(F, Z)
