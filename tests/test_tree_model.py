@@ -241,3 +241,21 @@ def test_a_leafless_scan_released_in_calm_air_dies_away_at_a_real_trees_damping(
     slope = np.polyfit(t[peaks], np.log(x[peaks]), 1)[0]
     zeta = -slope / (2 * np.pi * f)
     assert 0.02 < zeta < 0.10, (zeta, f)
+
+
+def test_a_scanned_trunks_frequency_scales_with_dbh_over_height_squared():
+    """REALISM.md (Moore & Maguire 2004): f ∝ DBH/H², measured from released scans."""
+    from treeanim.model.qsm import build_tree, synthetic_table
+
+    family = [(10.0, 0.25), (15.0, 0.3), (15.0, 0.45), (20.0, 0.5), (25.0, 0.7)]
+    ratio = np.array([dbh / h**2 for h, dbh in family])
+    f = []
+    for h, dbh in family:
+        tree = build_tree(synthetic_table(height=h, dbh=dbh))
+        top = tree.object_start[0] + tree.object_count[0] - 1
+        f.append(_peak_frequency(_release(tree, 0, (100.0 * dbh, 0.0, 0.0), 1 / 30, hold=6.0, seconds=24.0,
+                                          node=top)[1], 1 / 30))
+    f = np.array(f)
+    slope = np.sum(f * ratio) / np.sum(ratio * ratio)  # f = c · DBH/H², through the origin
+    assert np.max(np.abs(f / (slope * ratio) - 1)) < 0.15, (f, slope)
+    assert np.corrcoef(ratio, f)[0, 1] > 0.97
