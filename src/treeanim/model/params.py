@@ -91,6 +91,12 @@ class PhysicsParams:
         The effective Young's modulus E (Pa) of the branches' wood: the tree model's joints and
         the paper's ``modes="physical"`` (:mod:`treeanim.physics.physical`) (see
         :data:`WOOD_TYPES`).
+    leaf_area_index : float
+        The tree model: the crown's leaf area per unit of its ground projection (m²/m²;
+        broadleaf crowns 3–6, Bréda 2003). A tree's leaves stand for clusters: each carries the
+        mass, drag and petiole of as many real leaves as give its full crown this index (at
+        least one), so a preset drawn with a few thousand leaves weighs and catches the wind as
+        a real crown does.
     wood_damping : float
         The damping ratio of the wood and the stem's structure (the tree model's joints, the
         paper's ``modes="physical"``), to which the drag of the crown adds.
@@ -131,6 +137,7 @@ class PhysicsParams:
     drag_blade: float = 1.0
     leaf_flutter: float = 0.35
     wood_youngs_modulus: float = 6.0e9
+    leaf_area_index: float = 4.0
     wood_damping: float = 0.03
 
     def modes(self, kind: str, season: float) -> ModeRange | None:
@@ -155,7 +162,7 @@ SCALAR_MAX = {
     "wood_density": 1e4, "leaf_density": 1e4, "lamina_thickness": 0.05, "leaf_twist_c0": 100.0,
     "leaf_youngs_modulus": 1e12, "blade_youngs_modulus": 1e12, "air_density": 10.0, "drag_branch": 10.0,
     "drag_leaf": 10.0, "drag_blade": 10.0,
-    "leaf_flutter": 1.5, "wood_youngs_modulus": 1e12, "wood_damping": 10.0,
+    "leaf_flutter": 1.5, "wood_youngs_modulus": 1e12, "wood_damping": 10.0, "leaf_area_index": 20.0,
 }
 assert set(SCALAR_MAX) == set(SCALAR_KEYS)
 
@@ -182,7 +189,7 @@ def check_physics(p: PhysicsParams, kinds: Iterable[str]) -> None:
     if not isinstance(p, PhysicsParams):
         raise ValueError(f"physics must be a PhysicsParams, got {type(p).__name__}")
     positive = ("ei_max", "wood_density", "leaf_density", "lamina_thickness",
-                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density",
+                "leaf_youngs_modulus", "blade_youngs_modulus", "air_density", "leaf_area_index",
                 "wood_youngs_modulus")
     for name in SCALAR_KEYS:
         x = finite_float(f"physics.{name}", getattr(p, name))

@@ -30,10 +30,11 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+from scipy.spatial import ConvexHull, QhullError
 
 from ..model.geometry import lamina_frames, polygon_centroid, unit
 
-__all__ = ["Structure", "POISSON", "PETIOLE_BEND_TWIST", "PLATE_NORMAL_DRAG"]
+__all__ = ["Structure", "foliage_clusters", "POISSON", "PETIOLE_BEND_TWIST", "PLATE_NORMAL_DRAG"]
 
 #: Poisson's ratio of wood along the grain (G = E / 2(1 + ν)).
 POISSON = 0.3
@@ -129,6 +130,31 @@ def _flexible_frequency(parent, child_start, children, P, C, m, sh, kb, axis, ou
             if den > 0.0 and num > 0.0:
                 best = min(best, num / den)
         out[j] = np.sqrt(best)
+
+
+def foliage_clusters(X: np.ndarray, leaf_area: np.ndarray, lai: float) -> float:
+    """How many real leaves each of a tree's leaves stands for: enough that all of them cover
+    ``lai`` times the crown's ground projection (the convex hull of the nodes seen from
+    above), at least one.
+
+    Parameters
+    ----------
+    X : (N, 3) float
+        Rest node positions (y up).
+    leaf_area : (L,) float
+        Every leaf's lamina area (m²), present or not.
+    lai : float
+        The leaf area index wanted (m²/m²).
+    """
+    total = float(np.sum(leaf_area))
+    if total <= 0.0:
+        return 1.0
+    xz = np.asarray(X, float)[:, [0, 2]]
+    try:
+        crown = float(ConvexHull(xz).volume)  # in 2-D, the hull's area
+    except (QhullError, ValueError):
+        return 1.0  # a crown with no extent across (all nodes on a line)
+    return max(1.0, lai * crown / total)
 
 
 def _point_moments(mass: np.ndarray, r: np.ndarray):
@@ -301,11 +327,15 @@ class Structure:
         ktl = kbl * ell / (lever * PETIOLE_BEND_TWIST)
         Jb = lam_mass * (lever**2 + Llam**2 / 12.0) + pet_mass * ell**2 / 3.0
         Ja = lam_mass * width**2 / 12.0 + 1e-12
-        leaf_k = np.stack([ktl, kbl, kbl], axis=1)
-        leaf_J = np.stack([Ja, Jb, Jb], axis=1)
+        # each leaf stands for a cluster of n real ones (physics.leaf_area_index): n times the
+        # mass, drag, stiffness and inertia, so it turns as one leaf does and loads its twig as n
+        n = foliage_clusters(X, area, p.leaf_area_index)
+        leaf_mass = leaf_mass * n
+        leaf_k = n * np.stack([ktl, kbl, kbl], axis=1)
+        leaf_J = n * np.stack([Ja, Jb, Jb], axis=1)
         leaf_d = 2.0 * p.wood_damping * np.sqrt(leaf_k * leaf_J)
-        cna = 0.5 * p.air_density * p.drag_leaf * area
-        cswing = 0.5 * p.air_density * PLATE_NORMAL_DRAG * area
+        cna = 0.5 * p.air_density * p.drag_leaf * area * n
+        cswing = 0.5 * p.air_density * PLATE_NORMAL_DRAG * area * n
         # present leaves ride their twigs rigidly: their mass at their centroid
         m0, h0, J0 = mass.copy(), h_s, J_s
         if L:
