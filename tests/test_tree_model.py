@@ -259,3 +259,22 @@ def test_a_scanned_trunks_frequency_scales_with_dbh_over_height_squared():
     slope = np.sum(f * ratio) / np.sum(ratio * ratio)  # f = c · DBH/H², through the origin
     assert np.max(np.abs(f / (slope * ratio) - 1)) < 0.15, (f, slope)
     assert np.corrcoef(ratio, f)[0, 1] > 0.97
+
+
+def test_new_physics_take_effect_at_the_next_step():
+    """Stiffer wood, set mid-run, is what the next step uses (frequencies and θ re-derived)."""
+    import dataclasses
+
+    tree = ta.load_preset("beam")
+    tip = tree.object_start[0] + tree.object_count[0] - 1
+    held = {}
+    for E in (6e9, 24e9):
+        sim = ta.Simulation(tree)
+        for _ in range(3):
+            sim.step(1 / 60)
+        sim.physics = dataclasses.replace(sim.physics, wood_youngs_modulus=E)
+        sim.pull(0, (20.0, 0.0, 0.0))
+        for _ in range(240):
+            sim.step(1 / 60)
+        held[E] = sim.positions[tip, 0] - tree.rest_positions[tip, 0]
+    assert held[24e9] == pytest.approx(held[6e9] / 4, rel=0.05)  # a cantilever's x ∝ 1/E

@@ -83,6 +83,7 @@ class TreeSim:
 
     def _rebuild(self) -> None:
         self._s = Structure.build(self._tree, self._physics, self._present)
+        self._work.theta_h = None  # the joints' θ follow their frequencies
         if self._grab is not None:  # its spring follows the stiffness
             self.drag(self._grab_obj, self._grab.target, self._grab_s)
 
