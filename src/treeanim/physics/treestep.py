@@ -47,7 +47,6 @@ class TreeState:
     P: np.ndarray       # (B, 3) joint positions
     Om: np.ndarray      # (B, 3) angular velocities
     V: np.ndarray       # (B, 3) joint-point velocities
-    acc: np.ndarray     # (B, 6) the last step's change of spatial velocity
     th: np.ndarray      # (L, 3) petiole joints (twist, bend, bend)
     thd: np.ndarray     # (L, 3)
     leaf_F: np.ndarray  # (L, 3) the laminas' forces of the last step (world)
@@ -65,7 +64,7 @@ class TreeState:
         """The tree at rest at time 0."""
         B, L = len(s.parent), len(s.leaf_body)
         st = cls(time=0.0, Q=np.tile(np.eye(3), (B, 1, 1)), w=np.zeros((B, 3)), R=np.empty((B, 3, 3)),
-                 P=np.empty((B, 3)), Om=np.empty((B, 3)), V=np.empty((B, 3)), acc=np.zeros((B, 6)),
+                 P=np.empty((B, 3)), Om=np.empty((B, 3)), V=np.empty((B, 3)),
                  th=np.zeros((L, 3)), thd=np.zeros((L, 3)), leaf_F=np.zeros((L, 3)),
                  leaf_X=np.zeros((L, 3)), leaf_N=np.zeros((L, 3)), leaf_kap=np.zeros(L),
                  leaf_U=np.zeros((L, 3)), leaf_kap2=np.zeros(L), leaf_speed=np.zeros(L),
@@ -241,6 +240,7 @@ class Work:
         self.Dinv = np.empty((B, 3, 3))
         self.U = np.empty((B, 6, 3))
         self.u = np.empty((B, 3))
+        self.acc = np.empty((B, 6))  # each body's change of spatial velocity over the step
         self.theta = None
         self.theta_h = None
 
@@ -282,7 +282,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
         _grab_force(s, grab, out, dt, w)
     tb, tt = _thetas(s, dt, work)
     articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.kb, s.kt, s.dk, out.R, out.P, out.Q, out.w,
-                     w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.u, out.acc)
+                     w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.u, w.acc)
     forward_kinematics(s.parent, s.r0, out.Q, out.w, out.R, out.P, out.Om, out.V)
     if len(Ul):
         _flutter(s, out, Ul, dt, leaf_flutter)
