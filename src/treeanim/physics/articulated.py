@@ -47,17 +47,17 @@ STOP_TRACE = 1.0 + 2.0 * np.cos(JOINT_STOP)
 
 @njit(cache=True, fastmath=True, error_model="numpy")
 def theta_of(x):
-    """The θ-method's weight for a joint whose own frequency ω (with all it carries) makes
-    x = ωh a step.
+    """The θ-method's weight for a joint whose swing of frequency ω makes x = ωh a step.
 
-    θ = ½ + ½·x⁴/(x⁴ + 10⁴): the trapezoidal rule (no numerical damping, θ − ½ < 10⁻³ for
-    x < 2.4) for every joint the step resolves, rising to ¾ at x = 10 and toward 1 (backward
-    Euler) for joints far stiffer than the step, whose swing then shrinks by (1 − θ)/θ a step
-    instead of ringing at the step rate. A joint's own frequency is the highest of the modes
-    that bend it much; the tree's low modes bend mostly its trunk and limbs, whose θ is ½.
+    θ = ½ + ½·x⁴/(x⁴ + π⁴): the trapezoidal rule (no numerical damping; θ − ½ < 0.003 for
+    x < 1) for a swing the step resolves, ¾ at x = π (two steps a period, the step's Nyquist
+    limit) and toward 1 (backward Euler) for swings far faster than the step, which then
+    shrink by (1 − θ)/θ a step instead of ringing at the step rate. ω is the joint's lowest
+    swing with everything beyond it flexible (:func:`~treeanim.physics.structure._flexible_frequency`)
+    for its bends, its own segment's twist for its twist.
     """
     x4 = (x * x) ** 2
-    return 0.5 + 0.5 * x4 / (x4 + 1.0e4)
+    return 0.5 + 0.5 * x4 / (x4 + 97.40909103400242)
 
 
 @njit(cache=True, inline="always", fastmath=True, error_model="numpy")

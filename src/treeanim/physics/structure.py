@@ -210,7 +210,7 @@ class Structure:
     leaf_first: np.ndarray  # (L + 1,) offsets into leaf_nodes
     body_of_obj: np.ndarray  # (M,) the first body of each object (−1: a leaf)
     subtree_mass: np.ndarray  # (B,) everything beyond each joint
-    omega_j: np.ndarray     # (B,) each joint's own bending frequency with all it carries (rad/s)
+    omega_j: np.ndarray     # (B,) each joint's lowest swing with everything beyond it flexible (rad/s)
     omega_t: np.ndarray     # (B,) and its twisting one
 
     @classmethod
@@ -363,7 +363,9 @@ class Structure:
                             np.ascontiguousarray(com), m0, np.ascontiguousarray(sh), np.maximum(kb, 1e-30),
                             np.ascontiguousarray(axis), omega_flex)
         omega_flex = np.where(np.isfinite(omega_flex), np.minimum(omega_flex, omega_j), omega_j)
-        omega_t = np.sqrt(kt / np.maximum(np.einsum("bi,bij,bj->b", axis, sJ, axis), 1e-30))
+        # a twist's θ follows its fastest swing, the segment's own about its axis (a thin
+        # segment's is thousands of times its subtree's); twist is never the motion one sees
+        omega_t = np.sqrt(kt / np.maximum(np.einsum("bi,bij,bj->b", axis, J0, axis), 1e-30))
         # ... of its branch: a branch sways mostly as a whole, in its base joint's swing
         dk = 2.0 * p.wood_damping / omega_flex[first_body[obj]]
         leaf_first = np.r_[0, np.cumsum(count[leaves])].astype(np.int64)
@@ -378,4 +380,4 @@ class Structure:
                    leaf_d=c(leaf_d), leaf_cna=c(cna), leaf_cswing=c(cswing),
                    leaf_roll2=c(width**2 / 12.0), leaf_mass=c(leaf_mass), leaf_size=Llam,
                    leaf_nodes=c(leaf_nodes, np.int64), leaf_first=leaf_first, body_of_obj=first_body,
-                   subtree_mass=sm, omega_j=omega_j, omega_t=omega_t)
+                   subtree_mass=sm, omega_j=omega_flex, omega_t=omega_t)

@@ -275,9 +275,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     _air_forces(dt, out.R, out.Om, out.V, s.mid0, s.axis, s.cda, Ub, s.leaf_body,
                 out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, out.leaf_speed, w.F, w.kap)
     for b, ofs, f in pulls:
-        r = out.R[b] @ ofs
-        w.F[b, :3] += np.cross(r, f)
-        w.F[b, 3:] += f
+        _point_force(b, out.R[b] @ ofs, np.asarray(f, float), dt, out, w)
     if grab is not None:
         _grab_force(s, grab, out, dt, w)
     tb, tt = _thetas(s, dt, work)
@@ -321,11 +319,24 @@ def _grab_force(s: Structure, g: Grab, st: TreeState, h: float, w: Work) -> None
         alpha = g.f_max / float(np.linalg.norm(gap))
         beta = -alpha
     Kv = alpha * v + beta * (d @ v) * d
-    f = fs - g.c * v - theta * h * Kv
+    _point_force(b, r, fs, h, st, w)
+    f = -g.c * v - theta * h * Kv
     w.F[b, :3] += np.cross(r, f)
     w.F[b, 3:] += f
     q = (h * theta) ** 2
     add_point(w.kap, b, h * g.c + q * alpha, q * beta, d[0], d[1], d[2], 0.0, 0.0, 0.0, 0.0, r[0], r[1], r[2])
+
+
+def _point_force(b: int, r: np.ndarray, f: np.ndarray, h: float, st: TreeState, w: Work) -> None:
+    """A force ``f`` (world) at ``r`` from body b's joint, and its stiffness against the body's
+    turn, taken implicitly (:func:`_add_turn`): turning by δφ swings the lever, δτ = (δφ × r) × f,
+    so K = −∂τ/∂φ = (r·f)·1 − r fᵀ. A hard sideways pull on a light limb is many times stiffer
+    than the limb's own springs (taken explicitly, a 20-body-weight pull on a tulip poplar limb
+    diverged at 1/30 s steps)."""
+    w.F[b, :3] += np.cross(r, f)
+    w.F[b, 3:] += f
+    Ka = float(r @ f) * np.eye(3) - np.outer(r, f)
+    _add_turn(b, h, Ka, st.Om, w.F, w.kap)
 
 
 def _flutter(s: Structure, st: TreeState, U: np.ndarray, h: float, amp: float) -> None:
