@@ -82,12 +82,7 @@ def parse_pull(text: str) -> Pull:
     if not m:
         raise ValueError(f"--pull {text!r}: {form}")
     force = parse_force(m.group(2), f"--pull {text!r}")
-    try:
-        t0, t1 = float(m.group(3)), float(m.group(4))
-    except ValueError:
-        raise ValueError(f"--pull {text!r}: {form}") from None
-    if not (math.isfinite(t0) and math.isfinite(t1) and 0 <= t0 < t1):
-        raise ValueError(f"--pull {text!r}: expected times 0 <= T0 < T1")
+    t0, t1 = _interval(m.group(3), m.group(4), f"--pull {text!r}", form)
     return Pull(int(m.group(1)), force, t0, t1)
 
 
@@ -107,14 +102,24 @@ def parse_drag(text: str) -> Drag:
     target = parse_vector(m.group(3), f"--drag {text!r}")
     try:
         s = 1.0 if m.group(2) is None else float(m.group(2))
-        t0, t1 = float(m.group(4)), float(m.group(5))
     except ValueError:
         raise ValueError(f"--drag {text!r}: {form}") from None
     if not 0.0 <= s <= 1.0:
         raise ValueError(f"--drag {text!r}: expected S in [0, 1] (the fraction of the object's length)")
-    if not (math.isfinite(t0) and math.isfinite(t1) and 0 <= t0 < t1):
-        raise ValueError(f"--drag {text!r}: expected times 0 <= T0 < T1")
+    t0, t1 = _interval(m.group(4), m.group(5), f"--drag {text!r}", form)
     return Drag(int(m.group(1)), target, t0, t1, s)
+
+
+def _interval(start: str, end: str, what: str, form: str) -> tuple[float, float]:
+    """``T0``, ``T1`` of a scheduled pull or drag: finite, 0 <= T0 < T1; ValueError naming
+    ``what`` otherwise."""
+    try:
+        t0, t1 = float(start), float(end)
+    except ValueError:
+        raise ValueError(f"{what}: {form}") from None
+    if not (math.isfinite(t0) and math.isfinite(t1) and 0 <= t0 < t1):
+        raise ValueError(f"{what}: expected times 0 <= T0 < T1")
+    return t0, t1
 
 
 def check_pulls(pulls: list, n_objects: int, model: str = "tree") -> None:

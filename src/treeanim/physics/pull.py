@@ -32,15 +32,18 @@ GAIN = 1.5
 MAX_LENGTHS = 2.0
 
 
-def _aim(plane_point: np.ndarray, plane_normal: np.ndarray, origin, direction) -> np.ndarray | None:
-    """Where the ray from ``origin`` along ``direction`` meets the plane (never behind the
-    origin), or None where the ray runs along the plane."""
-    o, d = np.asarray(origin, float), np.asarray(direction, float)
-    denom = float(d @ plane_normal)
-    if abs(denom) < 1e-9:
-        return None
-    t = float((plane_point - o) @ plane_normal) / denom
-    return o + max(t, 0.0) * d
+class _Aimed:
+    """The target of a grab moves in the plane through the grabbed point facing the camera
+    (``plane_point``, ``plane_normal``, ``target``)."""
+
+    def aim(self, origin, direction) -> None:
+        """Move the target to where the ray from ``origin`` along ``direction`` meets the
+        plane (kept where the ray runs along the plane; never behind the origin)."""
+        o, d = np.asarray(origin, float), np.asarray(direction, float)
+        denom = float(d @ self.plane_normal)
+        if abs(denom) >= 1e-9:
+            t = float((self.plane_point - o) @ self.plane_normal) / denom
+            self.target = o + max(t, 0.0) * d
 
 
 def _nearest(P: np.ndarray, nodes: np.ndarray, point: np.ndarray) -> tuple[int, float, np.ndarray]:
@@ -61,7 +64,7 @@ def grab(sim, obj: int, point, plane_normal):
 
 
 @dataclass
-class TreeDrag:
+class TreeDrag(_Aimed):
     """A drag in progress on the tree model (make one with :meth:`grab`): the point at fraction
     :attr:`s` of the object's length is held by :meth:`Simulation.drag`, its target moved with
     the cursor.
@@ -114,13 +117,6 @@ class TreeDrag:
         d.step(sim, 0.0)
         return d
 
-    def aim(self, origin, direction) -> None:
-        """Move the target to where the ray from ``origin`` along ``direction`` meets the
-        plane (kept where the ray runs along the plane; never behind the origin)."""
-        t = _aim(self.plane_point, self.plane_normal, origin, direction)
-        if t is not None:
-            self.target = t
-
     def anchor(self, sim) -> np.ndarray:
         """Where the grabbed (picked) point is now (world): the held point plus the offset."""
         return np.asarray(sim.point_position(self.object, self.s), float) + self.offset
@@ -143,7 +139,7 @@ class TreeDrag:
 
 
 @dataclass
-class SpringPull:
+class SpringPull(_Aimed):
     """A pull in progress (make one with :meth:`grab`).
 
     Attributes
@@ -210,13 +206,6 @@ class SpringPull:
         return cls(object=int(obj), node=int(nodes[k]), s=s, offset=offset, plane_point=point.copy(),
                    plane_normal=np.asarray(plane_normal, float).copy(), target=point.copy(), k=spring,
                    f_max=spring * MAX_LENGTHS * length, force=np.zeros(3), ratio=G / G_tip)
-
-    def aim(self, origin, direction) -> None:
-        """Move the target to where the ray from ``origin`` along ``direction`` meets the
-        plane (kept where the ray runs along the plane; never behind the origin)."""
-        t = _aim(self.plane_point, self.plane_normal, origin, direction)
-        if t is not None:
-            self.target = t
 
     def anchor(self, sim) -> np.ndarray:
         """Where the grabbed point is now (world), from ``sim``'s pose."""
