@@ -81,7 +81,7 @@ class Simulation:
         A copy of everything that changes over time; assigning one taken from this simulation
         restores it exactly.
     energy : float
-        (tree) Kinetic plus elastic energy (J): in calm air it never rises.
+        (tree) Kinetic plus elastic energy (J): in calm air it falls (see docs/design.md §12).
     """
 
     def __init__(self, tree: Tree, wind=None, season: float = 0.0, seed: int = 0, model: str | None = None,
