@@ -79,11 +79,11 @@ class PhysicsParams:
         ρ of the air (kg/m³), for the drag ½ρ C A |U_rel| U_rel (the tree model).
     drag_branch, drag_leaf, drag_blade : float
         Drag coefficients (the tree model; the paper's ``modes="physical"`` damping): C_d of a
-        branch across the flow, C_n of a lamina's normal
-        force, C_d of a grass blade. Effective values for objects inside a crown: summed
-        one by one, twigs and leaves that shelter each other would catch 3–5 times the drag of
-        the crown they form (leaf area index), so branches and leaves take a quarter to a
-        third of an isolated cylinder's (1.2) and plate's (1.0) coefficient.
+        branch across the flow, C_n of a lamina's normal force, C_d of a grass blade. A
+        cylinder's (1.2) and a flat plate's (1.2): the crown's shelter is the wind's canopy
+        profile (the wind inside a canopy falls off with depth), not a smaller coefficient.
+        So a crown catches what measured crowns do (a drag coefficient of about 0.2 on its
+        silhouette at a few m/s) and its leaves reconfigure in a gale.
     leaf_flutter : float
         The tree model: the largest twist (rad) of a leaf's flutter about its petiole in a
         strong wind (:mod:`treeanim.physics.treestep`).
@@ -132,8 +132,8 @@ class PhysicsParams:
     leaf_youngs_modulus: float = 1.0e9
     blade_youngs_modulus: float = 5.0e5
     air_density: float = 1.2
-    drag_branch: float = 0.3
-    drag_leaf: float = 0.15
+    drag_branch: float = 1.2
+    drag_leaf: float = 1.2
     drag_blade: float = 1.0
     leaf_flutter: float = 0.35
     wood_youngs_modulus: float = 6.0e9

@@ -34,7 +34,8 @@ stepper lives in :mod:`treeanim.physics.structure` (the model) and
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+
+from .compiled import njit
 
 __all__ = ["theta_of", "forward_kinematics", "articulated_step", "rot_log", "rot_exp", "add_point", "JOINT_STOP"]
 

@@ -4,11 +4,21 @@ pose of every node: compiled passes (numba, ``cache=True``)."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from .articulated import _cross
+from .compiled import njit
 
-__all__ = ["leaf_step", "pose_nodes"]
+__all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP"]
+
+#: The most a leaf turns about one of its axes in one step (rad). The step takes the air's
+#: pull on a turning lamina linearised; in a gale a leaf settles in the flow within 10–20 ms
+#: (its lever over |U|), so a longer step's linear turn would overshoot the flow and flip the
+#: leaf from side to side. Capping the turn (and the speed with it: energy is only taken
+#: away) keeps each step where the linearisation holds.
+MAX_TURN = 0.4
+#: The most a petiole bends (rad): past a right angle, so a leaf whose petiole points upwind
+#: trails downwind of it in a gale instead of being held face-on to the flow.
+PETIOLE_STOP = 0.9 * np.pi
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
@@ -56,7 +66,7 @@ def _leaf_rotation(E, th, G):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R, P, Om, V, U,
+def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, cauchy, R, P, Om, V, U,
               flutter, th, thd, F, X, Nrm, kap, Uh, kap2, speed):
     """Advance every leaf's petiole joint (bend about two axes and twist) over one step, and
     give the force it passes to its twig for the next.
@@ -72,9 +82,9 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
     it (that would feed the leaf energy its twig never gives up): a leaf moves by the air
     relative to it, its twig's motion included — for a leaf, whose drag outweighs its
     inertia many times, the larger part. The air against the lamina's own swing damps it at
-    c·|U_rel|·r² (c = ½ρC_nA of a flat plate, r its lever: the crown shelters a leaf from the
-    wind, not from the air it moves through), at least the rate of the normal force's own
-    swing term, so in calm air the leaf and its twig together only ever lose energy.
+    c·|U_rel|·r² (c = ½ρC_nA of a flat plate unfolded, r its lever), at least the rate of the
+    normal force's own swing term, so in calm air the leaf and its twig together only ever
+    lose energy.
 
     Parameters
     ----------
@@ -83,9 +93,12 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
         lamina's centroid from the petiole's base, the lamina's rest normal.
     E : (L, 3, 3) — the leaf's axes (columns a, b₁, b₂) in rest axes.
     k, J, dstr : (L, 3) — stiffness, inertia and structural damping per axis.
-    cna : (L,) — ½ρC_nA of the lamina in the wind (the crown's sheltered coefficient).
+    cna : (L,) — ½ρC_nA of the lamina in the wind (``physics.drag_leaf``).
     cswing : (L,) — ½ρC_nA of the lamina against its own swing (a plate's coefficient).
     roll2 : (L,) — the lamina's mean squared distance from its axis (its width²/12).
+    cauchy : (L,) — the lamina's scaled Cauchy number C* per (m/s)²: in the flow it folds and
+        rolls, its normal force falls by R = (1 + C*|U_rel|²)^(−1/3) (Gosselin et al. 2010:
+        a flexible plate's drag grows as U^(4/3) once C* ≫ 1, Vogel's exponent −2/3).
     R, P, Om, V : the twigs' new kinematics.
     U : (L, 3) — the wind at each lamina (m/s).
     flutter : (L,) — the flutter's twist now (rad): its torque k_t·flutter drives the twist.
@@ -126,16 +139,17 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
         ux, uy, uz = U[l, 0] - V[b, 0] - o[0], U[l, 1] - V[b, 1] - o[1], U[l, 2] - V[b, 2] - o[2]
         s = np.sqrt(ux * ux + uy * uy + uz * uz)
         un = ux * nx + uy * ny + uz * nz
-        fn = cna[l] * s * un
+        c = cna[l] * (1.0 + cauchy[l] * s * s) ** (-1.0 / 3.0)  # the folded lamina's
+        fn = c * s * un
         fx, fy, fz = fn * nx, fn * ny, fn * nz
         F[l, 0], F[l, 1], F[l, 2] = fx, fy, fz
         Nrm[l, 0], Nrm[l, 1], Nrm[l, 2] = nx, ny, nz
-        kap[l] = cna[l] * s
+        kap[l] = c * s
         if s > 0.0:
             Uh[l, 0], Uh[l, 1], Uh[l, 2] = ux / s, uy / s, uz / s
         else:
             Uh[l, 0] = Uh[l, 1] = Uh[l, 2] = 0.0
-        kap2[l] = cna[l] * abs(un)
+        kap2[l] = c * abs(un)
         speed[l] = s
         # torque about the petiole's base: the bends take its part about the rest axes b₁, b₂
         # (in the twig's axes, Rᵀτ), the twist its part about the lamina's axis now (Ga): nil
@@ -145,7 +159,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
         tl1 = R[b, 0, 1] * t[0] + R[b, 1, 1] * t[1] + R[b, 2, 1] * t[2]
         tl2 = R[b, 0, 2] * t[0] + R[b, 1, 2] * t[1] + R[b, 2, 2] * t[2]
         lever2 = rc0[l, 0] ** 2 + rc0[l, 1] ** 2 + rc0[l, 2] ** 2
-        dair = cswing[l] * s * lever2  # the air against the lamina's own swing
+        dair = max(cswing[l], c) * s * lever2  # the air against the lamina's own swing
         for i in range(3):
             kk = k[l, i]
             ka = 0.0
@@ -164,9 +178,9 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
                 dr = _cross(ex, ey, ez, cx, cy, cz)
                 dn = _cross(ex, ey, ez, nx, ny, nz)
                 udn = ux * dn[0] + uy * dn[1] + uz * dn[2]
-                g0 = cna[l] * s * (udn * nx + un * dn[0])
-                g1 = cna[l] * s * (udn * ny + un * dn[1])
-                g2 = cna[l] * s * (udn * nz + un * dn[2])
+                g0 = c * s * (udn * nx + un * dn[0])
+                g1 = c * s * (udn * ny + un * dn[1])
+                g2 = c * s * (udn * nz + un * dn[2])
                 t1 = _cross(dr[0], dr[1], dr[2], fx, fy, fz)
                 t2 = _cross(cx, cy, cz, g0, g1, g2)
                 ka = max(0.0, -(ex * (t1[0] + t2[0]) + ey * (t1[1] + t2[1]) + ez * (t1[2] + t2[2])))
@@ -175,12 +189,17 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, R,
             hth = h * tl
             num = h * (tau - kk * th[l, i] - (d + hth * kt) * thd[l, i])
             dd = num / (J[l, i] + hth * d + hth * hth * kt)
-            th[l, i] += h * (thd[l, i] + tl * dd)
-            thd[l, i] += dd
-        # a petiole bends at most to a right angle (its lamina then lies in the flow)
+            turn = h * (thd[l, i] + tl * dd)
+            v = thd[l, i] + dd
+            if abs(turn) > MAX_TURN:
+                v *= MAX_TURN / abs(turn)
+                turn = MAX_TURN if turn > 0.0 else -MAX_TURN
+            th[l, i] += turn
+            thd[l, i] = v
+        # a petiole's stop
         bend = np.sqrt(th[l, 1] ** 2 + th[l, 2] ** 2)
-        if bend > 0.5 * np.pi:
-            sc = 0.5 * np.pi / bend
+        if bend > PETIOLE_STOP:
+            sc = PETIOLE_STOP / bend
             th[l, 1] *= sc
             th[l, 2] *= sc
             thd[l, 1] *= sc

@@ -29,10 +29,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 from scipy.spatial import ConvexHull, QhullError
 
 from ..model.geometry import lamina_frames, polygon_centroid, unit
+from .compiled import njit
 
 __all__ = ["Structure", "foliage_clusters", "POISSON", "PETIOLE_BEND_TWIST", "PLATE_NORMAL_DRAG"]
 
@@ -204,6 +204,7 @@ class Structure:
     leaf_cna: np.ndarray    # (L,) ½ρC_nA in the wind
     leaf_cswing: np.ndarray  # (L,) ½ρC_nA against the lamina's own swing
     leaf_roll2: np.ndarray  # (L,) width²/12 of the lamina (its roll's lever²)
+    leaf_cauchy: np.ndarray  # (L,) the lamina's scaled Cauchy number per (m/s)² (leafjoint.leaf_step)
     leaf_mass: np.ndarray   # (L,)
     leaf_size: np.ndarray   # (L,) lamina length
     leaf_nodes: np.ndarray  # concatenated node lists of the leaves
@@ -336,6 +337,10 @@ class Structure:
         leaf_d = 2.0 * p.wood_damping * np.sqrt(leaf_k * leaf_J)
         cna = 0.5 * p.air_density * p.drag_leaf * area * n
         cswing = 0.5 * p.air_density * PLATE_NORMAL_DRAG * area * n
+        # the lamina folds and rolls in the flow (Gosselin et al. 2010): its scaled Cauchy number
+        # C_n·ρU²ℓ³/(2D) per U², D = Et³/(12(1 − ν²)) its flexural rigidity (veins and all)
+        D = p.leaf_youngs_modulus * p.lamina_thickness**3 / (12.0 * (1.0 - POISSON**2))
+        cauchy = p.drag_leaf * p.air_density * Llam**3 / (2.0 * D)
         # present leaves ride their twigs rigidly: their mass at their centroid
         m0, h0, J0 = mass.copy(), h_s, J_s
         if L:
@@ -378,6 +383,6 @@ class Structure:
                    leaf_base0=c(base0),
                    leaf_rc0=c(rc0), leaf_n0=c(n0), leaf_E=c(Eax), leaf_k=c(leaf_k), leaf_J=c(leaf_J),
                    leaf_d=c(leaf_d), leaf_cna=c(cna), leaf_cswing=c(cswing),
-                   leaf_roll2=c(width**2 / 12.0), leaf_mass=c(leaf_mass), leaf_size=Llam,
+                   leaf_roll2=c(width**2 / 12.0), leaf_cauchy=c(cauchy), leaf_mass=c(leaf_mass), leaf_size=Llam,
                    leaf_nodes=c(leaf_nodes, np.int64), leaf_first=leaf_first, body_of_obj=first_body,
                    subtree_mass=sm, omega_j=omega_flex, omega_t=omega_t)

@@ -19,9 +19,9 @@ from __future__ import annotations
 from dataclasses import dataclass, fields
 
 import numpy as np
-from numba import njit
 
 from .articulated import add_point, articulated_step, forward_kinematics, rot_log, theta_of
+from .compiled import njit
 from .leafjoint import leaf_step, pose_nodes
 from .structure import Structure
 
@@ -285,7 +285,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     if len(Ul):
         _flutter(s, out, Ul, dt, leaf_flutter)
     leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
-              s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, out.R, out.P, out.Om, out.V, Ul,
+              s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, s.leaf_cauchy, out.R, out.P, out.Om, out.V, Ul,
               out.flutter * np.sin(out.phase), out.th, out.thd, out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap,
               out.leaf_U, out.leaf_kap2, out.leaf_speed)
     out.time = st.time + dt
