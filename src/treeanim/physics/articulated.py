@@ -399,31 +399,54 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
 @njit(cache=True, fastmath=True, error_model="numpy")
 def add_point(kap, b, alpha, b1, e1x, e1y, e1z, b2, e2x, e2y, e2z, rx, ry, rz):
     """kap[b] += Pᵀ C P for C = α·1 + β₁·e₁e₁ᵀ + β₂·e₂e₂ᵀ acting at the point r (world, from
-    b's joint)."""
-    C = np.empty((3, 3))
-    e1 = (e1x, e1y, e1z)
-    e2 = (e2x, e2y, e2z)
-    for i in range(3):
-        for j in range(3):
-            C[i, j] = b1 * e1[i] * e1[j] + b2 * e2[i] * e2[j]
-        C[i, i] += alpha
-    # M1 = C [r]×
-    M1 = np.empty((3, 3))
-    for i in range(3):
-        M1[i, 0] = C[i, 1] * rz - C[i, 2] * ry
-        M1[i, 1] = C[i, 2] * rx - C[i, 0] * rz
-        M1[i, 2] = C[i, 0] * ry - C[i, 1] * rx
-    # UL = −[r]× M1 ; UR = −M1ᵀ ; LL = −M1 ; LR = C
-    for j in range(3):
-        c0, c1, c2 = _cross(rx, ry, rz, M1[0, j], M1[1, j], M1[2, j])
-        kap[b, 0, j] -= c0
-        kap[b, 1, j] -= c1
-        kap[b, 2, j] -= c2
-    for i in range(3):
-        for j in range(3):
-            kap[b, i, 3 + j] -= M1[j, i]
-            kap[b, 3 + i, j] -= M1[i, j]
-            kap[b, 3 + i, 3 + j] += C[i, j]
+    b's joint). Scalars only: it runs for every segment and leaf each step."""
+    c00 = alpha + b1 * e1x * e1x + b2 * e2x * e2x
+    c11 = alpha + b1 * e1y * e1y + b2 * e2y * e2y
+    c22 = alpha + b1 * e1z * e1z + b2 * e2z * e2z
+    c01 = b1 * e1x * e1y + b2 * e2x * e2y
+    c02 = b1 * e1x * e1z + b2 * e2x * e2z
+    c12 = b1 * e1y * e1z + b2 * e2y * e2z
+    # M = C [r]×
+    m00, m01, m02 = c01 * rz - c02 * ry, c02 * rx - c00 * rz, c00 * ry - c01 * rx
+    m10, m11, m12 = c11 * rz - c12 * ry, c12 * rx - c01 * rz, c01 * ry - c11 * rx
+    m20, m21, m22 = c12 * rz - c22 * ry, c22 * rx - c02 * rz, c02 * ry - c12 * rx
+    # upper left −[r]× M (symmetric: [r]×ᵀ C [r]×), upper right −Mᵀ, lower left −M, lower right C
+    kap[b, 0, 0] -= ry * m20 - rz * m10
+    kap[b, 0, 1] -= ry * m21 - rz * m11
+    kap[b, 0, 2] -= ry * m22 - rz * m12
+    kap[b, 1, 0] -= rz * m00 - rx * m20
+    kap[b, 1, 1] -= rz * m01 - rx * m21
+    kap[b, 1, 2] -= rz * m02 - rx * m22
+    kap[b, 2, 0] -= rx * m10 - ry * m00
+    kap[b, 2, 1] -= rx * m11 - ry * m01
+    kap[b, 2, 2] -= rx * m12 - ry * m02
+    kap[b, 0, 3] -= m00
+    kap[b, 0, 4] -= m10
+    kap[b, 0, 5] -= m20
+    kap[b, 1, 3] -= m01
+    kap[b, 1, 4] -= m11
+    kap[b, 1, 5] -= m21
+    kap[b, 2, 3] -= m02
+    kap[b, 2, 4] -= m12
+    kap[b, 2, 5] -= m22
+    kap[b, 3, 0] -= m00
+    kap[b, 3, 1] -= m01
+    kap[b, 3, 2] -= m02
+    kap[b, 4, 0] -= m10
+    kap[b, 4, 1] -= m11
+    kap[b, 4, 2] -= m12
+    kap[b, 5, 0] -= m20
+    kap[b, 5, 1] -= m21
+    kap[b, 5, 2] -= m22
+    kap[b, 3, 3] += c00
+    kap[b, 3, 4] += c01
+    kap[b, 3, 5] += c02
+    kap[b, 4, 3] += c01
+    kap[b, 4, 4] += c11
+    kap[b, 4, 5] += c12
+    kap[b, 5, 3] += c02
+    kap[b, 5, 4] += c12
+    kap[b, 5, 5] += c22
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")

@@ -22,13 +22,13 @@ PETIOLE_STOP = 0.9 * np.pi
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _leaf_theta(x):
-    """A petiole joint's θ for x = ωh: ½ + ½·x⁴/(x⁴ + 10⁴), the trapezoidal rule up to a
+def _leaf_theta(x2):
+    """A petiole joint's θ for x² = (ωh)²: ½ + ½·x⁴/(x⁴ + 10⁴), the trapezoidal rule up to a
     few steps a period (a leaf's turns stay visible at 30 frames a second, at a turn per frame
     proportional to the frame's length), toward backward Euler for swings ten times faster.
     Defined here, not shared with the joints' (``articulated.theta_of``): numba's cache does
     not see a change in another module's inlined function."""
-    x4 = (x * x) ** 2
+    x4 = x2 * x2
     return 0.5 + 0.5 * x4 / (x4 + 1.0e4)
 
 
@@ -139,7 +139,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
         ux, uy, uz = U[l, 0] - V[b, 0] - o[0], U[l, 1] - V[b, 1] - o[1], U[l, 2] - V[b, 2] - o[2]
         s = np.sqrt(ux * ux + uy * uy + uz * uz)
         un = ux * nx + uy * ny + uz * nz
-        c = cna[l] * (1.0 + cauchy[l] * s * s) ** (-1.0 / 3.0)  # the folded lamina's
+        c = cna[l] / np.cbrt(1.0 + cauchy[l] * s * s)  # the folded lamina's
         fn = c * s * un
         fx, fy, fz = fn * nx, fn * ny, fn * nz
         F[l, 0], F[l, 1], F[l, 2] = fx, fy, fz
@@ -185,7 +185,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
                 t2 = _cross(cx, cy, cz, g0, g1, g2)
                 ka = max(0.0, -(ex * (t1[0] + t2[0]) + ey * (t1[1] + t2[1]) + ez * (t1[2] + t2[2])))
             kt = kk + ka
-            tl = _leaf_theta(h * np.sqrt(kt / J[l, i]))
+            tl = _leaf_theta(h * h * kt / J[l, i])
             hth = h * tl
             num = h * (tau - kk * th[l, i] - (d + hth * kt) * thd[l, i])
             dd = num / (J[l, i] + hth * d + hth * hth * kt)
