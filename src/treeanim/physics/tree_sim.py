@@ -69,7 +69,7 @@ class TreeSim:
         self._st = TreeState.rest(self._s, self._seed)
         self._next = self._st.copy()
         self._fallen = FallingLeaves(tree.object_start, tree.object_count, tree.rest_w, self._seed)
-        self._pulls: dict[int, tuple[int, np.ndarray, np.ndarray]] = {}
+        self._pulls: dict[int, tuple[int, np.ndarray, np.ndarray, np.ndarray]] = {}  # body, offset, applied, asked
         self._grab: Grab | None = None
         self._grab_obj: int | None = None
         self.wind = wind
@@ -170,7 +170,7 @@ class TreeSim:
         s, st = self._s, self._st
         t = st.time
         U = self._sample(treestep.sample_points(s, st), t)
-        pulls = list(self._pulls.values())
+        pulls = [(b, ofs, f) for b, ofs, f, _ in self._pulls.values()]
         treestep.step(s, st, self._next, U, dt, self._work, pulls, self._grab, self._physics.leaf_flutter)
         if len(self._fallen):
             self._fallen.step(None if self.wind is None else (lambda p: self._sample(p, t)), dt)
@@ -229,24 +229,25 @@ class TreeSim:
         return b0 + k, min(max(t, 0.0), 1.0) * L[k] * st.axis[b0 + k]
 
     def pull(self, i: int, force: np.ndarray) -> None:
-        """Hold object ``i``'s tip with a constant world ``force`` (validated by the façade)."""
+        """Hold object ``i``'s tip with a constant world ``force`` (validated by the façade),
+        at most what its wood bears: a larger pull would break a joint on the way to the root
+        (:data:`WOOD_RUPTURE`), so it is held at that force, in its direction."""
         b, ofs = self._point(i, 1.0)
-        self._pulls[i] = (b, ofs, np.asarray(force, float).copy())
+        force = np.asarray(force, float).copy()
+        n = float(np.linalg.norm(force))
+        f_max = self._strength(b, ofs)[1]
+        self._pulls[i] = (b, ofs, force * (f_max / n) if n > f_max else force.copy(), force)
 
     @property
     def pulls(self) -> dict[int, np.ndarray]:
-        """Held objects and their forces (a copy)."""
-        return {i: f.copy() for i, (_, _, f) in self._pulls.items()}
+        """Held objects and the forces asked of them (a copy)."""
+        return {i: f.copy() for i, (_, _, _, f) in self._pulls.items()}
 
-    def drag(self, i: int, target: np.ndarray, s: float = 1.0) -> None:
-        """Hold the point at fraction ``s`` along object ``i`` with a stiff spring toward the
-        world ``target`` (kept :data:`GROUND_CLEARANCE` above the ground), solved inside the
-        step; call again to move the target."""
-        b, ofs = self._point(i, s)
-        target = np.asarray(target, float).copy()
-        target[1] = max(target[1], GROUND_CLEARANCE)
+    def _strength(self, b: int, ofs: np.ndarray) -> tuple[float, float]:
+        """At the point ``ofs`` (rest, from body b's joint): the tree's compliance (m/N, every
+        joint on the way to the root bending) and the largest force no joint on the way breaks
+        under (N)."""
         st = self._s
-        # the tree's compliance at the point and the weakest joint on the way to the root
         X = self._tree.rest_positions
         p = X[st.node[b]] + ofs
         compliance, f_max, j = 0.0, np.inf, b
@@ -258,8 +259,18 @@ class TreeSim:
             if lever > 1e-9:
                 f_max = min(f_max, WOOD_RUPTURE * np.pi * st.diameter[j] ** 3 / 32.0 / lever)
             j = int(st.parent[j])
+        return compliance, f_max
+
+    def drag(self, i: int, target: np.ndarray, s: float = 1.0) -> None:
+        """Hold the point at fraction ``s`` along object ``i`` with a stiff spring toward the
+        world ``target`` (kept :data:`GROUND_CLEARANCE` above the ground), solved inside the
+        step; call again to move the target."""
+        b, ofs = self._point(i, s)
+        target = np.asarray(target, float).copy()
+        target[1] = max(target[1], GROUND_CLEARANCE)
+        compliance, f_max = self._strength(b, ofs)
         k = GRAB_STIFFNESS / max(compliance, 1e-30)
-        m = float(st.subtree_mass[b])
+        m = float(self._s.subtree_mass[b])
         self._grab = Grab(body=b, offset=ofs, target=target, k=k, c=2.0 * np.sqrt(k * m), f_max=float(f_max), mass=m)
         self._grab_obj, self._grab_s = i, s
 
