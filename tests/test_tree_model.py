@@ -160,8 +160,10 @@ def test_a_bad_drag_is_refused_in_one_line(target, s):
 
 
 def test_the_articulated_step_solves_the_implicit_system_exactly():
-    """One step of the O(n) sweeps against the dense system (M + Jᵀ κ J) Δ = h Jᵀ F, built from
-    finite differences of the kinematics, with a point damper (κ) on a moving beam."""
+    """One step of the O(n) sweeps against the dense system
+    (Jᵀ(M + κ + h·∂f/∂ν)J) Δ = h Jᵀ(F − f), built from finite differences of the kinematics,
+    with a point damper (κ) on a moving beam, f = ν ×* Iν each body's velocity-product force
+    and ∂f/∂ν its derivative by finite differences."""
     from treeanim.physics.articulated import add_point, articulated_step, forward_kinematics
 
     tree = ta.load_preset("beam")
@@ -187,21 +189,37 @@ def test_the_articulated_step_solves_the_implicit_system_exactly():
     kap = np.zeros((B, 6, 6))
     r = st.R[5] @ np.array([0.0, 0.1, 0.0])
     add_point(kap, 5, 1000.0 * h, 0.3, 1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, *r)
-    I = np.zeros((6 * B, 6 * B))
+
+    def cross(a):
+        return np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
+
+    def bias(Ib, nu):  # ν ×* Iν
+        n, p = np.split(Ib @ nu, 2)
+        w, v = np.split(nu, 2)
+        return np.concatenate([np.cross(w, n) + np.cross(v, p), np.cross(w, p)])
+
+    A = np.zeros((6 * B, 6 * B))
+    f = np.zeros(6 * B)
     for b in range(B):
         hw, Jb = st.R[b] @ s.h0[b], st.R[b] @ s.J0[b] @ st.R[b].T
-        hx = np.array([[0, -hw[2], hw[1]], [hw[2], 0, -hw[0]], [-hw[1], hw[0], 0]])
-        I[6 * b:6 * b + 6, 6 * b:6 * b + 6] = np.block([[Jb, hx], [hx.T, s.m0[b] * np.eye(3)]]) + kap[b]
+        Ib = np.block([[Jb, cross(hw)], [cross(hw).T, s.m0[b] * np.eye(3)]])
+        nu = np.concatenate([st.Om[b], st.V[b]])
+        hb = h / (1.0 + (h * h * nu[:3] @ nu[:3]) ** 2)  # the resolved whirl's share
+        G = np.stack([(bias(Ib, nu + 1e-6 * e) - bias(Ib, nu - 1e-6 * e)) / 2e-6 for e in np.eye(6)], axis=1)
+        A[6 * b:6 * b + 6, 6 * b:6 * b + 6] = Ib + kap[b] + hb * G
+        f[6 * b:6 * b + 6] = hb * bias(Ib, nu)
     F = np.zeros((B, 6))
     F[5, 3:] = (1.0, -0.5, 0.2)
     F[5, :3] = np.cross(r, F[5, 3:])
-    dense = np.linalg.solve(J.T @ I @ J, h * J.T @ F.ravel())
+    dense = np.linalg.solve(J.T @ A @ J, J.T @ (h * F.ravel() - f))
     w0 = st.w.copy()
     zero = np.zeros(B)
-    work = [np.empty((B, 6, 6)), np.empty((B, 6)), np.empty((B, 3, 3)), np.empty((B, 6, 3)), np.empty((B, 3))]
+    work = [np.empty((B, 6, 6)), np.empty((B, 6)), np.empty((B, 3, 3)), np.empty((B, 6, 3)), np.empty((B, 3, 6)),
+            np.empty((B, 3))]
     articulated_step(h, np.full(B, 0.5), np.full(B, 0.5), s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, zero, zero, zero,
-                     st.R, st.P, st.Q, st.w, F, kap, *work, np.zeros((B, 6)))
+                     st.R, st.P, st.Q, st.w, st.Om, st.V, F, kap, *work, np.zeros((B, 6)))
     aba = np.concatenate([Rp[b] @ (st.w[b] - w0[b]) for b in range(B)])
+    assert np.abs(f).max() > 1e-3 * np.abs(h * F).max()  # the velocity products are in play
     np.testing.assert_allclose(aba, dense, atol=1e-10 * np.abs(dense).max())
 
 

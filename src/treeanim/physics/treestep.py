@@ -239,6 +239,7 @@ class Work:
         self.pA = np.empty((B, 6))
         self.Dinv = np.empty((B, 3, 3))
         self.U = np.empty((B, 6, 3))
+        self.Ur = np.empty((B, 3, 6))
         self.u = np.empty((B, 3))
         self.acc = np.empty((B, 6))  # each body's change of spatial velocity over the step
         self.theta = None
@@ -280,7 +281,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
         _grab_force(s, grab, out, dt, w)
     tb, tt = _thetas(s, dt, work)
     articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.kb, s.kt, s.dk, out.R, out.P, out.Q, out.w,
-                     w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.u, w.acc)
+                     out.Om, out.V, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.Ur, w.u, w.acc)
     forward_kinematics(s.parent, s.r0, out.Q, out.w, out.R, out.P, out.Om, out.V)
     if len(Ul):
         _flutter(s, out, Ul, dt, leaf_flutter)
