@@ -1,4 +1,11 @@
-"""The physical wind (docs/design.md §12): a von Kármán tile carried downwind, a canopy profile, gusts."""
+"""The physical wind (docs/design.md §12): a von Kármán tile carried downwind, a canopy profile, gusts.
+
+A call of ``WindField.sample`` works out what is the same for every point in Python (the
+clocks, the two layers' whole-cell offsets and weights, the wind frame, the gusts' widths,
+the cached tile) and hands them to one compiled pass over the points (``_sample_points``):
+each point's cell coordinates, its periodic trilinear look-up of the two blended layers,
+its canopy profile and its gust.
+"""
 
 from __future__ import annotations
 
@@ -9,7 +16,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import scipy.fft
 
-from .settings import _CHUNK, _COORD_CLIP, _GRID_CLIP
+from ..compiled import njit
+from .settings import _COORD_CLIP, _GRID_CLIP
 
 if TYPE_CHECKING:
     from .field import WindField
@@ -39,52 +47,60 @@ _GUST_JITTER = 0.7
 _GUST_MAX_WIDTH = (1.0, 3.0)
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _canopy(h: float, inv_top: float) -> tuple[float, float]:
+    """(mean speed, σ) over their values at the canopy top, at height ``h`` (m), ``inv_top``
+    one over the canopy height: the log law above the canopy (σ constant there), exponential
+    decay inside it."""
+    z = min(max(h, 0.0), _COORD_CLIP) * inv_top
+    inside = min(z, 1.0) - 1.0  # ≤ 0
+    sigma = math.exp(SIGMA_ATTENUATION * inside)
+    if z > 1.0:
+        return math.log((z - DISPLACEMENT) / ROUGHNESS) / _LOG_TOP, sigma
+    return math.exp(CANOPY_ATTENUATION * inside), sigma
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _canopy_means(h: np.ndarray, inv_top: float) -> np.ndarray:
+    """The mean of :func:`_canopy` at each of the heights ``h`` (1-D)."""
+    out = np.empty(h.shape[0])
+    for i in range(h.shape[0]):
+        out[i] = _canopy(h[i], inv_top)[0]
+    return out
+
+
 def _canopy_mean(h: np.ndarray, top: float) -> np.ndarray:
     """Mean speed over the speed at the canopy top ``top`` at heights ``h`` (m)."""
     h = np.asarray(h, float)
-    return _canopy(h.reshape(-1), top)[0].reshape(h.shape)
+    return _canopy_means(h.reshape(-1), 1.0 / top).reshape(h.shape)
 
 
-def _canopy(h: np.ndarray, top: float) -> tuple[np.ndarray, np.ndarray]:
-    """(mean speed, σ) over their values at the canopy top ``top``, at heights ``h`` (m): the
-    log law above the canopy (σ constant there), exponential decay inside it."""
-    z = np.minimum(np.maximum(h, 0.0), _COORD_CLIP)
-    z *= 1.0 / top
-    inside = np.minimum(z, 1.0)
-    inside -= 1.0  # ≤ 0
-    sigma = np.exp(SIGMA_ATTENUATION * inside)
-    inside *= CANOPY_ATTENUATION
-    mean = np.exp(inside, out=inside)
-    above = z > 1.0
-    if above.any():
-        mean[above] = np.log((z[above] - DISPLACEMENT) / ROUGHNESS) / _LOG_TOP
-    return mean, sigma
+@lru_cache(maxsize=16)
+def _stream(seed: int, stream: int) -> np.uint64:
+    """The key of one stream of :func:`_hash_uniform`'s numbers for a seed (any size)."""
+    return np.uint64((seed * 0xD1B54A32D192ED03 + stream * 0x8CB92BA72F3D8DD7 + 0x632BE59BD9B4E019)
+                     & ((1 << 64) - 1))
 
 
-_M64 = (1 << 64) - 1
-
-
-def _mix(x: np.ndarray) -> np.ndarray:
-    """splitmix64's finaliser on a uint64 array (wrapping arithmetic)."""
-    x = x ^ (x >> np.uint64(30))
-    x = x * np.uint64(0xBF58476D1CE4E5B9)
-    x = x ^ (x >> np.uint64(27))
-    x = x * np.uint64(0x94D049BB133111EB)
-    return x ^ (x >> np.uint64(31))
-
-
-def _hash_uniform(seed: int, stream: int, k: np.ndarray, lanes: int) -> np.ndarray:
-    """Deterministic uniform [0, 1) numbers, (len(k), lanes), for integer keys ``k``."""
-    base = (seed * 0xD1B54A32D192ED03 + stream * 0x8CB92BA72F3D8DD7 + 0x632BE59BD9B4E019) & _M64
-    kk = np.asarray(k, dtype=np.int64).astype(np.uint64)
-    x = kk[:, None] * np.uint64(lanes) + np.arange(lanes, dtype=np.uint64)[None, :]
-    x = _mix(x * np.uint64(0x9E3779B97F4A7C15) + np.uint64(base))
-    return (x >> np.uint64(11)).astype(np.float64) * (1.0 / 9007199254740992.0)
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _hash_uniform(base: np.uint64, k: int, lanes: int, lane: int) -> float:
+    """A deterministic uniform [0, 1) number: lane ``lane`` of ``lanes`` for the integer key
+    ``k`` in the stream ``base`` (:func:`_stream`), by splitmix64's finaliser (wrapping
+    uint64 arithmetic)."""
+    x = np.uint64(k) * np.uint64(lanes) + np.uint64(lane)
+    x = x * np.uint64(0x9E3779B97F4A7C15) + base
+    x ^= x >> np.uint64(30)
+    x *= np.uint64(0xBF58476D1CE4E5B9)
+    x ^= x >> np.uint64(27)
+    x *= np.uint64(0x94D049BB133111EB)
+    x ^= x >> np.uint64(31)
+    return np.float64(x >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
 @lru_cache(maxsize=4)
 def _physical_table(beta_u: float, beta_vw: float, seed: int) -> np.ndarray:
-    """The padded tile's look-up tables: (u + i·v as complex64, w as float32), raveled."""
+    """The padded tile's look-up table: (cells, 3) float32 (u, v, w), the cells of the padded
+    (nx + 1, ny + 1, nz + 1) tile raveled, so a corner's three components are one 12-byte read."""
     nx, ny, nz = _TILE
     kx = 2 * np.pi * np.fft.fftfreq(nx)
     ky = 2 * np.pi * np.fft.fftfreq(ny)
@@ -121,183 +137,228 @@ def _physical_table(beta_u: float, beta_vw: float, seed: int) -> np.ndarray:
     tile[nx] = tile[0]
     tile[:, ny] = tile[:, 0]
     tile[:, :, nz] = tile[:, :, 0]
-    # u and v travel together as one complex64 (8-byte gathers), w alone (as the paper's).
-    uv = np.empty(tile[..., 0].size, dtype=np.complex64)
-    uv.real = tile[..., 0].ravel()
-    uv.imag = tile[..., 1].ravel()
-    w = np.ascontiguousarray(tile[..., 2]).ravel()
-    uv.setflags(write=False)
-    w.setflags(write=False)
-    return uv, w
+    table = tile.reshape(-1, 3)
+    table.setflags(write=False)
+    return table
 
 
-def _tile_corners() -> np.ndarray:
-    """(8, 1) int32 flat offsets of a cell's corners in the padded tile."""
-    nx, ny, nz = _TILE
-    d = np.arange(2)
-    off = (d[:, None, None] * (ny + 1) + d[None, :, None]) * (nz + 1) + d[None, None, :]
-    return off.reshape(8, 1).astype(np.int32)
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _gust_sum(base: np.uint64, gam: float, sr: float, sd: float) -> float:
+    """Σ_k A_k·env(γ − c_k) − mean at ``gam`` = γ in gust counts: gust k centred at
+    c_k = k + jitter, its envelope a Gaussian of width ``sr`` before its centre and ``sd``
+    after, A_k uniform in [0.5, 1.5]; ``base`` the gusts' stream (:func:`_stream`)."""
+    gam = min(max(gam, -(2.0**50)), 2.0**50)
+    kf = np.floor(gam)
+    frac = gam - kf  # exact: γ's distance to each gust is read from its fraction
+    total = 0.0
+    for m in range(-math.ceil(4.0 * sd + 1.0), math.ceil(4.0 * sr + 1.0) + 1):
+        key = np.int64(kf) + m
+        x = frac - (m + _GUST_JITTER * (_hash_uniform(base, key, 2, 0) - 0.5))
+        x /= sd if x >= 0.0 else sr
+        x = min(max(x, -40.0), 40.0)  # exp(−800) is 0 already; no overflow for tiny widths
+        total += math.exp(-0.5 * x * x) * (0.5 + _hash_uniform(base, key, 2, 1))
+    return total - math.sqrt(0.5 * math.pi) * (sr + sd)  # mean of A (1) × area per gust
 
 
-# Index arithmetic in int32 (the padded tile has 613,000 cells): half the memory traffic.
-_TILE_DIMS = np.array(_TILE, dtype=np.float64)[:, None]
-_TILE_INT = np.array(_TILE, dtype=np.int32)[:, None]
-_TILE_LAST = _TILE_INT - 1
-_TILE_CORNERS = _tile_corners()
-
-
-def _trilinear(tables, q: np.ndarray, offsets, weights) -> tuple[np.ndarray, np.ndarray]:
-    """Periodic trilinear look-up of the tile, blending layers before the interpolation.
-
-    ``q`` (3, n) cell coordinates (overwritten); ``offsets`` whole-cell shifts (3, 1) int32 of each
-    layer and ``weights`` their weights. Whole-cell offsets share the fractions, so the
-    layers' corner values blend first and one interpolation serves them all. Returns
-    ((n,) complex64 u + i·v, (n,) float32 w)."""
-    tab_uv, tab_w = tables
-    np.clip(q, -_GRID_CLIP, _GRID_CLIP, out=q)
-    fl = np.floor(q / _TILE_DIMS)
-    fl *= _TILE_DIMS
-    q -= fl
-    i = q.astype(np.int32)  # q ≥ −ε here: truncation gives 0 for it
-    np.minimum(i, _TILE_LAST, out=i)  # q may round up to the tile's size
-    fr = np.subtract(q, i, dtype=np.float32)
-    nx, ny, nz = _TILE
-    blend_uv = blend_w = None
-    for off, wt in zip(offsets, weights):
-        ij = i + off
-        ij -= (ij > _TILE_LAST) * _TILE_INT
-        base = ij[0] * np.int32(ny + 1)
-        base += ij[1]
-        base *= np.int32(nz + 1)
-        base += ij[2]
-        idx = np.add(_TILE_CORNERS, base).astype(np.intp)
-        vuv = tab_uv.take(idx, mode="clip")
-        vw = tab_w.take(idx, mode="clip")
-        vuv *= np.float32(wt)
-        vw *= np.float32(wt)
-        if blend_uv is None:
-            blend_uv, blend_w = vuv, vw
-        else:
-            blend_uv += vuv
-            blend_w += vw
-    fa, fb, fc = fr
-    out = []
-    for vals in (blend_uv, blend_w):
-        d = vals[4:8] - vals[0:4]
-        d *= fa
-        d += vals[0:4]
-        e = d[2:4] - d[0:2]
-        e *= fb
-        e += d[0:2]
-        r = e[1] - e[0]
-        r *= fc
-        r += e[0]
-        out.append(r)
-    return out[0], out[1]
-
-
-def _gusts(wind: "WindField", along: np.ndarray, unit: float, g: float, length: float) -> np.ndarray:
-    """Sum of gust envelopes minus their mean, at along-wind positions ``along`` (in units of
-    ``unit`` metres).
-
-    Gusts are plane fronts, so the sum is a function of ``along`` only: it is evaluated on
-    a 1-D grid of spacing GUST_RISE·L/8 over the points' span and interpolated (relative
-    error < 0.5 %), or directly where the span is too long for that."""
+def _gust_params(wind: "WindField", g: float) -> tuple[float, float, float, float, float, float]:
+    """The gusts of one call: (strength, gust clock g, gusts per metre, rise and decay
+    widths in gusts, lattice step in metres); strength 0 where there are none."""
     rg = wind.gust_rate / 60.0
     per_m = rg / max(wind.speed, 1e-6)  # gust count per metre (still air carries no gusts)
-    if not GUST_RISE * length * per_m > 1e-12:  # gusts so rare they never come
-        return np.zeros_like(along)
+    length = wind.length_scale
+    if not (wind.gust_strength > 0.0 and rg > 0.0 and GUST_RISE * length * per_m > 1e-12):
+        return (0.0, 0.0, 0.0, 1.0, 1.0, 1.0)  # none, or so rare they never come
     sr = min(GUST_RISE * length * per_m, _GUST_MAX_WIDTH[0])
     sd = min(GUST_DECAY * length * per_m, _GUST_MAX_WIDTH[1])
-    step = 0.125 * sr / per_m  # metres, on a lattice fixed in space (chunk-independent)
-    f = along * (unit / step)
-    lo, hi = float(f.min()), float(f.max())
-    if -(2.0**50) < lo and hi < 2.0**50 and hi - lo <= 4096:  # (a lattice of int64 indices)
-        lo_i = math.floor(lo)
-        ys = _gust_sum(wind.seed, g - (step * np.arange(lo_i, math.floor(hi) + 2)) * per_m, sr, sd)
-        i = np.floor(f)
-        f -= i
-        j = i.astype(np.intp)
-        j -= lo_i
-        out = ys[j + 1]
-        y0 = ys[j]
-        out -= y0
-        out *= f
-        out += y0
-        return out
-    return _gust_sum(wind.seed, g - along * (unit * per_m), sr, sd)
+    step = 0.125 * sr / per_m  # metres, on a lattice fixed in space (whatever the points)
+    return (wind.gust_strength, g, per_m, sr, sd, step)
 
 
-def _gust_sum(seed: int, gam: np.ndarray, sr: float, sd: float) -> np.ndarray:
-    """Σ_k A_k·env(γ − c_k) − mean, gust k centred at c_k = k + jitter, γ in gust counts."""
-    gam = np.clip(gam, -(2.0**50), 2.0**50)
-    kf = np.floor(gam)
-    lo, hi = -math.ceil(4.0 * sd + 1.0), math.ceil(4.0 * sr + 1.0)
-    m = np.arange(lo, hi + 1, dtype=np.float64)[:, None]
-    k = kf[None, :] + m  # (neighbours, n)
-    u = _hash_uniform(seed, 31, k.astype(np.int64).ravel(), 2).reshape(*k.shape, 2)
-    x = gam[None, :] - (k + _GUST_JITTER * (u[..., 0] - 0.5))
-    x /= np.where(x >= 0.0, sd, sr)
-    np.clip(x, -40.0, 40.0, out=x)  # exp(−800) is 0 already; no overflow for tiny widths
-    env = np.exp(-0.5 * x * x)
-    env *= 0.5 + u[..., 1]
-    total = env.sum(axis=0)
-    total -= math.sqrt(0.5 * math.pi) * (sr + sd)  # mean of A (1) × area per gust
-    return total
-
-
-def _ratio_frame(frame: np.ndarray) -> np.ndarray:
-    """The wind frame's rows (along, up, across) scaled by the components' σ ratios."""
-    return frame * np.asarray(SIGMA_RATIOS)[:, None]
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _gust_lattice(lo: float, hi: float, gusts: tuple, base: np.uint64) -> tuple[int, np.ndarray]:
+    """(first index, values) of the gust sum on the lattice points from ⌊lo⌋ to ⌊hi⌋ + 1
+    (in lattice steps), or (0, empty) where the span is beyond 4096 steps or ±2⁵⁰ (int64
+    indices). ``gusts`` from :func:`_gust_params`, ``base`` their stream."""
+    if not (-(2.0**50) < lo and hi < 2.0**50 and hi - lo <= 4096.0):
+        return 0, np.empty(0)
+    _, g, per_m, sr, sd, step = gusts
+    first = np.int64(math.floor(lo))
+    ys = np.empty(np.int64(math.floor(hi)) - first + 2)
+    for j in range(ys.shape[0]):
+        ys[j] = _gust_sum(base, g - (step * (first + j)) * per_m, sr, sd)
+    return first, ys
 
 
 @lru_cache(maxsize=8)
-def _layer_offset(seed: int, layer: int, cycle: int) -> np.ndarray:
-    """(3, 1) int32 whole-cell shift of a layer of the tile during one of its cycles."""
-    where = _hash_uniform(seed, 20 + layer, np.array([cycle]), 3)[0] * _TILE
-    off = np.minimum(where.astype(np.int32), np.array(_TILE, np.int32) - 1)[:, None]
-    off.setflags(write=False)
-    return off
+def _layer_offset(seed: int, layer: int, cycle: int) -> tuple[int, int, int]:
+    """Whole-cell shift (along, up, across) of a layer of the tile during one of its cycles."""
+    base = _stream(seed, 20 + layer)
+    return tuple(min(int(_hash_uniform(base, cycle, 3, c) * n), n - 1) for c, n in enumerate(_TILE))
+
+
+#: Flat strides of the padded tile along and up the wind (across: 1).
+_DX = (_TILE[1] + 1) * (_TILE[2] + 1)
+_DY = _TILE[2] + 1
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _cell(q: float, n: int) -> tuple[int, np.float32]:
+    """(index, float32 fraction) of the cell coordinate ``q`` in a periodic axis of ``n`` cells,
+    ``q`` clipped to ±2⁴⁰ cells first (where q mod n is still exact)."""
+    q = min(max(q, -_GRID_CLIP), _GRID_CLIP)
+    q -= np.floor(q / n) * n
+    i = min(int(q), n - 1)  # q ≥ −ε here: truncation gives 0 for it; q may round up to n
+    return i, np.float32(q - i)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _along(p: np.ndarray, i: int, m: np.ndarray, row: int = 0) -> float:
+    """Row ``row`` of ``m`` times the point ``p[i]`` clipped to ±1e12 m."""
+    x = min(max(p[i, 0], -_COORD_CLIP), _COORD_CLIP)
+    y = min(max(p[i, 1], -_COORD_CLIP), _COORD_CLIP)
+    z = min(max(p[i, 2], -_COORD_CLIP), _COORD_CLIP)
+    return m[row, 0] * x + m[row, 1] * y + m[row, 2] * z
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _corner(ia: int, ib: int, ic: int, off: tuple) -> int:
+    """Flat index in the padded tile of the first corner of cell (``ia``, ``ib``, ``ic``)
+    moved by a layer's whole-cell offset ``off``, periodically."""
+    nx, ny, nz = _TILE
+    ja, jb, jc = ia + off[0], ib + off[1], ic + off[2]
+    ja -= nx if ja >= nx else 0
+    jb -= ny if jb >= ny else 0
+    jc -= nz if jc >= nz else 0
+    return (ja * (ny + 1) + jb) * (nz + 1) + jc
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _trilinear(table: np.ndarray, c: int, r0: int, r1: int, w0: np.float32, w1: np.float32,
+               fa: np.float32, fb: np.float32, fc: np.float32) -> np.float32:
+    """Component ``c`` of the tile at a point: the corner values of its cell in the two layers
+    (flat indices ``r0``, ``r1`` of the cells' first corners) blended with the weights
+    ``w0``, ``w1``, then interpolated along (fraction ``fa``), up (``fb``) and across (``fc``),
+    all in float32."""
+    v000 = table[r0, c] * w0 + table[r1, c] * w1
+    v001 = table[r0 + 1, c] * w0 + table[r1 + 1, c] * w1
+    v010 = table[r0 + _DY, c] * w0 + table[r1 + _DY, c] * w1
+    v011 = table[r0 + _DY + 1, c] * w0 + table[r1 + _DY + 1, c] * w1
+    v100 = table[r0 + _DX, c] * w0 + table[r1 + _DX, c] * w1
+    v101 = table[r0 + _DX + 1, c] * w0 + table[r1 + _DX + 1, c] * w1
+    v110 = table[r0 + _DX + _DY, c] * w0 + table[r1 + _DX + _DY, c] * w1
+    v111 = table[r0 + _DX + _DY + 1, c] * w0 + table[r1 + _DX + _DY + 1, c] * w1
+    d00 = (v100 - v000) * fa + v000
+    d01 = (v101 - v001) * fa + v001
+    d10 = (v110 - v010) * fa + v010
+    d11 = (v111 - v011) * fa + v011
+    e0 = (d10 - d00) * fb + d00
+    e1 = (d11 - d01) * fb + d01
+    return (e1 - e0) * fc + e0
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _sample_points(p, out, frame, cell, shift, table, offsets, weights, inv_top, sigma_scale,
+                   mean_scale, gusts, gust_stream):
+    """The physical wind at the points ``p`` into ``out``, world m/s: one pass over the points.
+
+    Parameters
+    ----------
+    p, out : (K, 3) float64
+        World positions (m); the velocities are written to ``out``.
+    frame : (3, 3) float64
+        The wind frame's rows (along, up, across), world.
+    cell : float
+        The tile's cell size (m).
+    shift : float
+        The downwind travel in cells, modulo the tile's length.
+    table : (cells, 3) float32
+        The tile (:func:`_physical_table`).
+    offsets : tuple of two (int, int, int)
+        Each layer's whole-cell shift in the tile (:func:`_layer_offset`).
+    weights : tuple of two floats
+        The layers' weights (applied in float32).
+    inv_top : float
+        One over the canopy height (1/m).
+    sigma_scale, mean_scale : float
+        σ_u at the canopy top, and the mean speed there over σ_u's ratio (m/s).
+    gusts : tuple
+        :func:`_gust_params`.
+    gust_stream : uint64
+        The gusts' stream of random numbers (:func:`_stream`).
+
+    Notes
+    -----
+    A point's cell coordinates are its world position (clipped to ±1e12 m) in the wind
+    frame, over the cell size. The gusts read the along-wind one: gusts are plane fronts, so
+    their sum is a function of it only, evaluated on a 1-D lattice of spacing GUST_RISE·L/8
+    fixed in space over the points' span and interpolated (relative error < 0.5 %), or
+    directly at each point where the span is too long for that (:func:`_gust_lattice`). The
+    turbulence reads all three, moved upwind by the travel and reduced into the tile
+    (:func:`_cell`). Whole-cell layer offsets share the fractions, so the layers' corner
+    values blend first (in float32, as the table) and one trilinear interpolation serves
+    both.
+    """
+    nx, ny, nz = _TILE
+    m = frame * (1.0 / cell)
+    strength, g, per_m, sr, sd, step = gusts
+    scale = cell / step  # gust lattice steps per cell
+    first, ys = 0, np.empty(0)
+    if strength > 0.0 and p.shape[0]:
+        lo = hi = _along(p, 0, m)
+        for i in range(1, p.shape[0]):
+            along = _along(p, i, m)
+            lo = min(lo, along)
+            hi = max(hi, along)
+        first, ys = _gust_lattice(lo * scale, hi * scale, gusts, gust_stream)
+    ratio = np.empty((3, 3))  # the frame's rows scaled by the components' σ ratios
+    for c in range(3):
+        for d in range(3):
+            ratio[c, d] = frame[c, d] * SIGMA_RATIOS[c]
+    w0, w1 = np.float32(weights[0]), np.float32(weights[1])
+    for i in range(p.shape[0]):
+        qa = _along(p, i, m)  # cells along, up, across the wind
+        qb = _along(p, i, m, 1)
+        qc = _along(p, i, m, 2)
+        gust = 0.0
+        if strength > 0.0:
+            if ys.shape[0]:
+                f = qa * scale
+                # (within the lattice even where the span's ends round otherwise here)
+                j = min(max(np.int64(np.floor(f)) - first, 0), ys.shape[0] - 2)
+                gust = (ys[j + 1] - ys[j]) * (f - (first + j)) + ys[j]
+            else:
+                gust = _gust_sum(gust_stream, g - qa * (cell * per_m), sr, sd)
+        ia, fa = _cell(qa - shift, nx)
+        ib, fb = _cell(qb, ny)
+        ic, fc = _cell(qc, nz)
+        r0 = _corner(ia, ib, ic, offsets[0])
+        r1 = _corner(ia, ib, ic, offsets[1])
+        mean, sigma = _canopy(p[i, 1], inv_top)
+        sigma *= sigma_scale
+        mean *= strength * gust + 1.0
+        mean *= mean_scale
+        u = _trilinear(table, 0, r0, r1, w0, w1, fa, fb, fc) * sigma + mean  # over their σ ratios
+        v = _trilinear(table, 1, r0, r1, w0, w1, fa, fb, fc) * sigma
+        w = _trilinear(table, 2, r0, r1, w0, w1, fa, fb, fc) * sigma
+        for d in range(3):
+            out[i, d] = u * ratio[0, d] + v * ratio[1, d] + w * ratio[2, d]
 
 
 def _sample_physical(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray) -> None:
-    for start in range(0, p.shape[0], _CHUNK):
-        stop = min(start + _CHUNK, p.shape[0])
-        _physical_chunk(wind, p[start:stop], t, out[start:stop])
-
-
-def _physical_chunk(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray) -> None:
+    """The physical wind at the points ``p`` (K, 3) and time ``t`` into ``out`` (K, 3): what
+    is the same for every point, then :func:`_sample_points`."""
     length = wind.length_scale
-    top = wind.canopy_height
-    speed = wind.speed
-    frame = wind._frame
     a, s, g = wind._clocks(t)
     g = math.fmod(g, 2.0**40)  # the gust sequence is hashed: any shift of it is as good
-    table = _physical_table(wind.beta_u, wind.beta_vw, wind.seed)
     cell = length / _CELLS_PER_L
-    k = p.shape[0]
-    pc = np.clip(p, -_COORD_CLIP, _COORD_CLIP)
-    q = (frame * (1.0 / cell)) @ pc.T  # (3, k) cells along, up, across the wind
-    gust = None
-    if wind.gust_strength > 0.0 and wind.gust_rate > 0.0:
-        gust = _gusts(wind, q[0], cell, g, length)
     weights, offsets = [], []
     for j in (0, 1):
         phase = min(max(s + 0.5 * j, -2.0**62), 2.0**62)
         cycle = math.floor(phase)
         weights.append(math.sin(math.pi * (phase - cycle)))
         offsets.append(_layer_offset(wind.seed, j, cycle))
-    q[0] -= math.fmod(a / cell, _TILE[0])
-    uv, lat = _trilinear(table, q, offsets, weights)
-    mean, sigma = _canopy(p[:, 1], top)
-    sigma *= wind.turbulence * speed
-    comps = np.empty((3, k))  # along, up, across, each over its σ ratio
-    for c, x in enumerate((uv.real, uv.imag, lat)):
-        np.multiply(x, sigma, out=comps[c])
-    if gust is not None:
-        gust *= wind.gust_strength
-        gust += 1.0
-        mean *= gust
-    mean *= speed / SIGMA_RATIOS[0]
-    comps[0] += mean
-    np.matmul(comps.T, _ratio_frame(frame), out=out)
+    table = _physical_table(wind.beta_u, wind.beta_vw, wind.seed)
+    _sample_points(np.ascontiguousarray(p), out, wind._frame, cell, math.fmod(a / cell, _TILE[0]),
+                   table, tuple(offsets), tuple(weights), 1.0 / wind.canopy_height,
+                   wind.turbulence * wind.speed, wind.speed / SIGMA_RATIOS[0], _gust_params(wind, g),
+                   _stream(wind.seed, 31))

@@ -34,7 +34,8 @@ _MIN_LENGTH = 0.01
 _MAX_LENGTH = 1e4
 #: The physical clocks run for at most this many seconds from their last change.
 _TIME_CLIP = 1e12
-#: Points per vectorised pass of sample() (bounds the scratch memory).
+#: Points per vectorised pass of the paper's sample() (bounds the scratch memory; the
+#: physical model is one compiled pass with no per-point scratch).
 _CHUNK = 16384
 #: A direction whose horizontal part is at most this fraction of its length is "vertical".
 _VERTICAL_TOL = 1e-6
