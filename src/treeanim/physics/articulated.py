@@ -240,8 +240,7 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
     UD = np.empty((6, 3))
     pa = np.empty(6)
     wk = np.empty((3, 3, 3))
-    Ib = np.empty((6, 6))
-    Cr = np.empty((6, 6))
+    Ib, Cr, mom = np.empty((6, 6)), np.empty((6, 6)), np.empty(6)
     # --- 1. each body's own inertia (plus the implicit point terms) and bias force
     for b in range(B):
         m = m0[b]
@@ -277,7 +276,7 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
         for i in range(3):
             for j in range(3):
                 IA[b, 3 + i, j] = IA[b, j, 3 + i]
-        _add_bias(h, b, m, hx, hy, hz, Jw, Om, V, IA, pA, Ib, Cr)
+        _add_bias(h, b, kap, Om, V, IA, pA, Ib, Cr, mom)
     # --- 2. inward: articulated inertias and bias forces, the joints' terms folded in
     for b in range(B - 1, -1, -1):
         p = parent[b]
@@ -403,16 +402,25 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
                 w[b, 2] -= wn * th[2] / n
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _add_skew(M, r, c, s, x, y, z):
+    """M[r:r+3, c:c+3] += s·[(x, y, z)]×."""
+    M[r, c + 1] -= s * z
+    M[r, c + 2] += s * y
+    M[r + 1, c] += s * z
+    M[r + 1, c + 2] -= s * x
+    M[r + 2, c] -= s * y
+    M[r + 2, c + 1] += s * x
+
+
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _add_bias(h, b, m, hx, hy, hz, Jw, Om, V, IA, pA, Ib, Cr):
+def _add_bias(h, b, kap, Om, V, IA, pA, Ib, Cr, mom):
     """The body's velocity-product force f = ν ×* Iν (gyroscopic and centrifugal: ν = (ω, v)
-    its spatial velocity, I its spatial inertia about its joint) taken linearly implicitly:
-    pA += h·f and IA += h·∂f/∂ν, ∂f/∂ν = crf(ν)·I + [[−[n]×, −[p]×], [−[p]×, 0]] with
-    (n, p) = Iν. So a twig whirling on its joint keeps its angular momentum, not its angular
-    velocity (without it a scanned twig under heavy leaves whirled at 170 rad/s after a hard
-    release and gained up to 28 % of the tree's energy in a 1/120 s step). The joints'
-    velocity-product accelerations (a child's joint carried round by its parent) are still left
-    out."""
+    its spatial velocity, I its spatial inertia about its joint, IA[b] − κ[b] here) taken
+    linearly implicitly: pA += h·f and IA += h·∂f/∂ν, ∂f/∂ν = crf(ν)·I + [[−[n]×, −[p]×],
+    [−[p]×, 0]] with (n, p) = Iν. So a twig whirling on its joint keeps its angular momentum,
+    not its angular velocity (without it a scanned twig under heavy leaves whirled at 170 rad/s
+    after a hard release and gained up to 28 % of the tree's energy in a 1/120 s step)."""
     wx, wy, wz = Om[b, 0], Om[b, 1], Om[b, 2]
     vx, vy, vz = V[b, 0], V[b, 1], V[b, 2]
     # a whirl the step resolves (|ω|h ≲ 1) keeps its velocity products; one it cannot is left
@@ -420,66 +428,33 @@ def _add_bias(h, b, m, hx, hy, hz, Jw, Om, V, IA, pA, Ib, Cr):
     # linearisation overshoots and feeds the whirl (a scanned twig at 1/10 s)
     x2 = h * h * (wx * wx + wy * wy + wz * wz)
     h = h / (1.0 + x2 * x2)
-    for i in range(3):
-        for j in range(3):
-            Ib[i, j] = Jw[i, j]
-            Ib[3 + i, 3 + j] = m if i == j else 0.0
-    Ib[0, 3], Ib[0, 4], Ib[0, 5] = 0.0, -hz, hy
-    Ib[1, 3], Ib[1, 4], Ib[1, 5] = hz, 0.0, -hx
-    Ib[2, 3], Ib[2, 4], Ib[2, 5] = -hy, hx, 0.0
-    for i in range(3):
-        for j in range(3):
-            Ib[3 + i, j] = Ib[j, 3 + i]
     nu = (wx, wy, wz, vx, vy, vz)
-    n0 = n1 = n2 = p0 = p1 = p2 = 0.0
-    for j in range(6):
-        n0 += Ib[0, j] * nu[j]
-        n1 += Ib[1, j] * nu[j]
-        n2 += Ib[2, j] * nu[j]
-        p0 += Ib[3, j] * nu[j]
-        p1 += Ib[4, j] * nu[j]
-        p2 += Ib[5, j] * nu[j]
+    mom[:] = 0.0  # Iν = (n, p)
+    for i in range(6):
+        for j in range(6):
+            Ib[i, j] = IA[b, i, j] - kap[b, i, j]
+            mom[i] += Ib[i, j] * nu[j]
+    n0, n1, n2, p0, p1, p2 = mom[0], mom[1], mom[2], mom[3], mom[4], mom[5]
     a = _cross(wx, wy, wz, n0, n1, n2)
     c = _cross(vx, vy, vz, p0, p1, p2)
     d = _cross(wx, wy, wz, p0, p1, p2)
-    pA[b, 0] += h * (a[0] + c[0])
-    pA[b, 1] += h * (a[1] + c[1])
-    pA[b, 2] += h * (a[2] + c[2])
-    pA[b, 3] += h * d[0]
-    pA[b, 4] += h * d[1]
-    pA[b, 5] += h * d[2]
+    for i in range(3):
+        pA[b, i] += h * (a[i] + c[i])
+        pA[b, 3 + i] += h * d[i]
     # crf(ν) = [[ω×, v×], [0, ω×]]
-    for i in range(6):
-        for j in range(6):
-            Cr[i, j] = 0.0
-    for k in range(2):
-        o = 3 * k
-        Cr[o + 0, o + 1], Cr[o + 0, o + 2] = -wz, wy
-        Cr[o + 1, o + 0], Cr[o + 1, o + 2] = wz, -wx
-        Cr[o + 2, o + 0], Cr[o + 2, o + 1] = -wy, wx
-    Cr[0, 4], Cr[0, 5] = -vz, vy
-    Cr[1, 3], Cr[1, 5] = vz, -vx
-    Cr[2, 3], Cr[2, 4] = -vy, vx
+    Cr[:, :] = 0.0
+    _add_skew(Cr, 0, 0, 1.0, wx, wy, wz)
+    _add_skew(Cr, 3, 3, 1.0, wx, wy, wz)
+    _add_skew(Cr, 0, 3, 1.0, vx, vy, vz)
     for i in range(6):
         for j in range(6):
             s = 0.0
             for k in range(6):
                 s += Cr[i, k] * Ib[k, j]
             IA[b, i, j] += h * s
-    # + [[−[n]×, −[p]×], [−[p]×, 0]]
-    IA[b, 0, 1] += h * n2
-    IA[b, 0, 2] -= h * n1
-    IA[b, 1, 0] -= h * n2
-    IA[b, 1, 2] += h * n0
-    IA[b, 2, 0] += h * n1
-    IA[b, 2, 1] -= h * n0
-    for o1, o2 in ((0, 3), (3, 0)):
-        IA[b, o1 + 0, o2 + 1] += h * p2
-        IA[b, o1 + 0, o2 + 2] -= h * p1
-        IA[b, o1 + 1, o2 + 0] -= h * p2
-        IA[b, o1 + 1, o2 + 2] += h * p0
-        IA[b, o1 + 2, o2 + 0] += h * p1
-        IA[b, o1 + 2, o2 + 1] -= h * p0
+    _add_skew(IA[b], 0, 0, -h, n0, n1, n2)
+    _add_skew(IA[b], 0, 3, -h, p0, p1, p2)
+    _add_skew(IA[b], 3, 0, -h, p0, p1, p2)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")

@@ -3,7 +3,7 @@
 ``WindField(model="physical")`` (docs/design.md §12, issue 11) is weather-like wind:
 
 * **Turbulence in metres.** Three independent Gaussian fields (along-wind u, vertical v,
-  lateral w) on one periodic tile of 96 × 48 × 96 cells covering 8 L × 4 L × 8 L (along,
+  lateral w) on one periodic tile of 128 × 48 × 96 cells covering 8 L × 3 L × 6 L (along,
   up, across the wind), L the along-wind integral length scale (``length_scale``, by
   default the canopy height). The tile is independent of any tree's box, so several trees
   share one field. The 3-D spectrum is (k² + k0²)^−(β+2)/2 with k0 = 1/(1.339 L_c), so the

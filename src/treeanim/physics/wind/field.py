@@ -487,7 +487,7 @@ class WindField:
         points : array_like, shape (K, 3) or (3,)
             World positions in metres (y up, ground at y = 0). Any finite values. Paper:
             outside the bounds the field repeats periodically. Physical: the turbulence
-            repeats every 8 L along and across the wind and 4 L up, in space only (in time
+            repeats every 8 L along the wind, 6 L across and 3 L up, in space only (in time
             it never repeats); the mean profile keeps growing with height.
         t : float
             Time in seconds (moves the turbulence downwind).
