@@ -151,7 +151,6 @@ class Renderer:
         key = tuple(vars(s).values())
         if key == self._applied_scene:
             return
-        self._applied_scene = key
         sun = np.asarray(s.sun_direction, float)
         sun = sun / np.linalg.norm(sun)
         self.light.set(
@@ -169,6 +168,7 @@ class Renderer:
         if s.shadow:
             self.shadow.fit(sun, *self.bounds(), self.tree.rest_positions, self.pad)
         self.shadow.enable(s.shadow)
+        self._applied_scene = key
 
     # ------------------------------------------------------------------ per frame
     def update(self, positions: np.ndarray, rotations: np.ndarray, present: np.ndarray | None = None,
