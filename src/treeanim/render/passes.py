@@ -11,9 +11,9 @@ shadow map is the fifth (:class:`~.shadow.ShadowMap`).
   holds still, and copied each frame after.
 - :class:`OverlayPass`: the overlays' lines.
 
-Each pass frees what it made if its construction fails, and :meth:`release` is idempotent.
-Every pass expects the renderer's shared blocks (``Light``, ``View``) and the node and
-object textures bound when it draws.
+Each pass frees what it made if its construction fails, and its ``release()`` is idempotent.
+A pass binds its own block when it draws; the blocks every pass reads (``Light``, ``View``,
+``Shadow``) and the node and object textures are bound by the renderer first.
 """
 
 from __future__ import annotations

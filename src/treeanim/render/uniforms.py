@@ -10,8 +10,9 @@ tables is an error) and gives each block its binding point and each sampler its 
 is set on a program by name, so nothing can be skipped.
 
 A member ``name`` of a block is ``u_name`` in GLSL. The std140 layout holds a block's members
-in their order here; every member of an std140 block is active whether a program reads it or
-not, so one buffer a block serves every program.
+in their order here, and keeps every block and member active whether a program reads it or
+not: one buffer a block serves every program, and the checks do not depend on what a compiler
+strips.
 """
 
 from __future__ import annotations
