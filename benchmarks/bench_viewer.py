@@ -90,12 +90,12 @@ def bench_row(win, row: str, frames: int, warmup: int, step: bool = False) -> di
             win.swap()
         t = {k: _Timer() for k in ("sim", "draw", "driver", "update", "panel", "imgui")}
         r = v.renderer
-        for part in r.parts.values():
+        for part in r.tree_pass.parts.values():
             if part.vao is not None:
                 part.vao = _TimedVao(part.vao, t["driver"])
-        r.sky_vao = _TimedVao(r.sky_vao, t["driver"])
-        r.background_vao = _TimedVao(r.background_vao, t["driver"])
-        r.ground_vaos = [_TimedVao(v, t["driver"]) for v in r.ground_vaos]
+        r.sky_pass.vao = _TimedVao(r.sky_pass.vao, t["driver"])
+        r.background.vao = _TimedVao(r.background.vao, t["driver"])
+        r.ground_pass.vaos = [_TimedVao(v, t["driver"]) for v in r.ground_pass.vaos]
         v.advance = t["sim"].wrap(v.advance)
         v.draw = t["draw"].wrap(v.draw)
         r.update = t["update"].wrap(r.update)

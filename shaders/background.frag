@@ -2,7 +2,8 @@
 // The background (sky and the ground without shadows) copied from the renderer's cache: drawn
 // there, pixel for pixel, by sky.frag and ground.frag when the camera or the scene changed.
 
-uniform sampler2D u_background;
+#include "uniforms.glsl"
+
 out vec4 f_color;
 
 void main() {

@@ -1,16 +1,9 @@
 // Shared lighting (any shader stage): one sun with its shadow map (sun.glsl), a sky/ground
-// hemisphere, distance haze, noise. Fragment shaders' own helpers are in pixel.glsl.
+// hemisphere, distance haze, noise. Fragment shaders' own helpers are in pixel.glsl. Every
+// uniform is declared in uniforms.glsl, written from render/uniforms.py.
 
+#include "uniforms.glsl"
 #include "sun.glsl"
-
-uniform vec3 u_sun_color;      // linear
-uniform vec3 u_sky_zenith;     // linear
-uniform vec3 u_sky_horizon;    // linear (also the haze colour)
-uniform vec3 u_ground_bounce;  // linear, light from below
-uniform float u_ambient;       // strength of the sky/ground hemisphere light
-uniform vec3 u_camera_pos;
-uniform float u_haze_distance; // metres at which haze reaches 63 %
-uniform float u_exposure;
 
 vec3 srgb_to_linear(vec3 c) { return pow(c, vec3(2.2)); }
 

@@ -7,12 +7,6 @@
 #include "common.glsl"
 #include "pixel.glsl"
 
-uniform vec3 u_ground_centre;   // the trunk's foot
-uniform float u_earth_radius;   // bare earth around the trunk (0: none)
-uniform vec3 u_occlusion_centre;  // below the crown's centre: the sky is hidden there
-uniform float u_occlusion_radius; // 0: none
-uniform float u_trunk_radius;     // contact shadow round the trunk's foot (0: none)
-uniform float u_grid;           // 0: no grid; else grid line strength (1 m cells)
 out vec4 f_color;
 
 vec3 ground_color(vec2 xz, float fade) {

@@ -1,12 +1,12 @@
 #version 330 core
 // Overlay lines: world points, or points carried by a node (offset from it, skinned).
 
+#include "uniforms.glsl"
 #include "skin.glsl"
 
 in vec3 in_position;
 in vec4 in_color;
 in int in_node;       // -1: in_position is a world point
-uniform mat4 u_view_proj;
 out vec4 g_color;
 
 void main() {

@@ -4,8 +4,8 @@
 layout(lines) in;
 layout(triangle_strip, max_vertices = 4) out;
 
-uniform vec2 u_viewport;
-uniform float u_width;
+#include "uniforms.glsl"
+
 in vec4 g_color[];
 out vec4 f_color;
 

@@ -1,8 +1,7 @@
 // Fragment shaders' helpers (include after common.glsl): this pixel's view ray, and the colour
 // written for the display.
 
-uniform mat4 u_inv_view_proj;  // clip -> world (sky and ground)
-uniform vec2 u_viewport;       // pixels
+#include "uniforms.glsl"
 
 // The view ray through this pixel's centre (unit, world; fragment shaders).
 vec3 pixel_ray() {

@@ -2,15 +2,13 @@
 // The skinned tree's depth seen from the sun (render/shadow.py): the same skinning as
 // tree.vert, so the shadow follows every bent branch and fluttering leaf.
 
+#include "uniforms.glsl"
 #include "skin.glsl"
 
 in ivec4 in_ids;     // node, prev, object, material
 in vec3 in_offset;   // rest offset from the node
 in vec4 in_extra;    // x: weight of prev
 in vec2 in_curve;    // t along the segment, 1 where it ends at the object's tip
-
-uniform mat4 u_light_view_proj;
-uniform sampler2D u_objects;   // per object: r = visible
 
 void main() {
     if (fetch_texel(u_objects, in_ids.z).r < 0.5) {   // hidden: outside the clip volume

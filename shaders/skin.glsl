@@ -5,7 +5,7 @@
 //   texel 3j+2 = (r12, r20, r21, r22)
 // p is the node's world position, r its rotation relative to rest (row-major).
 
-uniform sampler2D u_nodes;
+#include "uniforms.glsl"
 
 vec4 fetch_texel(sampler2D tex, int i) {
     int w = textureSize(tex, 0).x;

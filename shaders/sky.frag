@@ -4,7 +4,6 @@
 #include "common.glsl"
 #include "pixel.glsl"
 
-uniform int u_show_sky;         // 0: flat horizon colour
 out vec4 f_color;
 
 vec3 sky_color(vec3 dir) {

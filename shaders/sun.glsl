@@ -1,10 +1,6 @@
 // The sun and its shadow map: how much of the sun reaches a point (any shader stage).
 
-uniform vec3 u_sun_dir;                // unit, towards the sun
-uniform sampler2DShadow u_shadow_map;  // depth seen from the sun (render/shadow.py)
-uniform mat4 u_light_view_proj;        // world -> the shadow map's clip space
-uniform int u_shadow_on;               // 0: everything in sunlight
-uniform float u_shadow_texel;          // one shadow-map texel, metres
+#include "uniforms.glsl"
 
 // Where `world` (normal `n`) falls in the shadow map: pushed off the surface towards the sun's
 // side by a texel and a half, so a surface never shadows itself (acne) and a leaf lit from

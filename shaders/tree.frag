@@ -16,7 +16,6 @@ noperspective in float v_edge;
 in float v_half;
 in vec3 v_light;
 in float v_haze;
-uniform vec4 u_bark;            // furrows around a branch, furrow depth, interlacing, lenticels
 
 out vec4 f_color;
 

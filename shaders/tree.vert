@@ -3,6 +3,7 @@
 // laminas; PART_BARK, branch tubes; PART_BLADES, grass blades). Each part has its own program
 // with only its own code: a software rasteriser runs both sides of every branch.
 
+#include "uniforms.glsl"
 #include "skin.glsl"
 #include "tree_light.glsl"
 
@@ -12,13 +13,6 @@ in vec3 in_normal;   // rest normal
 in vec4 in_extra;    // weight of prev, per-object jitter, ambient occlusion, key
 in vec2 in_uv;       // surface coordinates (see render/mesh.py)
 in vec2 in_curve;    // t along the segment, 1 where it ends at the object's tip
-
-uniform mat4 u_view_proj;
-uniform sampler2D u_objects;   // per object: r = visible, g = highlight
-uniform float u_season;        // 0 summer .. 1 winter
-uniform vec3 u_bark_color;     // sRGB
-uniform float u_pixels_per_metre;  // at one metre from the eye: a length's size on screen
-uniform float u_thin_pixels;       // twigs and blades with a half width below this (px) get soft edges
 
 out vec3 v_world;
 out vec3 v_normal;

@@ -6,8 +6,6 @@
 
 #include "common.glsl"
 
-uniform float u_translucency;   // 0: leaves pass no sunlight through
-
 vec3 tree_light(vec3 albedo, vec3 n, vec3 V, float ao, float sun, bool foliage, float highlight) {
     float ndl = dot(n, u_sun_dir);
     vec3 c = albedo * hemisphere(n) * ao;

@@ -10,7 +10,8 @@ from treeanim.model.tree import Lamina
 
 # --------------------------------------------------------------------------- markers
 #: Modules that draw through OpenGL (EGL offscreen), and those that open a window (Xvfb).
-GL_MODULES = {"test_render_gl", "test_render_look", "test_junctions", "test_offline", "test_examples"}
+GL_MODULES = {"test_render_gl", "test_render_look", "test_render_uniforms", "test_junctions", "test_offline",
+              "test_examples"}
 WINDOW_MODULES = {"test_app", "test_render_window"}
 #: Tests of a second or more on a 2-core machine (``pytest --durations``): ``-m "not slow"`` is
 #: the quick loop, under a minute; CI runs everything.

@@ -399,7 +399,7 @@ def test_renderer_on_a_plain_context_and_release(tree):
 def test_renderer_frees_what_it_made_when_construction_fails(tree, monkeypatch, fail_at):
     """A failure part-way through Renderer() (a shader that does not build, any later step)
     leaves no GL object behind: everything made before it is released."""
-    import treeanim.render.renderer as renderer_module
+    import treeanim.render.passes as passes_module
 
     ctx = create_egl_context()
     made = []
@@ -413,19 +413,19 @@ def test_renderer_frees_what_it_made_when_construction_fails(tree, monkeypatch, 
 
     for name in ("program", "buffer", "texture", "vertex_array"):
         monkeypatch.setattr(ctx, name, recording(getattr(ctx, name)))
-    load_program = renderer_module.load_program
+    load_program = passes_module.load_program
 
     def failing_load(c, vertex, *rest, **kw):
         if fail_at == "line program" and vertex == "line.vert":
             raise RuntimeError("shader program line.vert + line.frag failed to build: (test)")
         return load_program(c, vertex, *rest, **kw)
 
-    def failing_ground(self):
+    def failing_ground(self, *a):
         raise MemoryError("(test)")
 
-    monkeypatch.setattr(renderer_module, "load_program", failing_load)
-    if fail_at == "ground":
-        monkeypatch.setattr(Renderer, "_place_ground", failing_ground)
+    monkeypatch.setattr(passes_module, "load_program", failing_load)
+    if fail_at == "ground":  # the last pass made: after programs, buffers, textures and vertex arrays
+        monkeypatch.setattr(passes_module.GroundPass, "_place", failing_ground)
     try:
         with ctx:
             with pytest.raises(RuntimeError if fail_at == "line program" else MemoryError):

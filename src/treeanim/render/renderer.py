@@ -13,7 +13,10 @@ texel i at (i mod width, i div width), read with texelFetch):
 - objects, RGBA32F, 1 texel an object: ``(visible, highlight, 0, 0)``; rewritten only when
   the visibility or highlight changes.
 
-Each frame draws the sun's shadow map first (:mod:`treeanim.render.shadow`), then the leaves
+The frame is drawn by passes (:mod:`treeanim.render.passes`, :mod:`treeanim.render.shadow`),
+each with its own programs, buffers and uniform block; the renderer owns the pose's textures
+and the blocks every pass reads (``Light``: the scene's light, ``View``: the camera; see
+:mod:`treeanim.render.uniforms`). Each frame draws the sun's shadow map first, then the leaves
 (opaque), the ground over the shadow's footprint and the background (sky and the rest of the
 ground; while the camera is still, a copy of a cache) where the leaves left pixels uncovered,
 then the bark and the grass blades over them (blended: twigs and blades thinner than a pixel
@@ -26,19 +29,18 @@ so code a pixel does not need costs it unless it is left out of that pixel's pro
 from __future__ import annotations
 
 import math
-import weakref
-from dataclasses import dataclass
 
 import moderngl
 import numpy as np
 
 from ..model.tree import Tree
 from .camera import OrbitCamera
-from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh, build_mesh
-from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
-from .scene import Scene, clip_ground
-from .shaders import DEPTH_FOOTPRINT, DEPTH_GROUND, load_program
+from .mesh import TreeMesh, build_mesh
+from .passes import BackgroundCache, GroundPass, OverlayPass, SkyPass, TreePass, release_all
+from .scene import Scene
+from .shaders import DEPTH_FOOTPRINT, DEPTH_GROUND
 from .shadow import ShadowMap, shadow_indices
+from .uniforms import SAMPLERS, UniformBlock
 
 #: Width in texels of the node and object textures (GL 3.3 guarantees 1024).
 TEXTURE_WIDTH = 1024
@@ -56,38 +58,6 @@ def _bound_framebuffer(ctx: moderngl.Context) -> moderngl.Framebuffer:
     return ctx.fbo if ctx.fbo is not None else ctx.detect_framebuffer()
 
 
-@dataclass
-class _Part:
-    """One part of the mesh (``mesh.PARTS``): its program, and its triangles' range in the
-    renderer's index buffer."""
-
-    prog: moderngl.Program
-    vao: moderngl.VertexArray | None
-    first: int
-    count: int
-
-    def render(self) -> None:
-        if self.count:
-            self.vao.render(moderngl.TRIANGLES, vertices=self.count, first=self.first)
-
-
-class _Lines:
-    """GPU buffers of one overlay."""
-
-    def __init__(self, overlay: Overlay) -> None:
-        self.ref = weakref.ref(overlay)
-        self.vbo: moderngl.Buffer | None = None
-        self.vao: moderngl.VertexArray | None = None
-        self.count = 0
-        self.uploaded = False
-
-    def release(self) -> None:
-        for o in (self.vao, self.vbo):
-            if o is not None:
-                o.release()
-        self.vao = self.vbo = None
-
-
 class Renderer:
     """Draws one tree (plus sky, ground and overlays) on any moderngl context of GL >= 3.3.
 
@@ -99,6 +69,16 @@ class Renderer:
     mesh : TreeMesh or None
         A prebuilt mesh of ``tree`` (None builds one).
     scene : Scene or None
+
+    Attributes
+    ----------
+    tree_pass : TreePass
+    shadow : ShadowMap
+    ground_pass : GroundPass
+    sky_pass : SkyPass
+    background : BackgroundCache
+    overlay_pass : OverlayPass
+        The passes of a frame (:mod:`treeanim.render.passes`).
     """
 
     def __init__(self, ctx: moderngl.Context, tree: Tree, mesh: TreeMesh | None = None,
@@ -112,42 +92,18 @@ class Renderer:
         self.scene = scene if scene is not None else Scene()
         self._applied_scene: tuple | None = None
         self._released = False
-        # Every GL object starts as None, so that release() can free whatever was made before a
+        lo, hi = self.bounds()
+        self.size = float(np.max(hi - lo))
+        # Everything GL starts as None, so that release() can free whatever was made before a
         # failure part-way through (a shader that does not compile, an out-of-memory buffer).
-        self.line_prog = self.sky_prog = None
-        self.ground_progs: list[moderngl.Program] = []
-        self.parts: dict[str, _Part] = {}
-        self.vbo = self.ibo = self.sky_vao = self.ground_vbo = None
-        self.background_prog = self.background_vao = self.background_texture = self.background_fbo = None
-        self.background_depth = None
-        self._background_key: tuple | None = None  # the view the cache holds
-        self._last_view: tuple | None = None        # the last frame's
-        self.ground_vaos: list[moderngl.VertexArray] = []
-        self.node_texture = self.object_texture = None
-        self.shadow: ShadowMap | None = None
-        self._lines: dict[int, _Lines] = {}
+        self.light = self.view = self.node_texture = self.object_texture = None
+        self.tree_pass = self.shadow = self.sky_pass = self.background = self.overlay_pass = self.ground_pass = None
         try:
-            self.sky_prog = load_program(ctx, "sky.vert", "sky.frag")
-            for shadowed in (0, 1):  # off and over the shadow's footprint
-                self.ground_progs.append(load_program(ctx, "ground.vert", "ground.frag", defines={"SUN_SHADOW": shadowed}))
-            self.background_prog = load_program(ctx, "sky.vert", "background.frag")
-            self.line_prog = load_program(ctx, "line.vert", "line.frag", "line_geom.glsl")
-
-            # --- static mesh: one index buffer, part after part
-            tris = [self.mesh.part_indices(name) for name in PARTS]
-            if self.mesh.triangle_count:
-                self.vbo = ctx.buffer(self.mesh.vertices.tobytes())
-                self.ibo = ctx.buffer(np.concatenate(tris).tobytes())
-            first = 0
-            for k, (name, t) in enumerate(zip(PARTS, tris)):
-                part = self.parts[name] = _Part(load_program(ctx, "tree.vert", "tree.frag", defines={"PART": k}),
-                                                None, first, 3 * len(t))
-                if part.count:
-                    part.vao = ctx.vertex_array(part.prog, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRIBUTES)],
-                                                index_buffer=self.ibo, index_element_size=4)
-                first += part.count
+            self.light = UniformBlock(ctx, "Light")
+            self.view = UniformBlock(ctx, "View")
+            self.tree_pass = TreePass(ctx, self.mesh, tree)
             bound = _bound_framebuffer(ctx)
-            self.shadow = ShadowMap(ctx, self.vbo, shadow_indices(self.mesh, tree), self.scene.shadow_size)
+            self.shadow = ShadowMap(ctx, self.tree_pass.vbo, shadow_indices(self.mesh, tree), self.scene.shadow_size)
             bound.use()  # making the map's framebuffer bound it
 
             # --- per-frame textures
@@ -162,20 +118,11 @@ class Renderer:
             for tex in (self.node_texture, self.object_texture):
                 tex.filter = (moderngl.NEAREST, moderngl.NEAREST)
                 tex.repeat_x = tex.repeat_y = False
-            for prog in (*self.tree_progs, self.line_prog, self.shadow.prog):
-                self._uniform(prog, "u_nodes", 0)
-                self._uniform(prog, "u_objects", 1)
-            for prog in (*self.tree_progs, *self.ground_progs):
-                self._uniform(prog, "u_shadow_map", 2)
 
-            # --- sky and background: a full-screen triangle; ground: polygons in clip space
-            self.sky_vao = ctx.vertex_array(self.sky_prog, [])
-            self.background_vao = ctx.vertex_array(self.background_prog, [])
-            self._uniform(self.background_prog, "u_background", 3)
-            self.ground_vbo = ctx.buffer(reserve=4096, dynamic=True)
-            for prog in self.ground_progs:
-                self.ground_vaos.append(ctx.vertex_array(prog, [(self.ground_vbo, "4f", "in_clip")]))
-            self._place_ground()
+            self.sky_pass = SkyPass(ctx)
+            self.background = BackgroundCache(ctx)
+            self.overlay_pass = OverlayPass(ctx)
+            self.ground_pass = GroundPass(ctx, tree, (lo, hi))
 
             self._present: np.ndarray | None = None  # None: derived from the season at draw time
             self._present_season: float | None = None
@@ -188,28 +135,6 @@ class Renderer:
 
     # ------------------------------------------------------------------ helpers
     @property
-    def tree_progs(self) -> list[moderngl.Program]:
-        """The programs of the mesh's parts."""
-        return [p.prog for p in self.parts.values()]
-
-    @property
-    def lit_progs(self) -> list[moderngl.Program]:
-        """Every program that lights a surface (``common.glsl``'s uniforms)."""
-        return [*self.tree_progs, *self.ground_progs, self.sky_prog]
-
-    @staticmethod
-    def _uniform(prog: moderngl.Program, name: str, value) -> None:
-        u = prog.get(name, None)
-        if u is not None:
-            u.value = value
-
-    def _write(self, progs, name: str, data: bytes) -> None:
-        for prog in progs:
-            u = prog.get(name, None)
-            if u is not None:
-                u.write(data)
-
-    @property
     def pad(self) -> float:
         """How far the tree's surface reaches beyond its nodes (metres): a lamina's length plus
         half the thickest diameter."""
@@ -220,69 +145,30 @@ class Renderer:
         P = self.tree.rest_positions if positions is None else np.asarray(positions)
         return P.min(axis=0) - self.pad, P.max(axis=0) + self.pad
 
-    def _place_ground(self) -> None:
-        tree = self.tree
-        P = tree.rest_positions
-        lo, hi = self.bounds()
-        size = float(np.max(hi - lo))
-        self.size = size
-        roots = tree.object_start[tree.parent < 0]
-        branch = tree.kind == "branch"
-        trunk_foot = P[roots[0]] if len(roots) and branch.any() else 0.5 * (lo + hi)
-        self.ground_centre = np.array([trunk_foot[0], 0.0, trunk_foot[2]])
-        trunks = tree.object_start[(tree.parent < 0) & branch]
-        self.earth_radius = float(5.0 * tree.node_diameter[trunks].max()) if len(trunks) else 0.0
-        leafy = tree.kind != "branch"
-        pts = P[np.isin(tree.node_object, np.flatnonzero(leafy))] if leafy.any() else P
-        self.crown_centre = pts.mean(axis=0)
-        spread = np.percentile(np.linalg.norm(pts[:, [0, 2]] - self.crown_centre[[0, 2]], axis=1), 85)
-        self.occlusion_radius = float(max(1.1 * spread, 0.1 * size))
-        self.trunk_radius = float(0.5 * tree.node_diameter[trunks].max()) if len(trunks) else 0.0
-
     def _apply_scene(self) -> None:
+        """Hand the scene to the blocks and passes, when it changed."""
         s = self.scene
         key = tuple(vars(s).values())
         if key == self._applied_scene:
             return
-        self._applied_scene = key
         sun = np.asarray(s.sun_direction, float)
-        sun = tuple(sun / np.linalg.norm(sun))
-        lit = {
-            "u_sun_dir": sun,
-            "u_sun_color": tuple(c * s.sun_intensity for c in _lin(s.sun_color)),
-            "u_sky_zenith": _lin(s.sky_zenith),
-            "u_sky_horizon": _lin(s.sky_horizon),
-            "u_ground_bounce": _lin(s.ground_bounce),
-            "u_ambient": float(s.ambient),
-            "u_haze_distance": float(s.haze_distance or max(40.0 * self.size, 60.0)),
-            "u_exposure": float(s.exposure),
-        }
-        for prog in self.lit_progs:
-            for k, v in lit.items():
-                self._uniform(prog, k, v)
-        self._uniform(self.sky_prog, "u_show_sky", int(s.show_sky))
-        c = self.crown_centre  # the crown hides the sky straight above the ground under it
-        for g in self.ground_progs:
-            self._uniform(g, "u_ground_centre", tuple(self.ground_centre))
-            self._uniform(g, "u_earth_radius", float(self.earth_radius))
-            self._uniform(g, "u_occlusion_centre", (float(c[0]), 0.0, float(c[2])))
-            self._uniform(g, "u_occlusion_radius", float(self.occlusion_radius if s.shadow else 0.0))
-            self._uniform(g, "u_trunk_radius", float(self.trunk_radius if s.shadow else 0.0))
-            self._uniform(g, "u_grid", float(s.ground_grid))
-        bark = self.tree.bark
-        for prog in self.tree_progs:
-            self._uniform(prog, "u_translucency", float(s.translucency))
-            self._uniform(prog, "u_bark_color", tuple(float(c) for c in bark.color))
-            self._uniform(prog, "u_bark", (float(bark.furrows), float(bark.depth), float(bark.interlace),
-                                           float(bark.lenticels)))
+        sun = sun / np.linalg.norm(sun)
+        self.light.set(
+            sun_dir=sun,
+            sun_color=tuple(c * s.sun_intensity for c in _lin(s.sun_color)),
+            sky_zenith=_lin(s.sky_zenith),
+            sky_horizon=_lin(s.sky_horizon),
+            ground_bounce=_lin(s.ground_bounce),
+            ambient=s.ambient,
+            haze_distance=s.haze_distance or max(40.0 * self.size, 60.0),
+            exposure=s.exposure,
+        )
+        for p in (self.tree_pass, self.ground_pass, self.sky_pass):
+            p.apply(s)
         if s.shadow:
             self.shadow.fit(sun, *self.bounds(), self.tree.rest_positions, self.pad)
-        else:
-            self.shadow.clear()
-        for prog in self.lit_progs:
-            self._uniform(prog, "u_shadow_on", int(s.shadow))
-            self._uniform(prog, "u_shadow_texel", float(self.shadow.texel))
-            self._write((prog,), "u_light_view_proj", self.shadow.matrix.tobytes())
+        self.shadow.enable(s.shadow)
+        self._applied_scene = key
 
     # ------------------------------------------------------------------ per frame
     def update(self, positions: np.ndarray, rotations: np.ndarray, present: np.ndarray | None = None,
@@ -361,26 +247,18 @@ class Renderer:
         self._apply_scene()
         season = float(np.clip(season, 0.0, 1.0))
         self._upload_objects(season)
-        self.node_texture.use(0)
-        self.object_texture.use(1)
+        self.node_texture.use(SAMPLERS["nodes"].unit)
+        self.object_texture.use(SAMPLERS["objects"].unit)
         if self.scene.shadow:
             ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
             self.shadow.draw()
         vp = camera.view_projection(width, height)
-        vp_bytes = vp.tobytes()
-        eye = tuple(float(x) for x in camera.eye)
-        inv_bytes = np.linalg.inv(vp.astype(np.float64)).astype(np.float32).tobytes()
-        self._write((*self.tree_progs, self.line_prog), "u_view_proj", vp_bytes)
-        for prog in self.lit_progs:
-            self._uniform(prog, "u_camera_pos", eye)
-        for prog in (*self.ground_progs, self.sky_prog):
-            self._write((prog,), "u_inv_view_proj", inv_bytes)
-            self._uniform(prog, "u_viewport", (float(width), float(height)))
-        for prog in self.tree_progs:
-            self._uniform(prog, "u_season", season)
-            self._uniform(prog, "u_pixels_per_metre", 0.5 * height / math.tan(math.radians(camera.fov_y) / 2))
-            self._uniform(prog, "u_thin_pixels", float(self.scene.thin_pixels))
-        cached = self._cache_background(camera, vp, width, height)
+        self.view.set(view_proj=vp, inv_view_proj=np.linalg.inv(vp.astype(np.float64)), camera_pos=camera.eye,
+                      viewport=(width, height), pixels_per_metre=0.5 * height / math.tan(math.radians(camera.fov_y) / 2))
+        for block in (self.light, self.view, self.shadow.block):
+            block.use()
+        key = (width, height, vp.tobytes(), tuple(camera.eye), self._applied_scene)
+        cached = self.background.holds(key, (width, height), lambda: self._draw_background(camera, vp))
         target.use()
         ctx.viewport = (0, 0, width, height)
 
@@ -390,43 +268,26 @@ class Renderer:
         ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
-        self.shadow.texture.use(2)
+        self.shadow.texture.use(SAMPLERS["shadow_map"].unit)
         # The leaves first: solid, so the ground and sky under them are never shaded. Then the
         # ground over the shadow's footprint, with its shadow, and where neither was drawn the
         # background: sky and the rest of the ground (a copy of the cache, or drawn here).
-        self.parts["LEAVES"].render()
+        self.tree_pass.draw("LEAVES", season=season)
         if s.shadow and self._ground_shown(camera):
-            self._ground(self.ground_vaos[1], self.shadow.footprint, vp, DEPTH_FOOTPRINT)
+            self.ground_pass.draw(self.shadow.footprint, vp, DEPTH_FOOTPRINT, shadowed=True)
         if cached:
-            ctx.depth_func = "<="
-            self.background_texture.use(3)
-            self.background_vao.render(moderngl.TRIANGLES, vertices=3)
-            ctx.depth_func = "<"
+            self.background.draw()
         else:
             self._draw_background(camera, vp)
         # Blended: twigs and blades thinner than a pixel are drawn faint over what lies behind.
         ctx.enable(moderngl.BLEND)
         ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
-        self.parts["BARK"].render()
-        self.parts["BLADES"].render()
+        self.tree_pass.draw("BARK", "BLADES", season=season)
         ctx.disable(moderngl.BLEND)
-        overlays = [o for o in overlays if o is not None]
-        if overlays:
-            self._draw_overlays(overlays, width, height)
-        self._collect_lines({id(o) for o in overlays})
+        self.overlay_pass.draw([o for o in overlays if o is not None], self.tree)
 
     def _ground_shown(self, camera: OrbitCamera) -> bool:
         return bool(self.scene.show_ground and camera.eye[1] > 0.0)
-
-    def _ground(self, vao: moderngl.VertexArray, polygon: np.ndarray, vp: np.ndarray, depth: float) -> None:
-        """One convex polygon of the ground ((K, 2) corners x, z), drawn by ``vao``'s program at
-        ``depth`` (NDC z)."""
-        tris = clip_ground(polygon, vp, depth)
-        if len(tris):
-            if self.ground_vbo.size < tris.nbytes:
-                self.ground_vbo.orphan(2 * tris.nbytes)
-            self.ground_vbo.write(tris.tobytes())
-            vao.render(moderngl.TRIANGLES, vertices=len(tris))
 
     def _draw_background(self, camera: OrbitCamera, vp: np.ndarray) -> None:
         """The background, where nothing was drawn yet (depth test on): the ground without
@@ -435,80 +296,8 @@ class Renderer:
         if self._ground_shown(camera):
             eye = np.asarray(camera.eye, float)
             square = eye[[0, 2]] + HORIZON_REACH * eye[1] * np.array([[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]])
-            self._ground(self.ground_vaos[0], square, vp, DEPTH_GROUND)
-        self.ctx.depth_func = "<="
-        self.sky_vao.render(moderngl.TRIANGLES, vertices=3)
-        self.ctx.depth_func = "<"
-
-    def _cache_background(self, camera: OrbitCamera, vp: np.ndarray, width: int, height: int) -> bool:
-        """Whether the background cache holds this frame's background; drawn into it on the
-        second frame in a row with the same viewport, camera and scene. Neither sky nor the
-        ground without shadows moves with the tree, so while the camera is still each frame
-        copies them (a copy costs llvmpipe a fifth of shading them); while it moves they are
-        drawn in the frame as before, so a moving camera pays nothing for the cache."""
-        key = (width, height, vp.tobytes(), tuple(camera.eye), self._applied_scene)
-        if key == self._background_key:
-            return True
-        if key != self._last_view:
-            self._last_view = key
-            return False
-        ctx = self.ctx
-        if self.background_texture is None or self.background_texture.size != (width, height):
-            for o in (self.background_fbo, self.background_depth, self.background_texture):
-                if o is not None:
-                    o.release()
-            self.background_fbo = self.background_depth = None  # made next: released again if that fails
-            self.background_texture = ctx.texture((width, height), 4)
-            self.background_texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            self.background_depth = ctx.depth_renderbuffer((width, height))
-            self.background_fbo = ctx.framebuffer(self.background_texture, self.background_depth)
-        self.background_fbo.use()
-        ctx.viewport = (0, 0, width, height)
-        self.background_fbo.clear(depth=1.0)
-        ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
-        ctx.enable(moderngl.DEPTH_TEST)
-        ctx.depth_func = "<"
-        self._draw_background(camera, vp)
-        self._background_key = key
-        return True
-
-    # ------------------------------------------------------------------ overlays
-    def _draw_overlays(self, overlays, width: int, height: int) -> None:
-        ctx = self.ctx
-        ctx.enable(moderngl.BLEND)
-        ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
-        self._uniform(self.line_prog, "u_viewport", (float(width), float(height)))
-        for ov in overlays:
-            buf = self._lines.get(id(ov))
-            if buf is None or buf.ref() is not ov:
-                if buf is not None:
-                    buf.release()
-                buf = self._lines[id(ov)] = _Lines(ov)
-            if not (ov.static and buf.uploaded):
-                ls = ov.lines(self.tree)
-                data = ls.packed().tobytes() if ls is not None and len(ls.points) >= 2 else b""
-                buf.count = len(data) // 32
-                buf.uploaded = True
-                if buf.count:
-                    if buf.vbo is None or buf.vbo.size < len(data):
-                        buf.release()
-                        buf.vbo = ctx.buffer(reserve=max(len(data), 4096) * 2, dynamic=True)
-                        buf.vao = ctx.vertex_array(self.line_prog, [(buf.vbo, LINE_FORMAT, *LINE_ATTRIBUTES)])
-                    buf.vbo.write(data)
-            if not buf.count:
-                continue
-            if ov.on_top:
-                ctx.disable(moderngl.DEPTH_TEST)
-            else:
-                ctx.enable(moderngl.DEPTH_TEST)
-            self._uniform(self.line_prog, "u_width", float(ov.width))
-            buf.vao.render(moderngl.LINES, vertices=buf.count - buf.count % 2)
-        ctx.disable(moderngl.BLEND)
-        ctx.enable(moderngl.DEPTH_TEST)
-
-    def _collect_lines(self, live: set[int]) -> None:
-        for key in [k for k, b in self._lines.items() if k not in live or b.ref() is None]:
-            self._lines.pop(key).release()
+            self.ground_pass.draw(square, vp, DEPTH_GROUND, shadowed=False)
+        self.sky_pass.draw()
 
     # ------------------------------------------------------------------ teardown
     def release(self) -> None:
@@ -516,15 +305,5 @@ class Renderer:
         if self._released:
             return
         self._released = True
-        for b in self._lines.values():
-            b.release()
-        self._lines.clear()
-        if self.shadow is not None:
-            self.shadow.release()
-        for o in (*[p.vao for p in self.parts.values()], *self.tree_progs, self.vbo, self.ibo, self.sky_vao,
-                  *self.ground_vaos, self.ground_vbo, self.node_texture, self.object_texture, self.sky_prog,
-                  *self.ground_progs, self.background_vao, self.background_fbo, self.background_texture,
-                  self.background_depth,
-                  self.background_prog, self.line_prog):
-            if o is not None:
-                o.release()
+        release_all(self.overlay_pass, self.background, self.ground_pass, self.sky_pass, self.shadow, self.tree_pass,
+                    self.node_texture, self.object_texture, self.light, self.view)

@@ -1,7 +1,8 @@
 """Loading GLSL sources shipped as package data (``treeanim.shaders``), with ``#include``.
 
 ``#include "constants.glsl"`` is made here from the Python constants the shaders share (the
-mesh's material ids, the leaves' and blades' colours), so the two can never drift apart.
+mesh's material ids, the leaves' and blades' colours), and ``#include "uniforms.glsl"`` from
+the uniform tables of :mod:`treeanim.render.uniforms`, so the two sides can never drift apart.
 """
 
 from __future__ import annotations
@@ -11,6 +12,8 @@ from functools import lru_cache
 from importlib.resources import files
 
 import moderngl
+
+from .uniforms import bind_program, uniforms_glsl
 
 #: Where the renderer draws in the depth range (NDC z), behind every surface of the tree: twigs
 #: thinner than a few pixels (they lose to every solid surface, see shaders/tree.vert), then the
@@ -26,13 +29,17 @@ _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$', re.MULTILINE)
 @lru_cache(maxsize=None)
 def shader_source(name: str) -> str:
     """The text of shader file ``name`` with every ``#include "file"`` line replaced by that
-    file's text (recursively; each file at most once)."""
+    file's text (recursively; each file at most once: a second include of it is dropped)."""
+    included: set[str] = set()
 
     def expand(fname: str, seen: tuple[str, ...]) -> str:
         if fname in seen:
             raise ValueError(f"shader include cycle: {' -> '.join(seen + (fname,))}")
-        if fname == "constants.glsl":
-            return constants_glsl()
+        if fname in included:
+            return ""
+        included.add(fname)
+        if fname in _GENERATED:
+            return _GENERATED[fname]()
         text = files("treeanim.shaders").joinpath(fname).read_text(encoding="utf-8")
         return _INCLUDE.sub(lambda m: expand(m.group(1), seen + (fname,)), text)
 
@@ -51,6 +58,10 @@ def constants_glsl() -> str:
     lines.append(f"const float DEPTH_THIN = {DEPTH_THIN!r};")
     lines += [f"const vec3 C_{n} = vec3({r!r}, {g!r}, {b!r});" for n, (r, g, b) in palette.COLOURS.items()]
     return "\n".join(lines) + "\n"
+
+
+#: Includes written from Python: name → the function that writes the text.
+_GENERATED = {"constants.glsl": constants_glsl, "uniforms.glsl": uniforms_glsl}
 
 
 def with_defines(source: str, defines: dict | None) -> str:
@@ -80,12 +91,28 @@ def with_defines(source: str, defines: dict | None) -> str:
 def load_program(ctx: moderngl.Context, vertex: str, fragment: str, geometry: str | None = None,
                  defines: dict | None = None) -> moderngl.Program:
     """Compile and link a program from shader file names (e.g. ``"tree.vert"``), with
-    ``defines`` (name: value) set in every stage."""
+    ``defines`` (name: value) set in every stage, its uniforms checked and bound
+    (:func:`~treeanim.render.uniforms.bind_program`).
+
+    Raises
+    ------
+    RuntimeError
+        The program does not build, or declares a uniform outside ``uniforms.glsl``.
+    """
+    label = " + ".join(n for n in (vertex, geometry, fragment) if n)
+    if defines:
+        label += " (" + ", ".join(f"{k}={v}" for k, v in defines.items()) + ")"
     try:
-        return ctx.program(
+        prog = ctx.program(
             vertex_shader=with_defines(shader_source(vertex), defines),
             fragment_shader=with_defines(shader_source(fragment), defines),
             geometry_shader=with_defines(shader_source(geometry), defines) if geometry else None,
         )
     except moderngl.Error as exc:
         raise RuntimeError(f"shader program {vertex} + {fragment} failed to build: {exc}") from exc
+    try:
+        bind_program(prog, label)
+    except BaseException:
+        prog.release()
+        raise
+    return prog

@@ -1,6 +1,6 @@
 """The sun's shadow map: the skinned tree's depth seen from the sun, drawn each frame before the
 scene, and sampled with percentage-closer filtering by the tree and the ground
-(``sun_visibility`` in ``shaders/common.glsl``), so the crown shades the ground and itself.
+(``sun_visibility`` in ``shaders/sun.glsl``), so the crown shades the ground and itself.
 
 The sun's orthographic view is fitted once per sun direction to a box round the tree that
 leaves room for it to sway, and to that box's shadow on the ground: the map's texels stay
@@ -18,6 +18,7 @@ from ..model.lamina import ear_clip
 from ..model.tree import Tree
 from .mesh import MATERIAL_LAMINA, MATERIAL_PETIOLE, VERTEX_ATTRIBUTES, VERTEX_DTYPE, VERTEX_FORMAT, TreeMesh
 from .shaders import load_program
+from .uniforms import UniformBlock
 
 #: Attributes the shadow pass reads; the rest of each vertex is skipped.
 SHADOW_ATTRIBUTES = ("in_ids", "in_offset", "in_extra", "in_curve")
@@ -31,7 +32,7 @@ MIN_SUN_HEIGHT = 0.15
 #: Corners of a lamina's outline kept for its shadow (its teeth are far below a texel).
 SHADOW_LAMINA_CORNERS = 12
 #: The footprint reaches this many shadow-map texels beyond the box's shadow: the reach of a
-#: ground point's lookup (its offset off the ground and the filter's taps, ``shaders/common.glsl``).
+#: ground point's lookup (its offset off the ground and the filter's taps, ``shaders/sun.glsl``).
 FOOTPRINT_TEXELS = 4.0
 
 
@@ -180,7 +181,9 @@ def light_view_projection(sun: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tu
 
 
 class ShadowMap:
-    """A depth texture of the tree seen from the sun, and the pass that draws it.
+    """A depth texture of the tree seen from the sun, the pass that draws it, and the ``Shadow``
+    uniform block that the map's lookups read (``sun.glsl``): bound by the renderer for every
+    pass, by :meth:`draw` for its own.
 
     Parameters
     ----------
@@ -197,8 +200,9 @@ class ShadowMap:
         self.ctx = ctx
         self.size = int(min(max(size, 16), ctx.info["GL_MAX_TEXTURE_SIZE"]))
         self.count = 3 * len(indices)
-        self.prog = self.texture = self.fbo = self.vao = self.ibo = None
+        self.prog = self.texture = self.fbo = self.vao = self.ibo = self.block = None
         try:
+            self.block = UniformBlock(ctx, "Shadow")
             self.prog = load_program(ctx, "shadow.vert", "shadow.frag")
             self.texture = ctx.depth_texture((self.size, self.size))
             self.texture.compare_func = "<="  # sampler2DShadow: 1 where the point is nearest
@@ -216,6 +220,7 @@ class ShadowMap:
         self.texel = 1.0
         self.footprint = np.zeros((0, 2))
         self._fitted: tuple | None = None
+        self.block.set(light_view_proj=self.matrix, shadow_texel=self.texel, shadow_on=1)
         self.clear()
 
     def fit(self, sun, lo, hi, points, pad: float) -> None:
@@ -232,7 +237,14 @@ class ShadowMap:
         self.texel = extent / self.size
         reach = grow + pad + FOOTPRINT_TEXELS * self.texel / cast_direction(sun)[1]  # texels long on the ground
         self.footprint = ground_footprint(sun, points, reach)
-        self.prog["u_light_view_proj"].write(self.matrix.tobytes())
+        self.block.set(light_view_proj=self.matrix, shadow_texel=self.texel)
+
+    def enable(self, on: bool) -> None:
+        """Shadows on (the map drawn each frame by :meth:`draw`) or off (the map cleared, its
+        lookups everything lit)."""
+        self.block.set(shadow_on=on)
+        if not on:
+            self.clear()
 
     def clear(self) -> None:
         """Nothing in the map: everything lit."""
@@ -247,6 +259,7 @@ class ShadowMap:
         self.fbo.clear(depth=1.0)
         if self.vao is None:
             return
+        self.block.use()
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         ctx.polygon_offset = 1.5, 2.0  # slope-scaled bias against acne on grazing faces
@@ -255,7 +268,7 @@ class ShadowMap:
 
     def release(self) -> None:
         """Free the GL objects (idempotent)."""
-        for o in (self.vao, self.ibo, self.fbo, self.texture, self.prog):
+        for o in (self.vao, self.ibo, self.fbo, self.texture, self.prog, self.block):
             if o is not None:
                 o.release()
-        self.vao = self.ibo = self.fbo = self.texture = self.prog = None
+        self.vao = self.ibo = self.fbo = self.texture = self.prog = self.block = None

@@ -1,0 +1,375 @@
+"""The renderer's passes: each owns its programs, its vertex arrays and buffers, and the uniform
+block of its own settings (:mod:`treeanim.render.uniforms`); :class:`~.renderer.Renderer`
+makes them, feeds them the scene and the view, and calls them in the frame's order. The sun's
+shadow map is the fifth (:class:`~.shadow.ShadowMap`).
+
+- :class:`TreePass`: the skinned mesh, one program per part (``mesh.PARTS``).
+- :class:`GroundPass`: the ground plane, as convex polygons cut in front of the eye, with the
+  sun's shadow or without.
+- :class:`SkyPass`: the sky, a full-screen triangle at the far plane.
+- :class:`BackgroundCache`: sky and shadowless ground drawn once into a texture while the view
+  holds still, and copied each frame after.
+- :class:`OverlayPass`: the overlays' lines.
+
+Each pass frees what it made if its construction fails, and its ``release()`` is idempotent.
+A pass binds its own block when it draws; the blocks every pass reads (``Light``, ``View``,
+``Shadow``) and the node and object textures are bound by the renderer first.
+"""
+
+from __future__ import annotations
+
+import weakref
+
+import moderngl
+import numpy as np
+
+from ..model.tree import Tree
+from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh
+from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
+from .scene import Scene, clip_ground
+from .shaders import load_program
+from .uniforms import SAMPLERS, UniformBlock
+
+
+def release_all(*objects) -> None:
+    """Release each GL object or pass that is not None."""
+    for o in objects:
+        if o is not None:
+            o.release()
+
+
+class _Part:
+    """One part of the mesh: its program, and its triangles' range in the index buffer."""
+
+    def __init__(self, prog: moderngl.Program, first: int, count: int) -> None:
+        self.prog = prog
+        self.vao: moderngl.VertexArray | None = None
+        self.first = first
+        self.count = count
+
+    def render(self) -> None:
+        if self.count:
+            self.vao.render(moderngl.TRIANGLES, vertices=self.count, first=self.first)
+
+
+class TreePass:
+    """The tree's skinned mesh: one static vertex buffer, one index buffer part after part, a
+    program per part (``PART`` in ``tree.vert``/``tree.frag``: each holds only its own code), and
+    the ``Tree`` block.
+
+    Parameters
+    ----------
+    ctx : moderngl.Context
+    mesh : TreeMesh
+    tree : Tree
+        The mesh's tree (its bark's look).
+    """
+
+    def __init__(self, ctx: moderngl.Context, mesh: TreeMesh, tree: Tree) -> None:
+        self.vbo = self.ibo = self.block = None
+        self.parts: dict[str, _Part] = {}
+        try:
+            self.block = UniformBlock(ctx, "Tree")
+            bark = tree.bark
+            self.block.set(bark_color=bark.color, bark=(bark.furrows, bark.depth, bark.interlace, bark.lenticels))
+            tris = [mesh.part_indices(name) for name in PARTS]
+            if mesh.triangle_count:
+                self.vbo = ctx.buffer(mesh.vertices.tobytes())
+                self.ibo = ctx.buffer(np.concatenate(tris).tobytes())
+            first = 0
+            for k, (name, t) in enumerate(zip(PARTS, tris)):
+                part = self.parts[name] = _Part(load_program(ctx, "tree.vert", "tree.frag", defines={"PART": k}),
+                                                first, 3 * len(t))
+                if part.count:
+                    part.vao = ctx.vertex_array(part.prog, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRIBUTES)],
+                                                index_buffer=self.ibo, index_element_size=4)
+                first += part.count
+        except BaseException:
+            self.release()
+            raise
+
+    def apply(self, scene: Scene) -> None:
+        """Take the scene's settings (leaves' translucency, thin lines' width)."""
+        self.block.set(translucency=scene.translucency, thin_pixels=scene.thin_pixels)
+
+    def draw(self, *parts: str, season: float) -> None:
+        """Draw ``parts`` (names of ``mesh.PARTS``) in order, the leaves coloured for ``season``
+        (0 summer .. 1 winter); the shadow map bound to its unit."""
+        self.block.set(season=season)
+        self.block.use()
+        for name in parts:
+            self.parts[name].render()
+
+    def release(self) -> None:
+        """Free the GL objects (idempotent)."""
+        for part in self.parts.values():
+            release_all(part.vao, part.prog)
+        self.parts = {}
+        release_all(self.vbo, self.ibo, self.block)
+        self.vbo = self.ibo = self.block = None
+
+
+class GroundPass:
+    """The ground y = 0: bare earth round the trunk, the sky the crown hides and a contact shadow
+    at its foot; drawn as convex polygons in clip space (``ground.vert``), cut in front of the eye
+    (:func:`~.scene.clip_ground`), by one of two programs: with the sun's shadow (``SUN_SHADOW``
+    1, over the shadow's footprint only) or without.
+
+    Parameters
+    ----------
+    ctx : moderngl.Context
+    tree : Tree
+    bounds : ((3,) float, (3,) float)
+        The tree's box at rest (:meth:`Renderer.bounds`).
+    """
+
+    def __init__(self, ctx: moderngl.Context, tree: Tree, bounds) -> None:
+        self.progs: list[moderngl.Program] = []
+        self.vaos: list[moderngl.VertexArray] = []
+        self.vbo = self.block = None
+        try:
+            self.block = UniformBlock(ctx, "Ground")
+            for shadowed in (0, 1):
+                self.progs.append(load_program(ctx, "ground.vert", "ground.frag", defines={"SUN_SHADOW": shadowed}))
+            self.vbo = ctx.buffer(reserve=4096, dynamic=True)
+            for prog in self.progs:
+                self.vaos.append(ctx.vertex_array(prog, [(self.vbo, "4f", "in_clip")]))
+            self._place(tree, *bounds)
+        except BaseException:
+            self.release()
+            raise
+
+    def _place(self, tree: Tree, lo: np.ndarray, hi: np.ndarray) -> None:
+        """Where the ground's features lie, from the tree at rest."""
+        P = tree.rest_positions
+        roots = tree.object_start[tree.parent < 0]
+        branch = tree.kind == "branch"
+        trunk_foot = P[roots[0]] if len(roots) and branch.any() else 0.5 * (lo + hi)
+        trunks = tree.object_start[(tree.parent < 0) & branch]
+        leafy = tree.kind != "branch"
+        pts = P[np.isin(tree.node_object, np.flatnonzero(leafy))] if leafy.any() else P
+        crown = pts.mean(axis=0)
+        spread = np.percentile(np.linalg.norm(pts[:, [0, 2]] - crown[[0, 2]], axis=1), 85)
+        self.occlusion_radius = float(max(1.1 * spread, 0.1 * float(np.max(hi - lo))))
+        self.trunk_radius = float(0.5 * tree.node_diameter[trunks].max()) if len(trunks) else 0.0
+        self.block.set(ground_centre=(trunk_foot[0], 0.0, trunk_foot[2]),
+                       earth_radius=5.0 * tree.node_diameter[trunks].max() if len(trunks) else 0.0,
+                       occlusion_centre=(crown[0], 0.0, crown[2]))
+
+    def apply(self, scene: Scene) -> None:
+        """Take the scene's settings (the crown's shade and the trunk's contact shadow go with the
+        sun's shadows; the grid)."""
+        self.block.set(occlusion_radius=self.occlusion_radius if scene.shadow else 0.0,
+                       trunk_radius=self.trunk_radius if scene.shadow else 0.0, grid=scene.ground_grid)
+
+    def draw(self, polygon: np.ndarray, view_proj: np.ndarray, depth: float, shadowed: bool) -> None:
+        """Draw one convex polygon of the ground at ``depth`` (NDC z).
+
+        Parameters
+        ----------
+        polygon : (K, 2) float
+            Corners (x, z), in order round it.
+        view_proj : (4, 4) float
+            World → clip (:meth:`OrbitCamera.view_projection`).
+        depth : float
+        shadowed : bool
+            With the sun's shadow (the shadow map bound to its unit).
+        """
+        tris = clip_ground(polygon, view_proj, depth)
+        if len(tris):
+            if self.vbo.size < tris.nbytes:
+                self.vbo.orphan(2 * tris.nbytes)
+            self.vbo.write(tris.tobytes())
+            self.block.use()
+            self.vaos[int(shadowed)].render(moderngl.TRIANGLES, vertices=len(tris))
+
+    def release(self) -> None:
+        """Free the GL objects (idempotent)."""
+        release_all(*self.vaos, *self.progs, self.vbo, self.block)
+        self.vaos, self.progs = [], []
+        self.vbo = self.block = None
+
+
+class SkyPass:
+    """The sky: gradient, sun disc and glow (``sky.frag``), one full-screen triangle at the far
+    plane drawn with depth test <=, where nothing else was."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self.prog = self.vao = self.block = None
+        try:
+            self.block = UniformBlock(ctx, "Sky")
+            self.prog = load_program(ctx, "sky.vert", "sky.frag")
+            self.vao = ctx.vertex_array(self.prog, [])
+        except BaseException:
+            self.release()
+            raise
+
+    def apply(self, scene: Scene) -> None:
+        """Take the scene's settings (the sky shown, or a flat horizon colour)."""
+        self.block.set(show_sky=scene.show_sky)
+
+    def draw(self) -> None:
+        """Draw the sky where the depth buffer is clear."""
+        self.block.use()
+        self.ctx.depth_func = "<="
+        self.vao.render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.depth_func = "<"
+
+    def release(self) -> None:
+        """Free the GL objects (idempotent)."""
+        release_all(self.vao, self.prog, self.block)
+        self.vao = self.prog = self.block = None
+
+
+class BackgroundCache:
+    """The background (the sky and the ground without shadows) of the last still view, in a
+    texture, and the pass that copies it into a frame (``background.frag``).
+
+    Neither moves with the tree, so while the camera, the viewport and the scene hold still a
+    frame copies them (a copy costs llvmpipe a fifth of shading them). A view is cached on the
+    second frame in a row it is drawn; while the camera moves the background is drawn in the
+    frame, so a moving camera pays nothing for the cache.
+    """
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self.prog = self.vao = self.texture = self.depth = self.fbo = None
+        self._key: tuple | None = None        # the view the cache holds
+        self._last_view: tuple | None = None  # the last frame's
+        try:
+            self.prog = load_program(ctx, "sky.vert", "background.frag")
+            self.vao = ctx.vertex_array(self.prog, [])
+        except BaseException:
+            self.release()
+            raise
+
+    def holds(self, key: tuple, size: tuple[int, int], draw) -> bool:
+        """Whether the cache holds the background of view ``key`` (anything that changes the
+        background: viewport, camera, scene); on the second frame in a row with the same key, the
+        background is drawn into it first by ``draw()`` (depth test on, nothing blended).
+
+        Parameters
+        ----------
+        key : tuple
+        size : (int, int)
+            Width and height in pixels.
+        draw : callable
+            Draws the background into the bound framebuffer.
+        """
+        if key == self._key:
+            return True
+        if key != self._last_view:
+            self._last_view = key
+            return False
+        ctx = self.ctx
+        if self.texture is None or self.texture.size != size:
+            release_all(self.fbo, self.depth, self.texture)
+            self.fbo = self.depth = None  # made next: released again if that fails
+            self.texture = ctx.texture(size, 4)
+            self.texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self.depth = ctx.depth_renderbuffer(size)
+            self.fbo = ctx.framebuffer(self.texture, self.depth)
+        self.fbo.use()
+        ctx.viewport = (0, 0, *size)
+        self.fbo.clear(depth=1.0)
+        ctx.disable(moderngl.BLEND | moderngl.CULL_FACE)
+        ctx.enable(moderngl.DEPTH_TEST)
+        ctx.depth_func = "<"
+        draw()
+        self._key = key
+        return True
+
+    def draw(self) -> None:
+        """Copy the cache into the bound framebuffer where nothing was drawn yet."""
+        self.texture.use(SAMPLERS["background"].unit)
+        self.ctx.depth_func = "<="
+        self.vao.render(moderngl.TRIANGLES, vertices=3)
+        self.ctx.depth_func = "<"
+
+    def release(self) -> None:
+        """Free the GL objects (idempotent)."""
+        release_all(self.vao, self.fbo, self.texture, self.depth, self.prog)
+        self.vao = self.fbo = self.texture = self.depth = self.prog = None
+
+
+class _Lines:
+    """GPU buffers of one overlay."""
+
+    def __init__(self, overlay: Overlay) -> None:
+        self.ref = weakref.ref(overlay)
+        self.vbo: moderngl.Buffer | None = None
+        self.vao: moderngl.VertexArray | None = None
+        self.count = 0
+        self.uploaded = False
+
+    def release(self) -> None:
+        release_all(self.vao, self.vbo)
+        self.vao = self.vbo = None
+
+
+class OverlayPass:
+    """Overlays (:mod:`~.overlays`) as screen-space lines (``line.vert`` + ``line_geom.glsl``),
+    each overlay's in its own buffers, uploaded once if it is static, freed once it is gone."""
+
+    def __init__(self, ctx: moderngl.Context) -> None:
+        self.ctx = ctx
+        self.prog = self.block = None
+        self._lines: dict[int, _Lines] = {}
+        try:
+            self.block = UniformBlock(ctx, "Lines")
+            self.prog = load_program(ctx, "line.vert", "line.frag", "line_geom.glsl")
+        except BaseException:
+            self.release()
+            raise
+
+    def draw(self, overlays: list[Overlay], tree: Tree) -> None:
+        """Draw ``overlays`` in order (blended; with or without depth test, as each says), and
+        free the buffers of overlays not drawn."""
+        ctx = self.ctx
+        if overlays:
+            ctx.enable(moderngl.BLEND)
+            ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
+            for ov in overlays:
+                buf = self._upload(ov, tree)
+                if not buf.count:
+                    continue
+                if ov.on_top:
+                    ctx.disable(moderngl.DEPTH_TEST)
+                else:
+                    ctx.enable(moderngl.DEPTH_TEST)
+                self.block.set(width=ov.width)
+                self.block.use()
+                buf.vao.render(moderngl.LINES, vertices=buf.count - buf.count % 2)
+            ctx.disable(moderngl.BLEND)
+            ctx.enable(moderngl.DEPTH_TEST)
+        live = {id(o) for o in overlays}
+        for key in [k for k, b in self._lines.items() if k not in live or b.ref() is None]:
+            self._lines.pop(key).release()
+
+    def _upload(self, ov: Overlay, tree: Tree) -> _Lines:
+        buf = self._lines.get(id(ov))
+        if buf is None or buf.ref() is not ov:
+            if buf is not None:
+                buf.release()
+            buf = self._lines[id(ov)] = _Lines(ov)
+        if not (ov.static and buf.uploaded):
+            ls = ov.lines(tree)
+            data = ls.packed().tobytes() if ls is not None and len(ls.points) >= 2 else b""
+            buf.count = len(data) // 32
+            buf.uploaded = True
+            if buf.count:
+                if buf.vbo is None or buf.vbo.size < len(data):
+                    buf.release()
+                    buf.vbo = self.ctx.buffer(reserve=max(len(data), 4096) * 2, dynamic=True)
+                    buf.vao = self.ctx.vertex_array(self.prog, [(buf.vbo, LINE_FORMAT, *LINE_ATTRIBUTES)])
+                buf.vbo.write(data)
+        return buf
+
+    def release(self) -> None:
+        """Free the GL objects (idempotent)."""
+        for b in self._lines.values():
+            b.release()
+        self._lines.clear()
+        release_all(self.prog, self.block)
+        self.prog = self.block = None
