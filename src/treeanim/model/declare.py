@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-import math
 import types
 import typing
 from dataclasses import dataclass
@@ -73,10 +72,6 @@ class Param:
     def widget_format(self) -> str:
         """:attr:`fmt` with the unit."""
         return f"{self.fmt} {self.unit}" if self.unit else self.fmt
-
-    def contains(self, x: float) -> bool:
-        """Whether ``x`` is allowed (finite and within the range)."""
-        return math.isfinite(x) and (x > self.lo if self.lo_open else x >= self.lo) and x <= self.hi
 
     def __get_pydantic_core_schema__(self, source, handler):
         # A strict float (bools and strings refused, any int or numpy number taken), finite, in

@@ -71,6 +71,12 @@ def _positive(hi: float, unit: str = "", **kw) -> Param:
     return Param(0.0, hi, lo_open=True, unit=unit, **kw)
 
 
+def _material(lo: float, hi: float, unit: str, **kw) -> Param:
+    """A material's density or modulus, in [lo, hi]: far beyond any plant either way (the tree
+    model's masses and stiffnesses overflow near 0)."""
+    return Param(lo, hi, unit=unit, **kw)
+
+
 def _non_negative(hi: float, unit: str = "", **kw) -> Param:
     """A quantity 0 switches off (a gain, a drag, a twist ...), at most ``hi``."""
     return Param(0.0, hi, unit=unit, **kw)
@@ -119,18 +125,19 @@ class PhysicsParams:
         1e3, "N·s/m³", help="The paper's drag gain of branches: load = gain × exposed area × wind velocity.")] = 3.0
     wind_gain_leaf: Annotated[float, _non_negative(1e3, "N·s/m³", help="The paper's drag gain of leaves.")] = 0.5
     wind_gain_blade: Annotated[float, _non_negative(1e3, "N·s/m³", help="The paper's drag gain of grass blades.")] = 3.0
-    wood_density: Annotated[float, _positive(
-        1e4, "kg/m³", help="Wood density: the paper's base-excitation inertia (docs/design.md §6 step 3) and the "
+    wood_density: Annotated[float, _material(
+        1e-3, 1e4, "kg/m³", help="Wood density: the paper's base-excitation inertia (docs/design.md §6 step 3) and the "
                            "tree model's segment masses.")] = 700.0
-    leaf_density: Annotated[float, _positive(1e4, "kg/m³", help="Density of petioles and laminas (their masses).")] = 500.0
-    lamina_thickness: Annotated[float, _positive(
-        0.05, "m", help="Thickness of a leaf lamina (and of a grass blade), for its mass.")] = 3.0e-4
+    leaf_density: Annotated[float, _material(1e-3, 1e4, "kg/m³", help="Density of petioles and laminas (their masses).")] = 500.0
+    lamina_thickness: Annotated[float, Param(
+        1e-6, 0.05, unit="m", help="Thickness of a leaf lamina (and of a grass blade), for its mass and its "
+                                   "bending as it folds in the flow.")] = 3.0e-4
     leaf_twist_c0: Annotated[float, _non_negative(
         100.0, help="twist_c0 for leaves (their petioles twist more readily than wood).")] = 0.5
-    leaf_youngs_modulus: Annotated[float, _positive(
-        1e12, "Pa", help="The tree model (docs/design.md §12): Young's modulus E of petioles (EI = E pi D^4 / 64).")] = 1.0e9
-    blade_youngs_modulus: Annotated[float, _positive(
-        1e12, "Pa", help="The tree model: the effective modulus of grass blades, bent as a round rod as wide as the "
+    leaf_youngs_modulus: Annotated[float, _material(
+        1.0, 1e12, "Pa", help="The tree model (docs/design.md §12): Young's modulus E of petioles (EI = E pi D^4 / 64).")] = 1.0e9
+    blade_youngs_modulus: Annotated[float, _material(
+        1.0, 1e12, "Pa", help="The tree model: the effective modulus of grass blades, bent as a round rod as wide as the "
                          "blade: 5e5 Pa gives a 12 mm blade EI = 5e-4 N·m² at its base, that of a keeled blade with "
                          "its midrib, so a meadow bends visibly in a 5 m/s breeze and lies over in a 30 m/s "
                          "gale.")] = 5.0e5
@@ -146,8 +153,8 @@ class PhysicsParams:
     leaf_flutter: Annotated[float, _non_negative(
         1.5, "rad", help="The tree model: the largest twist of a leaf's flutter about its petiole in a strong wind "
                          "(treeanim.physics.treestep).")] = 0.35
-    wood_youngs_modulus: Annotated[float, _positive(
-        1e12, "Pa", help="The effective Young's modulus E of the branches' wood: the tree model's joints and the "
+    wood_youngs_modulus: Annotated[float, _material(
+        1.0, 1e12, "Pa", help="The effective Young's modulus E of the branches' wood: the tree model's joints and the "
                          "paper's modes='physical' (see WOOD_TYPES).")] = 6.0e9
     leaf_area_index: Annotated[float, _positive(
         20.0, "m²/m²", help="The tree model: the crown's leaf area per unit of its ground projection (broadleaf "
