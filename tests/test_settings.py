@@ -180,3 +180,22 @@ def test_every_setting_at_its_bounds_keeps_the_tree_finite_in_a_gale(name):
                 for _ in range(20):
                     sim.step(1 / 30)
                 assert np.isfinite(sim.positions).all(), (preset, model, value)
+
+
+def test_the_command_line_sets_physics_for_the_run():
+    from treeanim import cli
+
+    args = cli.build_parser().parse_args(["info", "beam", "--physics", "ei_max=75", "--physics", "twist_c0=0"])
+    tree = cli.load_any(args.preset, args)
+    assert (tree.physics.ei_max, tree.physics.twist_c0) == (75.0, 0.0)
+    assert tree.physics == dataclasses.replace(ta.load_preset("beam").physics, ei_max=75.0, twist_c0=0.0)
+
+
+def test_the_command_line_refuses_a_setting_in_one_line(tmp_path):
+    import subprocess
+    import sys
+
+    res = subprocess.run([sys.executable, "-m", "treeanim", "info", "beam", "--physics", "ei_max=-3"],
+                         capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert res.stderr.count("\n") == 1 and "physics.ei_max: expected a number in (0, 1e+12], got -3.0" in res.stderr

@@ -126,9 +126,9 @@ def add_season_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--modes", choices=["paper", "physical"], default=None,
                    help="the paper's model's modal f and zeta: paper (Eqs. 20-22; the presets' default) or "
                    "physical (beam theory; TreeQSM models' default)")
+    names = ", ".join(f"{k} ({p.unit + ' ' if p.unit else ''}{p.interval})" for k, p in PARAMS.items())
     p.add_argument("--physics", type=physics_setting, action="append", default=[], metavar="NAME=VALUE",
-                   help="set a physics parameter over the preset's (repeatable; e.g. ei_max=3e4): "
-                   f"{', '.join(PARAMS)} (units and ranges: docs/design.md, 'Adding a setting')")
+                   help=f"set one of the preset's physics parameters (repeatable; e.g. ei_max=3e4): {names}")
 
 
 def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
