@@ -248,13 +248,13 @@ class Panel:
         imgui.push_item_width(-110 * s)
 
         # --- statistics
-        key = (id(sim.tree), sim.season)
-        if key != self._text_key:  # the counts change only with the tree and the season
+        key = self._text_key  # the counts change only with the tree (itself, not its id) and the season
+        if key is None or key[0] is not sim.tree or key[1] != sim.season:
             st = v.stats()
             kinds = [k for k in KINDS if st[PLURAL[k]]]
             self._text = ("  ".join(f"{st[PLURAL[k]]:,} {PLURAL[k]}" for k in kinds),
                           f"{st['objects']:,} objects  {st['nodes']:,} nodes  {st['triangles']:,} tris")
-            self._text_key = key
+            self._text_key = (sim.tree, sim.season)
         imgui.text(self._text[0])
         imgui.text(self._text[1])
         now = time.perf_counter()

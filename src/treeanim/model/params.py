@@ -67,13 +67,13 @@ def _default_season() -> SeasonModes:
 
 
 def _positive(hi: float, unit: str = "", **kw) -> Param:
-    """A quantity that must be > 0 (a density, a modulus ...), at most ``hi``."""
+    """A quantity that must be > 0 (a stiffness, the air's density ...), at most ``hi``."""
     return Param(0.0, hi, lo_open=True, unit=unit, **kw)
 
 
 def _material(lo: float, hi: float, unit: str, **kw) -> Param:
-    """A material's density or modulus, in [lo, hi]: far beyond any plant either way (the tree
-    model's masses and stiffnesses overflow near 0)."""
+    """A material's density or modulus in [lo, hi], far beyond any plant either way (near 0 the
+    tree model's masses and stiffnesses overflow)."""
     return Param(lo, hi, unit=unit, **kw)
 
 
@@ -171,8 +171,12 @@ class PhysicsParams:
         if a is None or b is None:
             return a or b
         s = min(max(float(season), 0.0), 1.0)
-        lerp = lambda p, q: (p[0] + (q[0] - p[0]) * s, p[1] + (q[1] - p[1]) * s)  # noqa: E731
-        return ModeRange(lerp(a.f, b.f), lerp(a.zeta, b.zeta))
+
+        def lerp(p, q, param):  # (kept in range and order should rounding step an ulp out)
+            ends = sorted((p[0] + (q[0] - p[0]) * s, p[1] + (q[1] - p[1]) * s))
+            return tuple(min(max(x, param.lo), param.hi) for x in ends)
+
+        return ModeRange(lerp(a.f, b.f, MODE_PARAMS["f"]), lerp(a.zeta, b.zeta, MODE_PARAMS["zeta"]))
 
 
 #: The scalar settings of a preset's [physics] table, by name, in declaration order.
