@@ -829,8 +829,10 @@ def test_preset_text_rewrites_unusual_layouts(tmp_path):
     assert ta.load_tree(path).physics == physics
     assert save_preset(tmp_path / "c.toml", tree, physics) == tmp_path / "c.toml"
     assert ta.load_tree(tmp_path / "c.toml").physics == physics
-    with pytest.raises(ValueError, match="positive"):
-        physics_toml(dataclasses.replace(physics, twist_c0=0.0))
+    # what the simulation takes, the preset takes: no twist (once refused by the save alone)
+    untwisted = dataclasses.replace(physics, twist_c0=0.0)
+    assert "twist_c0 = 0.0" in physics_toml(untwisted)
+    assert ta.load_tree(save_preset(tmp_path / "d.toml", tree, untwisted)).physics == untwisted
 
 
 def test_saved_preset_gets_plain_file_permissions(tmp_path):
@@ -840,14 +842,20 @@ def test_saved_preset_gets_plain_file_permissions(tmp_path):
     os.umask(umask)
     assert path.stat().st_mode & 0o777 == 0o666 & ~umask, "created like any new file, not private (0600)"
     assert [f.name for f in tmp_path.iterdir()] == ["beam-mine.toml"]
-    # A text the preset reader refuses is never moved into place, and leaves nothing behind.
-    p = tree.physics
-    fast = dataclasses.replace(p, summer=dataclasses.replace(p.summer, branch=ModeRange((1.0, 500.0), (0.1, 0.2))))
+    # A text the preset reader refuses (its shape broken on disk since it was loaded) is never
+    # moved into place, and leaves nothing behind.
+    source = tmp_path / "beam-mine.toml"
+    tree = ta.load_tree(source)
+    source.write_text(source.read_text().replace("segments = 10", "segments = 1000"))
     with pytest.raises(ValueError) as err:
-        save_preset(tmp_path / "bad.toml", tree, fast)
+        save_preset(tmp_path / "bad.toml", tree, tree.physics)
     msg = str(err.value)
-    assert "physics.summer.branch.f" in msg and str(tmp_path / "bad.toml") in msg and ".part" not in msg
+    assert "beam.segments" in msg and str(tmp_path / "bad.toml") in msg and ".part" not in msg
     assert [f.name for f in tmp_path.iterdir()] == ["beam-mine.toml"]
+    # and a range no preset can hold cannot be set in the first place
+    p = tree.physics
+    with pytest.raises(ValueError, match=r"ModeRange\.f: expected a number in \[0\.001, 10000\], got 50000\.0"):
+        dataclasses.replace(p, summer=dataclasses.replace(p.summer, branch=ModeRange((1.0, 5e4), (0.1, 0.2))))
 
 
 def test_presets_switch_in_the_viewer(viewer):

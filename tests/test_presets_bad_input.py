@@ -40,9 +40,9 @@ CASES = [
     ("bark furrows", lambda s: s.replace("furrows = 8.0", "furrows = 0.0"), "bark.furrows", "[1, 64]"),
     # accepted once, and the simulation went NaN (issue #14, item 5)
     ("huge damping scale", lambda s: s.replace("[physics.summer]", "[physics]\nleaf_zeta_w_scale = 1e300\n[physics.summer]"),
-     "physics.leaf_zeta_w_scale", "(0, 100]"),
+     "physics.leaf_zeta_w_scale", "[0, 100]"),
     ("huge wind gain", lambda s: s.replace("[physics.summer]", "[physics]\nwind_gain_leaf = 1e308\n[physics.summer]"),
-     "physics.wind_gain_leaf", "(0, 1000]"),
+     "physics.wind_gain_leaf", "[0, 1000]"),
 ]
 
 

@@ -330,10 +330,9 @@ def test_presets_with_physical_modes_stay_calm_in_a_gale(name):
 
 def test_physical_parameters_are_checked():
     tree = cylinder()
-    bad = dataclasses.replace(tree.physics, wood_youngs_modulus=0.0)
     sim = ta.Simulation(tree, modes="physical", model="paper")
-    with pytest.raises(ValueError, match="wood_youngs_modulus must be > 0"):
-        sim.physics = bad
+    with pytest.raises(ValueError, match=r"physics\.wood_youngs_modulus: expected a number in \[1, 1e\+12\], got 0\.0"):
+        sim.physics = dataclasses.replace(tree.physics, wood_youngs_modulus=0.0)
 
 
 @pytest.mark.parametrize("seed", range(40))

@@ -226,7 +226,9 @@ def cmd_view(args) -> int:
 
 def load_any(name_or_path: str, args=None):
     """A preset by name, a preset TOML file or a TreeQSM model (.txt, .csv, .mat) by path, with
-    ``args``' --leaves (QSM only) and --modes."""
+    ``args``' --leaves (QSM only), --modes and --physics."""
+    import dataclasses
+
     import treeanim as ta
     from treeanim.model.qsm import QSM_SUFFIXES, load_file
 
@@ -239,6 +241,9 @@ def load_any(name_or_path: str, args=None):
         tree = ta.load_preset(name_or_path)
     if modes is not None:
         tree.modes = modes
+    settings = dict(getattr(args, "physics", None) or ())
+    if settings:
+        tree = dataclasses.replace(tree, physics=dataclasses.replace(tree.physics, **settings))
     return tree
 
 

@@ -94,8 +94,29 @@ def wind_speed(text: str) -> float:
     return number(float, 0, MAX_SPEED, lo_open=False)(text)
 
 
+def physics_setting(text: str) -> tuple[str, float]:
+    """An argparse type: ``NAME=VALUE``, a physics setting (:data:`treeanim.model.params.PARAMS`)
+    checked by its declaration."""
+    from treeanim.model.params import PARAMS, PhysicsParams, SettingError
+
+    name, sep, value = text.partition("=")
+    name = name.strip().replace("-", "_")
+    if not sep or name not in PARAMS:
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with NAME one of {', '.join(PARAMS)}, got {text!r}")
+    try:
+        x = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"physics.{name}: expected {PARAMS[name].expected}, got {value.strip()!r}") from None
+    try:
+        PhysicsParams(**{name: x})
+    except SettingError as e:
+        raise argparse.ArgumentTypeError(str(e)) from None
+    return name, x
+
+
 def add_season_option(p: argparse.ArgumentParser) -> None:
-    """--season, --leaves and --modes, for every command that builds a tree."""
+    """--season, --leaves, --modes and --physics, for every command that builds a tree."""
+    from treeanim.model.params import PARAMS
     from treeanim.model.qsm import SPECIES
 
     p.add_argument("--season", type=number(float, 0, 1, lo_open=False), default=0.0, help="0 = summer … 1 = winter (default 0)")
@@ -105,6 +126,9 @@ def add_season_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--modes", choices=["paper", "physical"], default=None,
                    help="the paper's model's modal f and zeta: paper (Eqs. 20-22; the presets' default) or "
                    "physical (beam theory; TreeQSM models' default)")
+    names = ", ".join(f"{k} ({p.unit + ' ' if p.unit else ''}{p.interval})" for k, p in PARAMS.items())
+    p.add_argument("--physics", type=physics_setting, action="append", default=[], metavar="NAME=VALUE",
+                   help=f"set one of the preset's physics parameters (repeatable; e.g. ei_max=3e4): {names}")
 
 
 def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:

@@ -108,8 +108,8 @@ class Panel:
         self._default_path = f"{v.sim.tree.name}-custom.toml"
         self.edit_season = "summer" if v.sim.season < 0.5 else "winter"
         self._kinds = [k for k in KINDS if np.any(v.sim.tree.kind == k)]
-        ei = float(v.sim.tree.physics.ei_max)
-        self._ranges = {"ei_max": (ei / EI_SPAN, ei * EI_SPAN)}
+        ei, st = float(v.sim.tree.physics.ei_max), SETTINGS["ei_max"]
+        self._ranges = {"ei_max": (max(ei / EI_SPAN, st.lo), min(ei * EI_SPAN, st.hi))}
         self._pending.clear()
 
     # ------------------------------------------------------------------ changes
@@ -212,15 +212,16 @@ class Panel:
         if changed:
             self.apply(name, new)
 
-    def _range_pair(self, name: str, speed: float, fmt: str) -> None:
-        """Setting ``name``'s (min, max) pair as two linked drag fields (f or ζ of a kind)."""
+    def _range_pair(self, name: str, speed: float) -> None:
+        """Setting ``name``'s (min, max) pair as two linked drag fields (f or ζ of a kind), in its
+        declared range and format."""
         st = SETTINGS[name]
         if st.shown is not None and not st.shown(self.viewer):
             return
         r = st.get(self.viewer)
         if r is None:
             return
-        changed, lo, hi = imgui.drag_float_range2(st.label, r[0], r[1], speed, st.lo, st.hi, fmt, fmt,
+        changed, lo, hi = imgui.drag_float_range2(st.label, r[0], r[1], speed, st.lo, st.hi, st.fmt, st.fmt,
                                                   imgui.SliderFlags_.always_clamp)
         self._rect(name.replace(":", " "))
         if changed:
@@ -247,13 +248,13 @@ class Panel:
         imgui.push_item_width(-110 * s)
 
         # --- statistics
-        key = (id(sim.tree), sim.season)
-        if key != self._text_key:  # the counts change only with the tree and the season
+        key = self._text_key  # the counts change only with the tree (itself, not its id) and the season
+        if key is None or key[0] is not sim.tree or key[1] != sim.season:
             st = v.stats()
             kinds = [k for k in KINDS if st[PLURAL[k]]]
             self._text = ("  ".join(f"{st[PLURAL[k]]:,} {PLURAL[k]}" for k in kinds),
                           f"{st['objects']:,} objects  {st['nodes']:,} nodes  {st['triangles']:,} tris")
-            self._text_key = key
+            self._text_key = (sim.tree, sim.season)
         imgui.text(self._text[0])
         imgui.text(self._text[1])
         now = time.perf_counter()
@@ -306,8 +307,8 @@ class Panel:
                 if imgui.radio_button("winter", self.edit_season == "winter"):
                     self.edit_season = "winter"
                 for kind in self._kinds:
-                    self._range_pair(f"f:{kind}", 0.01, "%.2f")
-                    self._range_pair(f"zeta:{kind}", 0.002, "%.3f")
+                    self._range_pair(f"f:{kind}", 0.01)
+                    self._range_pair(f"zeta:{kind}", 0.002)
             self.widget("ei_max")
             self.widget("physical_modes")
 

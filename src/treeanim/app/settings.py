@@ -16,7 +16,7 @@ import dataclasses
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from ..model.params import ModeRange
+from ..model.params import MODE_PARAMS, PARAMS, ModeRange
 from ..model.tree import KINDS
 from ..physics.oscillator import INTEGRATORS
 from ..render.scene import sun_angles, sun_direction
@@ -133,8 +133,14 @@ def _wind_preset(v, name) -> None:
     v.say(f"wind: {name}")
 
 
-def _set_ei_max(v, x) -> None:
-    v.sim.physics = dataclasses.replace(v.sim.physics, ei_max=float(x))
+def _physics(name: str) -> Setting:
+    """A slider of the physics setting ``name``: label, unit, format and scale from its
+    declaration (:data:`~treeanim.model.params.PARAMS`), set through ``dataclasses.replace``
+    (which checks it)."""
+    p = PARAMS[name]
+    return Setting(p.label or name, lambda v: getattr(v.sim.physics, name),
+                   lambda v, x: setattr(v.sim, "physics", dataclasses.replace(v.sim.physics, **{name: float(x)})),
+                   lo=p.lo, hi=p.hi, fmt=p.widget_format, log=p.log)
 
 
 def _set_sun(v, azimuth=None, elevation=None) -> None:
@@ -163,8 +169,9 @@ def _modes(what: str, kind: str) -> Setting:
         v.sim.physics = dataclasses.replace(p, **{v.panel.edit_season: dataclasses.replace(table(v), **{kind: new})})
 
     # the ranges are the preset's (saved with it) on either model; only the paper's uses them
-    return Setting(f"f {kind} (Hz)" if what == "f" else f"ζ {kind}", get, put, kind="custom",
-                   lo=0.05 if what == "f" else 0.0, hi=20.0 if what == "f" else 2.0, shown=_paper_model)
+    p = MODE_PARAMS[what]
+    return Setting(f"{p.label} {kind}" + (f" ({p.unit})" if p.unit else ""), get, put, kind="custom",
+                   lo=p.lo, hi=p.hi, fmt=p.fmt, shown=_paper_model)
 
 
 #: Every setting the panel shows or :meth:`Panel.apply` takes, by name.
@@ -186,7 +193,7 @@ SETTINGS: dict[str, Setting] = {
     "c3": _wind("c3", "c3 (vertical)", 0.0, 2.0, shown=_paper),
     "c4": _wind("c4", "c4 (lateral)", 0.0, 2.0, shown=_paper),
     # physics: the range is the preset's value ÷ or × EI_SPAN (Panel.tree_changed)
-    "ei_max": Setting("EI_max", lambda v: v.sim.physics.ei_max, _set_ei_max, fmt="%.3g N·m²", log=True),
+    "ei_max": _physics("ei_max"),
     **{f"{what}:{kind}": _modes(what, kind) for kind in KINDS for what in ("f", "zeta")},
     # simulation
     "time_scale": Setting("time scale", lambda v: v.time_scale, lambda v, x: setattr(v, "time_scale", float(x)),

@@ -343,10 +343,11 @@ class Viewer(ViewerInput):
 
     def stats(self) -> dict:
         """The tree's counts at the current season (cached)."""
-        key = (id(self.sim.tree), self.sim.season)
-        if key != self._stats_key:
+        key = self._stats_key
+        if key is None or key[0] is not self.sim.tree or key[1] != self.sim.season:
+            # (the key holds the tree itself: a freed tree's id() may come back as a new tree's)
             self._stats = self.sim.tree.stats(self.sim.season)
-            self._stats_key = key
+            self._stats_key = (self.sim.tree, self.sim.season)
         return self._stats
 
     # ------------------------------------------------------------------ pixels

@@ -17,12 +17,14 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import PresetError
+from .declare import SettingError, describe
 from .generate import BeamSpec, CrownSpec, GrassSpec, LaminaSpec, LeafSpec, LevelSpec, TreeSpec, generate
 from .look import Bark
-from .params import SCALAR_KEYS, SCALAR_MAX, ModeRange, PhysicsParams, SeasonModes
+from .params import PhysicsParams
 from .tree import BRANCH_SIDES, PLURAL, Tree, curve_bands
 
-#: Allowed ranges of numeric keys (inclusive); keys not listed must be finite and >= 0.
+#: Allowed ranges of the shape tables' numeric keys (inclusive); keys not listed must be finite
+#: and >= 0. The [physics] table's are declared with :class:`PhysicsParams` itself.
 BOUNDS: dict[str, tuple[float, float]] = {
     "segments": (1, 64),
     "length": (1e-4, 100.0),
@@ -71,8 +73,6 @@ BOUNDS: dict[str, tuple[float, float]] = {
     "lenticels": (0.0, 1.0),
     "tip_angle": (0.0, 180.0),
     "seed": (0, 2**63 - 1),
-    "f": (1e-3, 100.0),
-    "zeta": (0.0, 10.0),
 }
 
 #: Longest string value (a name, a description, a shape).
@@ -186,20 +186,15 @@ class _KeyProblem(Exception):
         self.key, self.expected = key, expected
 
 
-def _describe(value) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else text[:37] + "..."
-
-
 def _number(value, key: str, integer: bool):
     name = key.rsplit(".", 1)[-1]
     lo, hi = BOUNDS.get(name, (0.0, math.inf))
     kind = "an integer" if integer else "a number"
     ok_type = isinstance(value, int) if integer else isinstance(value, (int, float))
     if isinstance(value, bool) or not ok_type:
-        raise _KeyProblem(key, f"expected {kind} in [{lo:g}, {hi:g}], got {_describe(value)}")
+        raise _KeyProblem(key, f"expected {kind} in [{lo:g}, {hi:g}], got {describe(value)}")
     if not math.isfinite(value) or not lo <= value <= hi:
-        raise _KeyProblem(key, f"expected {kind} in [{lo:g}, {hi:g}], got {_describe(value)}")
+        raise _KeyProblem(key, f"expected {kind} in [{lo:g}, {hi:g}], got {describe(value)}")
     return int(value) if integer else float(value) + 0.0  # (-0.0 is 0)
 
 
@@ -207,7 +202,7 @@ def _coerce(value, default, key: str):
     """Check ``value`` against the type of ``default`` and the bounds of ``key``."""
     if isinstance(default, str):
         if not isinstance(value, str):
-            raise _KeyProblem(key, f"expected a string, got {_describe(value)}")
+            raise _KeyProblem(key, f"expected a string, got {describe(value)}")
         if len(value) > MAX_STRING:
             raise _KeyProblem(key, f"expected at most {MAX_STRING} characters, got {len(value):,}")
         return value
@@ -219,28 +214,28 @@ def _coerce(value, default, key: str):
             if not isinstance(value, list) or not 3 <= len(value) <= MAX_OUTLINE or not all(
                 isinstance(p, list) and len(p) == 2 for p in value
             ):
-                raise _KeyProblem(key, f"expected a list of 3 to {MAX_OUTLINE} [x, y] points, got {_describe(value)}")
+                raise _KeyProblem(key, f"expected a list of 3 to {MAX_OUTLINE} [x, y] points, got {describe(value)}")
             return tuple(tuple(_number(c, key, False) for c in p) for p in value)
         if name == "color":
             if not isinstance(value, list) or len(value) != 3:
-                raise _KeyProblem(key, f"expected an sRGB colour [r, g, b] in [0, 1], got {_describe(value)}")
+                raise _KeyProblem(key, f"expected an sRGB colour [r, g, b] in [0, 1], got {describe(value)}")
             return tuple(_number(c, key, False) for c in value)
         if name == "levels":
             if not isinstance(value, list):
-                raise _KeyProblem(key, f"expected a list of level numbers, got {_describe(value)}")
+                raise _KeyProblem(key, f"expected a list of level numbers, got {describe(value)}")
             return tuple(_number(v, key, True) for v in value)
         if not isinstance(value, list) or len(value) != 2:
-            raise _KeyProblem(key, f"expected a pair [min, max], got {_describe(value)}")
+            raise _KeyProblem(key, f"expected a pair [min, max], got {describe(value)}")
         lo, hi = (_number(v, key, False) for v in value)
         if lo > hi and name != "diameter":
-            raise _KeyProblem(key, f"expected [min, max] with min <= max, got {_describe(value)}")
+            raise _KeyProblem(key, f"expected [min, max] with min <= max, got {describe(value)}")
         return lo, hi
     raise AssertionError(f"no rule for {key}")  # pragma: no cover - programming error
 
 
 def _table(data, key: str) -> dict:
     if not isinstance(data, dict):
-        raise _KeyProblem(key, f"expected a table, got {_describe(data)}")
+        raise _KeyProblem(key, f"expected a table, got {describe(data)}")
     return data
 
 
@@ -258,42 +253,16 @@ def _dataclass_from(cls, data: dict, prefix: str, required=()):
     return cls(**{k: _coerce(v, getattr(defaults, k), prefix + k) for k, v in data.items()})
 
 
-def _modes(data, prefix: str) -> SeasonModes:
-    data = _table(data, prefix.rstrip("."))
-    out = {}
-    for kind, table in data.items():
-        if kind not in ("branch", "leaf", "blade"):
-            raise _KeyProblem(prefix + kind, "unknown key; expected branch, leaf or blade")
-        table = _table(table, prefix + kind)
-        for k in table:
-            if k not in ("f", "zeta"):
-                raise _KeyProblem(f"{prefix}{kind}.{k}", "unknown key; expected f or zeta")
-        for k in ("f", "zeta"):
-            if k not in table:
-                raise _KeyProblem(f"{prefix}{kind}.{k}", "missing; expected [min, max]")
-        f = _coerce(table["f"], (0.0, 0.0), f"{prefix}{kind}.f")
-        z = _coerce(table["zeta"], (0.0, 0.0), f"{prefix}{kind}.zeta")
-        out[kind] = ModeRange(f, z)
-    return SeasonModes(**out)
-
-
 def _physics(data) -> PhysicsParams:
+    """The [physics] table, checked by the declarations of :class:`PhysicsParams`."""
     data = _table(data, "physics")
-    for k in data:
-        if k not in (*SCALAR_KEYS, "summer", "winter"):
-            raise _KeyProblem(f"physics.{k}", f"unknown key; expected one of summer, winter, {', '.join(SCALAR_KEYS)}")
     for k in ("summer", "winter"):
         if k not in data:
             raise _KeyProblem(f"physics.{k}", "missing; expected a table of f and zeta ranges per kind")
-    scalars = {}
-    for k in SCALAR_KEYS:
-        if k in data:
-            v = data[k]
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 < v <= SCALAR_MAX[k]:
-                raise _KeyProblem(f"physics.{k}", f"expected a number in (0, {SCALAR_MAX[k]:g}], got {_describe(v)}")
-            scalars[k] = float(v)
-    return PhysicsParams(summer=_modes(data["summer"], "physics.summer."),
-                         winter=_modes(data["winter"], "physics.winter."), **scalars)
+    try:
+        return PhysicsParams(**data)
+    except SettingError as e:
+        raise _KeyProblem(e.key, e.problem) from None
 
 
 def _tree_spec(data: dict, source: str) -> TreeSpec:
@@ -319,7 +288,7 @@ def _tree_spec(data: dict, source: str) -> TreeSpec:
         levels = [_dataclass_from(LevelSpec, data["trunk"], "trunk.", required=("length", "diameter", "segments"))]
         raw_levels = data.get("levels", [])
         if not isinstance(raw_levels, list):
-            raise _KeyProblem("levels", f"expected an array of tables [[levels]], got {_describe(raw_levels)}")
+            raise _KeyProblem("levels", f"expected an array of tables [[levels]], got {describe(raw_levels)}")
         for i, lv in enumerate(raw_levels):
             levels.append(_dataclass_from(LevelSpec, lv, f"levels[{i}].", required=("count", "length")))
         kw["levels"] = tuple(levels)

@@ -7,7 +7,7 @@ import numbers
 
 import numpy as np
 
-from ..model.params import PhysicsParams, check_physics
+from ..model.params import MODE_PARAMS, PhysicsParams, check_physics
 from ..model.tree import KINDS, Tree
 from ..validate import finite_float, finite_vector3, float_within, object_index
 from .derived import Derived
@@ -28,9 +28,10 @@ MAX_PULL = 1e9
 #: coefficients (and no animation steps by years).
 MAX_STEP = 1e6
 #: The highest modal frequency (Hz) and damping ratio accepted: far beyond any plant (and any
-#: step rate), small enough that (2πf)² and 2ζω stay finite.
-MAX_FREQUENCY = 1e4
-MAX_ZETA = 1e3
+#: step rate), small enough that (2πf)² and 2ζω stay finite. Each object's modes are checked
+#: against the same declarations as a preset's ranges (:data:`~treeanim.model.params.MODE_PARAMS`).
+MAX_FREQUENCY = MODE_PARAMS["f"].hi
+MAX_ZETA = MODE_PARAMS["zeta"].hi
 
 class PaperSim(Derived, Stages, Pose, Snapshot):
     """A tree animated by wind and by pulls (Hu, Chiba & He 2012; docs/design.md §5–§8).
@@ -190,15 +191,12 @@ class PaperSim(Derived, Stages, Pose, Snapshot):
             raise ValueError(f"modes.f must have shape {shape}, got {fa.shape}")
         if za.shape != shape:
             raise ValueError(f"modes.zeta must have shape {shape}, got {za.shape}")
-        badf = ~((fa > 0) & (fa <= MAX_FREQUENCY))
-        if badf.any():
-            j, c = np.argwhere(badf)[0]
-            raise ValueError(f"modes.f must be > 0 and at most {MAX_FREQUENCY:g} Hz: object {j} mode {'uvw'[c]} "
-                             f"is {fa[j, c]!r}")
-        badz = ~((za >= 0) & (za <= MAX_ZETA))
-        if badz.any():
-            j, c = np.argwhere(badz)[0]
-            raise ValueError(f"modes.zeta must be in [0, {MAX_ZETA:g}]: object {j} mode {'uvw'[c]} is {za[j, c]!r}")
+        for name, a in (("f", fa), ("zeta", za)):
+            param = MODE_PARAMS[name]
+            bad = ~(((a > param.lo) if param.lo_open else (a >= param.lo)) & (a <= param.hi))
+            if bad.any():
+                j, c = np.argwhere(bad)[0]
+                raise ValueError(f"modes.{name} must be {param.expected}: object {j} mode {'uvw'[c]} is {a[j, c]!r}")
         f3, z3 = fa.T.copy(), za.T.copy()
         self._mode_snap = (f, z, fa.copy(), za.copy(), f3, z3)
         self._osc.clear()
@@ -426,8 +424,8 @@ class PaperSim(Derived, Stages, Pose, Snapshot):
         Raises
         ------
         ValueError
-            ``dt`` not in (0, MAX_STEP], invalid ``modes`` (f not in (0, MAX_FREQUENCY], ζ not
-            in [0, MAX_ZETA], wrong shape), or a wind whose ``sample`` returns the wrong
+            ``dt`` not in (0, MAX_STEP], invalid ``modes`` (f or ζ outside
+            :data:`~treeanim.model.params.MODE_PARAMS`, wrong shape), or a wind whose ``sample`` returns the wrong
             shape or non-finite values. The state is left unchanged.
         """
         dt = finite_float("dt", dt)
