@@ -5,6 +5,7 @@ durations in tests/durations.json (``pytest --store-durations`` writes them)."""
 from __future__ import annotations
 
 import json
+import resource
 import time
 from pathlib import Path
 
@@ -27,7 +28,7 @@ settings.load_profile("treeanim")
 #: Modules that draw through OpenGL (EGL offscreen), and those that open a window (Xvfb).
 GL_MODULES = {"test_render_gl", "test_render_look", "test_junctions", "test_offline", "test_examples"}
 WINDOW_MODULES = {"test_app", "test_render_window"}
-#: Each test's measured seconds (node id -> s), written by ``pytest --store-durations``.
+#: Each test's measured CPU seconds (node id -> s), written by ``pytest --store-durations``.
 DURATIONS = Path(__file__).with_name("durations.json")
 #: A test measured at this many seconds or more is marked ``slow``: ``-m "not slow"`` is the
 #: quick loop.
@@ -80,14 +81,22 @@ def pytest_report_collectionfinish(config, items):
         return f"{n} test(s) not in tests/durations.json (counted quick): measure them with --store-durations"
 
 
+def cpu_seconds() -> float:
+    """CPU seconds used so far by this process (all its threads, llvmpipe's included) and by its
+    children that have been waited for (the command-line tests' subprocesses)."""
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + children.ru_utime + children.ru_stime
+
+
 class DurationRecorder:
-    """The ``--store-durations`` plugin: each passing test's seconds, merged into
+    """The ``--store-durations`` plugin: each passing test's CPU seconds, merged into
     :data:`DURATIONS` at the end of the session.
 
     A test's seconds are its own setup, call and teardown, plus the setup of every shared
     (module- or session-scoped) fixture it uses, whichever test happened to create it: run on its
     own, or with the quick loop, a test pays for those. So the marks do not depend on the order
-    the tests ran in.
+    the tests ran in, and CPU time (not wall time) keeps them from depending on how busy the
+    machine was.
 
     Parameters
     ----------
@@ -112,12 +121,12 @@ class DurationRecorder:
     def pytest_fixture_setup(self, fixturedef, request):
         if fixturedef.scope == "function":
             return (yield)
-        t0 = time.perf_counter()
+        t0 = cpu_seconds()
         self._nested.append(0.0)
         try:
             return (yield)
         finally:
-            total = time.perf_counter() - t0
+            total = cpu_seconds() - t0
             own = total - self._nested.pop()
             if self._nested:
                 self._nested[-1] += total
@@ -125,14 +134,32 @@ class DurationRecorder:
             self.shared[key] = self.shared.get(key, 0.0) + own
             self._in_phase += own
 
+    def _timed(self, item):
+        """Add the CPU seconds of the phase this wraps to ``item``'s own."""
+        self._in_phase = 0.0
+        t0 = cpu_seconds()
+        try:
+            return (yield)
+        finally:
+            spent = cpu_seconds() - t0 - self._in_phase
+            self.own[item.nodeid] = self.own.get(item.nodeid, 0.0) + spent
+
+    @pytest.hookimpl(wrapper=True)
     def pytest_runtest_setup(self, item):
         params = item.callspec.params if hasattr(item, "callspec") else {}
         scopes = [node.nodeid for node in item.listchain()]
         self.uses[item.nodeid] = [(scope, name, repr(params.get(name))) for name in item.fixturenames for scope in scopes]
+        return (yield from self._timed(item))
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtest_call(self, item):
+        return (yield from self._timed(item))
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtest_teardown(self, item, nextitem):
+        return (yield from self._timed(item))
 
     def pytest_runtest_logreport(self, report):
-        self.own[report.nodeid] = self.own.get(report.nodeid, 0.0) + report.duration - self._in_phase
-        self._in_phase = 0.0
         if report.when == "call" and report.passed:
             self.passed.add(report.nodeid)
 
