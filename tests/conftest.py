@@ -1,58 +1,182 @@
-"""Shared fixtures: small hand-built trees and one EGL offscreen context per test session."""
+"""Shared fixtures (small hand-built trees, one EGL offscreen context per test session), the
+Hypothesis profile, and the markers: ``gl`` and ``window`` by module, ``slow`` from the measured
+durations in tests/durations.json (``pytest --store-durations`` writes them)."""
 
 from __future__ import annotations
 
+import json
+import resource
+import time
+from pathlib import Path
+
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 
 from treeanim.model.build import ObjectSpec, assemble
 from treeanim.model.tree import Lamina
+
+# --------------------------------------------------------------------------- hypothesis
+#: Every property test draws the same examples on every run (a seed from the test itself), has no
+#: deadline (a loaded 2-core machine made one flaky) and keeps no example database (no run
+#: replays another's failures). A test sets only its own ``max_examples``.
+settings.register_profile("treeanim", derandomize=True, deadline=None, max_examples=50, database=None,
+                          suppress_health_check=[HealthCheck.too_slow], print_blob=True)
+settings.load_profile("treeanim")
 
 # --------------------------------------------------------------------------- markers
 #: Modules that draw through OpenGL (EGL offscreen), and those that open a window (Xvfb).
 GL_MODULES = {"test_render_gl", "test_render_look", "test_render_uniforms", "test_junctions", "test_offline",
               "test_examples"}
 WINDOW_MODULES = {"test_app", "test_render_window"}
-#: Tests of a second or more on a 2-core machine (``pytest --durations``): ``-m "not slow"`` is
-#: the quick loop, under a minute; CI runs everything.
-SLOW = (
-    "test_simulation.py::test_free_decay_of_a_beam_has_the_set_f_and_zeta",
-    "test_simulation.py::test_release_in_the_u_w_plane_shows_both_frequencies",
-    "test_simulation.py::test_euler_agrees_with_exact_at_small_dt",
-    "test_simulation.py::test_modal_loads_settle_at_the_load_unit_static_gain",
-    "test_export.py",
-    "test_examples.py",
-    "test_readme.py::test_the_quick_readme_commands_run_as_typed",
-    "test_install.py",
-    "test_offline.py::test_bench_json_reports_every_preset",
-    "test_offline.py::test_a_write_that_fails_part_way",
-    "test_offline.py::test_ctrl_c_keeps_a_playable_video",
-    "test_offline.py::test_trace_after_release_has_the_beams_modal_frequencies",
-    "test_offline.py::test_png_frames_and_still_match_the_simulated_times",
-    "test_offline.py::test_render_mp4_reads_back_and_moves",
-    "test_offline.py::test_sigterm_during_a_render",
-    "test_presets_fuzz.py::test_a_mutated_preset",
-    "test_leaves.py",
-    "test_grass.py",
-    "test_simulation_hypothesis.py",
-    "test_wind_physical.py",
-    "test_junctions.py::test_collars_stay_welded_in_a_gale",
-    "test_species.py::test_crown_pruning_and_leaf_placement_keep_the_invariants",
-    "test_model.py::test_generator_invariants",
-    "test_app.py",
-)
+#: Each test's measured CPU seconds (node id -> s), written by ``pytest --store-durations``.
+DURATIONS = Path(__file__).with_name("durations.json")
+#: A test measured at this many CPU seconds or more is marked ``slow``: ``-m "not slow"`` is the
+#: quick loop (0.4 s keeps it under 30 s of CPU; at 1 s it took a minute).
+SLOW_SECONDS = 0.4
 
 
-def pytest_collection_modifyitems(items):
+def pytest_addoption(parser):
+    parser.addoption("--store-durations", action="store_true",
+                     help="measure every test that passes and merge its seconds into tests/durations.json, "
+                          "from which the 'slow' mark is derived")
+
+
+def pytest_configure(config):
+    if config.getoption("store_durations"):
+        config.pluginmanager.register(DurationRecorder(config.rootpath), "treeanim-durations")
+
+
+def load_durations(path: Path = DURATIONS) -> dict[str, float]:
+    """The measured seconds of each test, by node id.
+
+    Parameters
+    ----------
+    path : Path
+        A JSON object of node id -> seconds, as :class:`DurationRecorder` writes it.
+
+    Returns
+    -------
+    dict of str to float
+        Empty when the file does not exist.
+    """
+    return json.loads(path.read_text()) if path.is_file() else {}
+
+
+def pytest_collection_modifyitems(config, items):
+    durations = load_durations()
     for item in items:
         module = item.path.stem
         if module in GL_MODULES:
             item.add_marker(pytest.mark.gl)
         if module in WINDOW_MODULES:
             item.add_marker(pytest.mark.window)
-        nodeid = f"{item.path.name}::{item.name}"
-        if nodeid.startswith(SLOW):
+        if durations.get(item.nodeid, 0.0) >= SLOW_SECONDS:
             item.add_marker(pytest.mark.slow)
+
+
+def pytest_report_collectionfinish(config, items):
+    durations = load_durations()
+    n = sum(item.nodeid not in durations for item in items)
+    if n:
+        return f"{n} test(s) not in tests/durations.json (counted quick): measure them with --store-durations"
+
+
+def cpu_seconds() -> float:
+    """CPU seconds used so far by this process (all its threads, llvmpipe's included) and by its
+    children that have been waited for (the command-line tests' subprocesses)."""
+    children = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return time.process_time() + children.ru_utime + children.ru_stime
+
+
+class DurationRecorder:
+    """The ``--store-durations`` plugin: each passing test's CPU seconds, merged into
+    :data:`DURATIONS` at the end of the session.
+
+    A test's seconds are its own setup, call and teardown, plus the setup of every shared
+    (module- or session-scoped) fixture it uses, whichever test happened to create it: run on its
+    own, or with the quick loop, a test pays for those. So the marks do not depend on the order
+    the tests ran in, and CPU time (not wall time) keeps them from depending on how busy the
+    machine was.
+
+    Parameters
+    ----------
+    rootpath : Path
+        The rootdir, which node ids are relative to.
+    """
+
+    def __init__(self, rootpath: Path) -> None:
+        self.rootpath = rootpath
+        self.shared: dict[tuple, float] = {}  # (scope node id, fixture, param) -> seconds of its own setup
+        self.own: dict[str, float] = {}
+        self.uses: dict[str, list[tuple]] = {}
+        self.passed: set[str] = set()
+        self.collected: set[str] = set()
+        self._nested: list[float] = []  # shared setups in progress: seconds of the shared ones inside each
+        self._in_phase = 0.0  # shared setup seconds within the current phase (not the test's own)
+
+    def pytest_itemcollected(self, item):
+        self.collected.add(item.nodeid)
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_fixture_setup(self, fixturedef, request):
+        if fixturedef.scope == "function":
+            return (yield)
+        t0 = cpu_seconds()
+        self._nested.append(0.0)
+        try:
+            return (yield)
+        finally:
+            total = cpu_seconds() - t0
+            own = total - self._nested.pop()
+            if self._nested:
+                self._nested[-1] += total
+            key = (request.node.nodeid, fixturedef.argname, repr(getattr(request, "param", None)))
+            self.shared[key] = self.shared.get(key, 0.0) + own
+            self._in_phase += own
+
+    def _timed(self, item):
+        """Add the CPU seconds of the phase this wraps to ``item``'s own."""
+        self._in_phase = 0.0
+        t0 = cpu_seconds()
+        try:
+            return (yield)
+        finally:
+            spent = cpu_seconds() - t0 - self._in_phase
+            self.own[item.nodeid] = self.own.get(item.nodeid, 0.0) + spent
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtest_setup(self, item):
+        params = item.callspec.params if hasattr(item, "callspec") else {}
+        scopes = [node.nodeid for node in item.listchain()]
+        self.uses[item.nodeid] = [(scope, name, repr(params.get(name))) for name in item.fixturenames for scope in scopes]
+        return (yield from self._timed(item))
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtest_call(self, item):
+        return (yield from self._timed(item))
+
+    @pytest.hookimpl(wrapper=True)
+    def pytest_runtest_teardown(self, item, nextitem):
+        return (yield from self._timed(item))
+
+    def pytest_runtest_logreport(self, report):
+        if report.when == "call" and report.passed:
+            self.passed.add(report.nodeid)
+
+    def pytest_sessionfinish(self, session):
+        data = load_durations()
+        files = {nodeid.split("::")[0] for nodeid in self.collected}
+        data = {nodeid: s for nodeid, s in data.items()
+                if (self.rootpath / nodeid.split("::")[0]).is_file()
+                and (nodeid.split("::")[0] not in files or nodeid in self.collected)}
+        for nodeid in self.passed:
+            shared = sum(self.shared.get(key, 0.0) for key in self.uses.get(nodeid, ()))
+            data[nodeid] = round(max(self.own[nodeid], 0.0) + shared, 2)
+        DURATIONS.write_text(json.dumps(dict(sorted(data.items())), indent=0) + "\n")
+
+    def pytest_terminal_summary(self, terminalreporter):
+        terminalreporter.write_line(f"stored the durations of {len(self.passed)} test(s) in {DURATIONS}")
 
 
 def rot(axis, angle):

@@ -50,15 +50,11 @@ def test_installed_wheel_finds_assets(tmp_path):
 
 
 def test_scripts_view_runs_as_typed_from_another_folder_without_reinstalling(tmp_path):
-    """The README's first command, with an installed .venv: it does not reinstall (no pip run,
-    well under the ~5 s a reinstall took) and runs treeanim in the caller's folder, where a
-    command's output lands."""
-    import time
-
-    t0 = time.perf_counter()
+    """The README's first command, with an installed .venv: it does not reinstall (no pip run:
+    scripts/view says "Installing" before it runs pip) and runs treeanim in the caller's folder,
+    where a command's output lands."""
     res = subprocess.run([str(ROOT / "scripts" / "view"), "render", "beam", "--seconds", "0.1", "--size", "32x24",
                           "--out", "still.png", "--quiet"], cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert res.returncode == 0, res.stderr
     assert (tmp_path / "still.png").is_file(), "the output lands in the caller's folder"
     assert "Installing" not in res.stdout + res.stderr
-    assert time.perf_counter() - t0 < 30.0

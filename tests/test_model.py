@@ -183,7 +183,7 @@ level = st.builds(
 )
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=30)
 @given(
     trunk=st.builds(LevelSpec, segments=st.integers(1, 8), length=st.floats(0.5, 5.0),
                     diameter=st.floats(0.05, 0.5), taper=st.floats(0, 0.9), curvature=st.floats(-30, 30),

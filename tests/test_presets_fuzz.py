@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import tomlkit
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import treeanim as ta
@@ -59,17 +59,19 @@ def mutated(path, how, value) -> dict:
     return doc
 
 
-@settings(max_examples=200, deadline=10_000, suppress_health_check=[HealthCheck.too_slow], derandomize=True)
+@settings(max_examples=200)
 @given(path=st.sampled_from(PATHS), how=st.sampled_from(["replace", "replace", "replace", "delete", "unknown"]),
        value=values)
-def test_a_mutated_preset_loads_or_is_refused_in_one_line(tmp_path_factory, path, how, value):
+def loads_or_is_refused_in_one_line(tmp_path_factory, path, how, value):
+    """A preset with one key mutated loads and simulates, or is refused in one line."""
     target = tmp_path_factory.mktemp("fuzz") / "mutated.toml"
     target.write_text(tomlkit.dumps(mutated(path, how, value)), encoding="utf-8")  # the save's writer
     try:
         tree = ta.load_tree(target)
     except PresetError as e:
         msg = str(e)
-        assert msg.startswith(f"{target}: ") and "\n" not in msg and len(msg) < 400 + len(str(target)), msg[:500]
+        # (600: an unknown key in [physics] lists the table's 24 known keys, 420 characters)
+        assert msg.startswith(f"{target}: ") and "\n" not in msg and len(msg) < 600 + len(str(target)), msg[:700]
         return
     try:
         sim = ta.Simulation(tree, wind=ta.WindField(speed=12.0))
@@ -81,8 +83,9 @@ def test_a_mutated_preset_loads_or_is_refused_in_one_line(tmp_path_factory, path
     assert np.isfinite(sim.positions).all()
 
 
-def test_the_fuzzing_stayed_within_2_gb():
-    """(Runs after the fuzz test in this module.) The process's peak memory."""
+def test_a_mutated_preset_loads_or_is_refused_in_one_line(tmp_path_factory):
+    """The fuzzing, then the process's peak memory: it stayed within 2 GB."""
+    loads_or_is_refused_in_one_line(tmp_path_factory)
     peak_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
     assert peak_kb < 2 * 1024 * 1024, f"peak {peak_kb / 1024:.0f} MB"
 

@@ -7,7 +7,7 @@ rotations stay rotations, and the same inputs give the same result.
 import functools
 
 import numpy as np
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import treeanim as ta
@@ -45,7 +45,7 @@ wind_args = dict(
 )
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=60)
 @given(**wind_args)
 def test_gale_keeps_lengths_and_stays_finite(name, azimuth, speed, turbulence, wind_seed, seed, dts, integrator,
                                              coupling, season):
@@ -58,7 +58,7 @@ def test_gale_keeps_lengths_and_stays_finite(name, azimuth, speed, turbulence, w
     check_pose(sim, within, rest_len)
 
 
-@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=30)
 @given(name=st.sampled_from(PRESETS[:4]), obj_frac=st.floats(0, 1), force=st.lists(st.floats(-1e6, 1e6), min_size=3,
                                                                                       max_size=3),
        hold=st.integers(1, 4), after=st.lists(st.sampled_from([1e-3, 1 / 60, 2.0]), min_size=1, max_size=3))
@@ -76,7 +76,7 @@ def test_any_pull_and_release_keeps_lengths(name, obj_frac, force, hold, after):
     check_pose(sim, within, rest_len)
 
 
-@settings(max_examples=6, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=6)
 @given(name=st.sampled_from(PRESETS[:4]), seed=st.integers(0, 1000), speed=st.floats(0, 40),
        steps=st.integers(1, 5))
 def test_same_inputs_same_result(name, seed, speed, steps):
@@ -91,7 +91,7 @@ def test_same_inputs_same_result(name, seed, speed, steps):
 
 
 # ---------------------------------------------------------------------------- the tree model
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=25)
 @given(name=st.sampled_from(PRESETS[:4]), azimuth=st.floats(0, 2 * np.pi), speed=st.floats(0, 60),
        seed=st.integers(0, 2**16), dts=st.lists(st.sampled_from([1e-3, 1 / 240, 1 / 60, 1 / 10, 0.5, 4.0]),
                                                 min_size=1, max_size=5),

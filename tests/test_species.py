@@ -211,7 +211,7 @@ def test_the_large_cherry_trunk_meets_its_limbs_without_a_collar_step(trees):
 
 
 # ---------------------------------------------------------------------------- generator
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=25)
 @given(
     radius=st.floats(0.5, 3.0), height=st.tuples(st.floats(0.0, 1.0), st.floats(2.0, 5.0)),
     min_scale=st.floats(0.2, 1.0), count=st.floats(1.0, 3.0), attach=st.floats(0.0, 1.0),

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy import stats
 from scipy.ndimage import map_coordinates
@@ -591,7 +591,7 @@ _SHARED = WindField(seed=12)
 _finite_float = st.floats(allow_nan=False, allow_infinity=False)
 
 
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=200)
 @given(
     direction=st.tuples(_finite_float, _finite_float, _finite_float),
     speed=st.floats(0.0, 60.0),
@@ -614,7 +614,7 @@ def test_any_finite_input_gives_a_finite_field(direction, speed, points, t):
         assert not u.any()
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60)
 @given(
     c3=st.floats(0.0, 1000.0),
     c4=st.floats(0.0, 1000.0),

@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import signal
 
@@ -304,7 +304,7 @@ _SHARED = WindField(seed=12)
 _f = st.floats(allow_nan=False, allow_infinity=False)
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=150)
 @given(
     speed=st.floats(0.0, 1000.0),
     turbulence=st.floats(0.0, 1.0),
