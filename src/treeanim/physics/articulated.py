@@ -240,7 +240,7 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
     UD = np.empty((6, 3))
     pa = np.empty(6)
     wk = np.empty((3, 3, 3))
-    Ib, Cr, mom = np.empty((6, 6)), np.empty((6, 6)), np.empty(6)
+    Ib, mom = np.empty((6, 6)), np.empty(6)
     # --- 1. each body's own inertia (plus the implicit point terms) and bias force
     for b in range(B):
         m = m0[b]
@@ -276,7 +276,7 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
         for i in range(3):
             for j in range(3):
                 IA[b, 3 + i, j] = IA[b, j, 3 + i]
-        _add_bias(h, b, kap, Om, V, IA, pA, Ib, Cr, mom)
+        _add_bias(h, b, kap, Om, V, IA, pA, Ib, mom)
     # --- 2. inward: articulated inertias and bias forces, the joints' terms folded in
     for b in range(B - 1, -1, -1):
         p = parent[b]
@@ -413,19 +413,26 @@ def _add_skew(M, r, c, s, x, y, z):
     M[r + 2, c + 1] += s * x
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _add_cross(M, r, c, s, x, y, z, A, ra, ca):
+    """M[r:r+3, c:c+3] += s·[(x, y, z)]×·A[ra:ra+3, ca:ca+3], column by column."""
+    for j in range(3):
+        a0, a1, a2 = A[ra, ca + j], A[ra + 1, ca + j], A[ra + 2, ca + j]
+        M[r, c + j] += s * (y * a2 - z * a1)
+        M[r + 1, c + j] += s * (z * a0 - x * a2)
+        M[r + 2, c + j] += s * (x * a1 - y * a0)
+
+
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _add_bias(h, b, kap, Om, V, IA, pA, Ib, Cr, mom):
+def _add_bias(h, b, kap, Om, V, IA, pA, Ib, mom):
     """The body's velocity-product force f = ν ×* Iν (gyroscopic and centrifugal: ν = (ω, v)
     its spatial velocity, I its spatial inertia about its joint, IA[b] − κ[b] here) taken
     linearly implicitly: pA += h·f and IA += h·∂f/∂ν, ∂f/∂ν = crf(ν)·I + [[−[n]×, −[p]×],
-    [−[p]×, 0]] with (n, p) = Iν. So a twig whirling on its joint keeps its angular momentum,
-    not its angular velocity (without it a scanned twig under heavy leaves whirled at 170 rad/s
-    after a hard release and gained up to 28 % of the tree's energy in a 1/120 s step)."""
+    [−[p]×, 0]] with (n, p) = Iν: a twig whirling on its joint keeps its angular momentum, not
+    its angular velocity (docs/design.md §12)."""
     wx, wy, wz = Om[b, 0], Om[b, 1], Om[b, 2]
     vx, vy, vz = V[b, 0], V[b, 1], V[b, 2]
-    # a whirl the step resolves (|ω|h ≲ 1) keeps its velocity products; one it cannot is left
-    # without them, by (1 + (|ω|h)⁴)⁻¹: over a turn of a radian or more in one step the
-    # linearisation overshoots and feeds the whirl (a scanned twig at 1/10 s)
+    # weighted by (1 + (|ω|h)⁴)⁻¹: a turn of a radian or more a step the linearisation overshoots
     x2 = h * h * (wx * wx + wy * wy + wz * wz)
     h = h / (1.0 + x2 * x2)
     nu = (wx, wy, wz, vx, vy, vz)
@@ -441,17 +448,11 @@ def _add_bias(h, b, kap, Om, V, IA, pA, Ib, Cr, mom):
     for i in range(3):
         pA[b, i] += h * (a[i] + c[i])
         pA[b, 3 + i] += h * d[i]
-    # crf(ν) = [[ω×, v×], [0, ω×]]
-    Cr[:, :] = 0.0
-    _add_skew(Cr, 0, 0, 1.0, wx, wy, wz)
-    _add_skew(Cr, 3, 3, 1.0, wx, wy, wz)
-    _add_skew(Cr, 0, 3, 1.0, vx, vy, vz)
-    for i in range(6):
-        for j in range(6):
-            s = 0.0
-            for k in range(6):
-                s += Cr[i, k] * Ib[k, j]
-            IA[b, i, j] += h * s
+    # crf(ν)·I, crf(ν) = [[ω×, v×], [0, ω×]], block by block
+    for c in (0, 3):
+        _add_cross(IA[b], 0, c, h, wx, wy, wz, Ib, 0, c)
+        _add_cross(IA[b], 0, c, h, vx, vy, vz, Ib, 3, c)
+        _add_cross(IA[b], 3, c, h, wx, wy, wz, Ib, 3, c)
     _add_skew(IA[b], 0, 0, -h, n0, n1, n2)
     _add_skew(IA[b], 0, 3, -h, p0, p1, p2)
     _add_skew(IA[b], 3, 0, -h, p0, p1, p2)
