@@ -1,8 +1,8 @@
-"""Orbit / pan / zoom camera (pyrr matrices), and the one framing of a tree that the viewer
+"""Orbit / pan / zoom camera (row-vector matrices), and the one framing of a tree that the viewer
 (F, and every new tree) and the offline commands share (:func:`framed_camera`,
 :meth:`OrbitCamera.frame_points`).
 
-Matrices are returned in pyrr's layout (row-vector convention: ``p_clip = p @ view @ proj``),
+Matrices are returned in the row-vector layout (``p_clip = p @ view @ proj``),
 whose bytes are exactly what an OpenGL ``mat4`` uniform expects; the mathematical (column-
 vector) matrix is their transpose.
 
@@ -21,7 +21,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from pyrr import matrix44
 
 Bounds = tuple[tuple[float, float, float], tuple[float, float, float]]
 
@@ -111,22 +110,34 @@ class OrbitCamera:
 
     # ------------------------------------------------------------------ matrices
     def view_matrix(self) -> np.ndarray:
-        """(4, 4) float32 view matrix (pyrr layout)."""
-        return matrix44.create_look_at(self.eye, self.target, np.array([0.0, 1.0, 0.0]), dtype=np.float32)
+        """(4, 4) float32 view matrix (row-vector layout): the eye at the origin looking down −z,
+        y up."""
+        eye = np.asarray(self.eye, float)
+        forward = _unit(np.asarray(self.target, float) - eye)
+        side = _unit(np.cross(forward, (0.0, 1.0, 0.0)))
+        up = _unit(np.cross(side, forward))
+        m = np.eye(4)
+        m[:3, 0], m[:3, 1], m[:3, 2] = side, up, -forward
+        m[3, :3] = -side @ eye, -up @ eye, forward @ eye
+        return m.astype(np.float32)
 
     def projection_matrix(self, aspect: float) -> np.ndarray:
-        """(4, 4) float32 perspective projection for ``aspect`` = width / height (pyrr layout)."""
+        """(4, 4) float32 perspective projection for ``aspect`` = width / height (row-vector
+        layout, OpenGL's clip space)."""
         near, far = self.clip_planes()
-        proj = matrix44.create_perspective_projection(self.fov_y, max(float(aspect), 1e-6), near, far,
-                                                      dtype=np.float32)
+        f = 1.0 / np.tan(np.radians(self.fov_y) / 2.0)
+        proj = np.zeros((4, 4), np.float32)
+        proj[0, 0], proj[1, 1] = f / max(float(aspect), 1e-6), f
+        proj[2, 2], proj[2, 3] = -(far + near) / (far - near), -1.0
+        proj[3, 2] = -2.0 * far * near / (far - near)
         # The lens shift: clip x, y += shift · w_clip (w_clip = −z_eye), so NDC moves by shift.
         proj[2, :2] -= self.shift.astype(np.float32)
         return proj
 
     def view_projection(self, width: int, height: int) -> np.ndarray:
-        """(4, 4) float32 view·projection for a ``width`` × ``height`` viewport (pyrr layout),
-        read-only: kept until the camera or the viewport changes (pyrr takes ~0.2 ms to build
-        it, and most of the viewer's frames reuse it)."""
+        """(4, 4) float32 view·projection for a ``width`` × ``height`` viewport (row-vector
+        layout), read-only: kept until the camera or the viewport changes (most of the
+        viewer's frames reuse it)."""
         key = (self.target.tobytes(), self.shift.tobytes(), self.distance, self.azimuth, self.elevation, self.fov_y,
                self.near, self.far, width, height)
         if key != self._vp_key:
@@ -241,6 +252,10 @@ class OrbitCamera:
 
 
 # ---------------------------------------------------------------------------- framing a tree
+def _unit(v: np.ndarray) -> np.ndarray:
+    return v / np.linalg.norm(v)
+
+
 def framing_elevation(tree) -> float:
     """:data:`FLAT_ELEVATION` for a flat scene (height under 0.3 of its width: grass),
     else :data:`TREE_ELEVATION` (degrees)."""
