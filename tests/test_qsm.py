@@ -149,11 +149,35 @@ def test_refuses_a_non_finite_number(tmp_path, col, value, what):
     refuse(tmp_path, t, rf"row 3 .*{what}; expected a finite number")
 
 
-@pytest.mark.parametrize("col,value,what", [(0, 0.0, "radius is 0.0"), (1, -0.5, "length is -0.5")])
-def test_refuses_a_non_positive_radius_or_length(tmp_path, col, value, what):
+@pytest.mark.parametrize("col,value,what", [(0, 0.0, "radius is 0"), (1, -0.5, "length is -0.5"),
+                                            (0, 1e300, "radius is 1e\\+300"), (0, 5e-5, "radius is 5e-05"),
+                                            (1, 1e3, "length is 1000")])
+def test_refuses_a_radius_or_length_no_tree_has(tmp_path, col, value, what):
+    """Issue 31: a radius of 1e300 gave an OverflowError traceback, subnormal radii an
+    uncaught ValueError from deep inside."""
     t = small_table()
     t[1, col] = value
-    refuse(tmp_path, t, rf"row 2 .*{what}; expected a positive number")
+    refuse(tmp_path, t, rf"row 2 .*{what}; expected 0.0001 to (10|150) m")
+
+
+def test_refuses_a_table_scaled_far_beyond_a_tree(tmp_path):
+    """Issue 31: every size times 1e150 gave 'repeats may not contain negative values'."""
+    t = small_table()
+    t[:, :5] *= 1e150
+    refuse(tmp_path, t, r"row 1 .*radius is .*; expected 0.0001 to 10 m")
+
+
+def test_refuses_a_start_far_from_the_origin_but_loads_a_georeferenced_scan(tmp_path):
+    """Issue 31: a start coordinate of 1e308 overflowed. A scan in UTM coordinates (hundreds
+    of kilometres east, thousands north) is a tree as any other."""
+    t = small_table()
+    t[2, 3] = 1e308
+    refuse(tmp_path, t, r"row 3 .*the start \(.*1e\+308.*\) is more than 1e\+07 m from the origin")
+    t = small_table()
+    t[:, 2:4] += (6.0e5, 5.7e6)
+    path = tmp_path / "utm.txt"
+    write_table(path, t)
+    assert load_qsm(path).n_objects == build_tree(small_table()).n_objects
 
 
 def test_refuses_an_empty_table(tmp_path):
@@ -186,7 +210,7 @@ def test_the_command_line_reads_a_qsm_and_reports_a_bad_one_in_one_line(tmp_path
     write_table(tmp_path / "bad.txt", bad)
     assert main(["info", str(tmp_path / "bad.txt")]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.count("\n") == 0 and "row 3" in err and "radius is -1.0" in err
+    assert err.count("\n") == 0 and "row 3" in err and "radius is -1;" in err
     assert main(["info", "small_cherry", "--leaves", "cherry"]) == 2  # a preset has its own leaves
     assert "--leaves is for TreeQSM models" in capsys.readouterr().err
     assert main(["info", str(ASSET), "--leaves", "cherry:many"]) == 2
@@ -368,8 +392,8 @@ def test_refuses_a_zero_length_segment(tmp_path, where):
         t[1, 2:5] = t[0, 2:5]  # row 2 starts where row 1 starts
         refuse(tmp_path, t, r"row 1 .*a zero-length segment")
     else:
-        t[2, 1] = 1e-12  # the stem's last cylinder (too short for the text table's 6 decimals)
-        with pytest.raises(QSMError, match=r"^stem: row 3: a zero-length segment"):
+        t[2, 1] = 1e-12  # the stem's last cylinder: shorter than any tree's
+        with pytest.raises(QSMError, match=r"^stem: row 3: length is 1e-12; expected 0.0001 to 150 m"):
             build_tree(t, name="stem")
 
 

@@ -16,8 +16,16 @@ from ..tree import Tree
 from .leaves import DEFAULT_PRESET, _leaf_rule, _preset_spec, _scaled_ei_max, parse_leaves
 from .read import COLUMNS, MAX_CYLINDERS, QSM_SUFFIXES, WIDTHS, _problem, _read_text, _widths_text, read_table
 
-
 # ---------------------------------------------------------------------------- checking
+#: A cylinder's radius and length (m): from a tenth of a millimetre (TreeQSM resolves a few
+#: millimetres) to the largest trunks and the tallest trees' longest pieces.
+MIN_RADIUS, MAX_RADIUS, MAX_LENGTH = 1e-4, 10.0, 150.0
+#: How far from the origin a cylinder may start (m): georeferenced scans (UTM) lie within it.
+MAX_COORDINATE = 1e7
+#: How far apart a tree's cylinders may start (m).
+MAX_SPAN = 1000.0
+
+
 def _jump(pointer: np.ndarray, steps: int) -> np.ndarray:
     """Follow ``pointer`` (a fixed point at each root) ``2**steps`` times, by doubling."""
     p = pointer.copy()
@@ -54,10 +62,18 @@ def _check(table: np.ndarray, path, lines) -> tuple[np.ndarray, ...]:
     if bad.any():
         k, c = np.argwhere(bad)[0]
         raise _problem(path, k, f"{COLUMNS[c]} is {float(table[k, c])!r}; expected a finite number", lines)
-    for c, what in ((0, "radius"), (1, "length")):
-        k = np.flatnonzero(table[:, c] <= 0)
+    for c, what, lo, hi in ((0, "radius", MIN_RADIUS, MAX_RADIUS), (1, "length", MIN_RADIUS, MAX_LENGTH)):
+        k = np.flatnonzero(~((table[:, c] >= lo) & (table[:, c] <= hi)))
         if len(k):
-            raise _problem(path, k[0], f"{what} is {float(table[k[0], c])!r}; expected a positive number of metres", lines)
+            raise _problem(path, k[0], f"{what} is {float(table[k[0], c]):.6g}; expected {lo:g} to {hi:g} m",
+                           lines)
+    k = np.flatnonzero(np.abs(table[:, 2:5]).max(axis=1) > MAX_COORDINATE)
+    if len(k):
+        raise _problem(path, k[0], f"the start ({', '.join(f'{v:.6g}' for v in table[k[0], 2:5])}) is more than "
+                                   f"{MAX_COORDINATE:g} m from the origin", lines)
+    span = float(np.max(np.ptp(table[:, 2:5], axis=0)))
+    if span > MAX_SPAN:
+        raise QSMError(f"{path}: the cylinders' starts span {span:.6g} m; one tree spans at most {MAX_SPAN:g} m")
     axis = table[:, 5:8]
     norm = np.linalg.norm(axis, axis=1)
     k = np.flatnonzero(norm < 1e-9)
