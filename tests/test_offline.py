@@ -398,6 +398,19 @@ def test_standard_output_on_a_full_disk_is_one_line_and_exit_1():
     assert res.stderr.strip().splitlines() == ["treeanim: error: No space left on device"], res.stderr
 
 
+def test_an_ascii_terminal_or_a_closed_standard_output_is_no_traceback():
+    """Issue 31: with PYTHONIOENCODING=ascii `info` raised UnicodeEncodeError after its work
+    (its table has en dashes); `treeanim list >&-` raised AttributeError."""
+    env = dict(os.environ, PYTHONIOENCODING="ascii")
+    res = subprocess.run([sys.executable, "-m", "treeanim", "info", "beam"], capture_output=True, text=True,
+                         env=env, timeout=120)
+    assert res.returncode == 0 and "Traceback" not in res.stderr, res.stderr
+    assert "\\u2013" in res.stdout  # the en dash, escaped
+    res = subprocess.run([sys.executable, "-m", "treeanim", "list"], stderr=subprocess.PIPE, text=True,
+                         preexec_fn=lambda: os.close(1), timeout=120)
+    assert res.returncode == 0 and res.stderr == "", res.stderr
+
+
 def test_ctrl_c_while_the_command_line_starts_is_a_quiet_exit_130(monkeypatch, capsys):
     def interrupted():
         raise KeyboardInterrupt

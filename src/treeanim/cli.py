@@ -410,6 +410,7 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``treeanim`` console script."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _terminated)  # `kill`: unwind, so temporary files are removed
+    _plain_streams()
     try:  # building the parser imports the wind's presets: Ctrl-C may come that early
         parser = build_parser()
         args = parser.parse_args(argv)
@@ -433,6 +434,18 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("treeanim: interrupted", file=sys.stderr)
         return 130
+
+
+def _plain_streams() -> None:
+    """Standard output and error that never fail on a character: a closed one (`treeanim list
+    >&-`) writes nowhere, one that cannot encode a character (`PYTHONIOENCODING=ascii`) writes
+    it as an escape instead of raising after the work is done."""
+    for name in ("stdout", "stderr"):
+        stream = getattr(sys, name)
+        if stream is None:
+            setattr(sys, name, open(os.devnull, "w", encoding="utf-8"))
+        elif hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
 
 
 def _terminated(signum, frame) -> None:
