@@ -409,3 +409,24 @@ def test_a_stiff_stub_twig_is_just_stiff_in_either_model():
         for _ in range(30):
             sim.step(1 / 60)
         assert np.isfinite(sim.positions).all()
+
+
+def test_a_chain_of_five_thousand_nested_branches_has_finite_modes(tmp_path):
+    """Issue 31: 5,000 nested one-cylinder branches gave the tip NaN modes (one running sum
+    over the whole tree lost the small outer branches to round-off): `info` printed nan–nan.
+    The tip of the deep chain sways as the tip of a short one does."""
+    def tip_modes(n):
+        t = np.zeros((n, 14))
+        t[:, 0], t[:, 1] = 0.01, 0.05
+        t[:, 4] = np.arange(n) * 0.05  # straight up, z
+        t[:, 7] = 1.0
+        t[:, 8] = np.arange(n)  # each row's parent is the row before (1-based; the first: 0)
+        t[:, 10] = np.arange(1, n + 1)  # each its own branch
+        t[:, 11] = np.arange(n)
+        path = tmp_path / f"chain{n}.txt"
+        write_table(path, t)
+        return ta.Simulation(load_qsm(path), model="paper").modes
+
+    deep, short = tip_modes(5000), tip_modes(50)
+    assert np.isfinite(deep.f).all() and np.isfinite(deep.zeta).all()
+    np.testing.assert_allclose(deep.f[-1], short.f[-1], rtol=1e-3)

@@ -33,6 +33,7 @@ import numpy as np
 from ..model.geometry import segment_lengths
 from ..model.params import PhysicsParams
 from ..model.tree import Tree
+from .compiled import njit
 from .modal import ModalParameters, subtree_sums
 
 __all__ = ["MODAL_MODELS", "MIN_ELEMENTS", "QUASI_STATIC_F", "MAX_PHYSICAL_F", "U_REF", "branch_modes", "physical_modes", "subtree_sums"]
@@ -224,17 +225,27 @@ def branch_modes(tree: Tree, youngs_modulus: float, mass: np.ndarray, air: np.nd
 
 def _segmented_cumsum(v: np.ndarray, first: np.ndarray, count: np.ndarray) -> np.ndarray:
     """Cumulative sums of ``v`` restarting at each run (runs ``first[i] : first[i] + count[i]``
-    tile ``v``)."""
-    c = np.cumsum(v)
-    offset = c[first] - v[first]
-    return c - np.repeat(offset, count)
+    tile ``v``), each run summed on its own: one running sum minus its value at a run's start
+    lost a deep tree's small outer runs to the round-off of the large inner ones (NaN modes for
+    the tip of a 5,000-deep chain)."""
+    return _runs(np.ascontiguousarray(v, float), np.asarray(first, np.int64), np.asarray(count, np.int64), False)
 
 
 def _segmented_suffix(v: np.ndarray, first: np.ndarray, count: np.ndarray) -> np.ndarray:
     """Sums of ``v`` from each entry to the end of its run (inclusive)."""
-    c = np.cumsum(v)
-    total = c[first + count - 1]
-    return np.repeat(total, count) - c + v
+    return _runs(np.ascontiguousarray(v, float), np.asarray(first, np.int64), np.asarray(count, np.int64), True)
+
+
+@njit(cache=True)
+def _runs(v, first, count, suffix):
+    out = np.empty_like(v)
+    for i in range(first.shape[0]):
+        s = 0.0
+        for j in range(count[i]):
+            k = first[i] + count[i] - 1 - j if suffix else first[i] + j
+            s += v[k]
+            out[k] = s
+    return out
 
 
 def physical_modes(tree: Tree, params: PhysicsParams, paper: ModalParameters, mass: np.ndarray,
