@@ -325,7 +325,8 @@ BAD = [
     (["render", "small_cherry", "--out", "c.mp4", "--size=-160x120"], "WIDTHxHEIGHT"),
     (["render", "small_cherry", "--out", "c.mp4", "--size", "160"], "WIDTHxHEIGHT"),
     (["render", "small_cherry", "--out", "c.mp4", "--size", "160x120x3"], "WIDTHxHEIGHT"),
-    (["render", "small_cherry", "--out", "c.mp4", "--distance", "0"], "positive"),
+    (["render", "small_cherry", "--out", "c.mp4", "--distance", "0"], "in [0.01, 100000]"),
+    (["render", "beam", "--out", "c.png", "--distance", "1e-320"], "in [0.01, 100000]"),  # was an empty sky
     (["render", "oak", "--out", "c.mp4"], "unknown preset"),
     (["trace", "beam", "--object", "1", "--pull", "1,0,0", "--out", "t.csv"], "objects 0 to 0"),
     (["trace", "beam", "--object", "-1", "--pull", "1,0,0", "--out", "t.csv"], "objects 0 to 0"),

@@ -334,7 +334,7 @@ def build_parser() -> argparse.ArgumentParser:
                    "to right (default 0)")
     p.add_argument("--elevation", type=opt.finite, default=None, metavar="DEG",
                    help="camera height angle above the horizon (default 8, or 25 for flat scenes like grass)")
-    p.add_argument("--distance", type=opt.positive(float), default=None, metavar="METRES",
+    p.add_argument("--distance", type=opt.number(float, 0.01, 1e5, lo_open=False), default=None, metavar="METRES",
                    help="camera distance to the tree's centre (default: framed on the tree)")
     p.add_argument("--samples", type=opt.samples, default=4, help="MSAA samples (default 4; 0 = none)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
