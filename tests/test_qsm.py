@@ -430,3 +430,19 @@ def test_a_chain_of_five_thousand_nested_branches_has_finite_modes(tmp_path):
     deep, short = tip_modes(5000), tip_modes(50)
     assert np.isfinite(deep.f).all() and np.isfinite(deep.zeta).all()
     np.testing.assert_allclose(deep.f[-1], short.f[-1], rtol=1e-3)
+
+
+def test_a_million_row_table_is_refused_before_it_is_parsed(tmp_path):
+    """Issue 31: a 1,000,000-row table was refused only after every row was parsed (30–50 s)."""
+    path = tmp_path / "big.txt"
+    path.write_text("0.01 0.05 0 0 0 0 0 1 0 0 1 0 0 0\n" * 1_000_000)
+    with pytest.raises(QSMError, match=r"1,000,000 lines; a model may have at most 200,000 cylinders"):
+        ta.load_tree(path)
+
+
+def test_load_tree_reads_a_treeqsm_model_by_its_suffix_as_the_command_line_does(tmp_path):
+    """Issue 31: ta.load_tree("scan.txt") said "not valid TOML" where the CLI read a TreeQSM model."""
+    assert ta.load_tree(ASSET).n_objects == load_qsm(ASSET).n_objects
+    assert ta.load_tree(ASSET, leaves="cherry").n_objects == load_qsm(ASSET, leaves="cherry").n_objects
+    with pytest.raises(PresetError, match="--leaves is for TreeQSM models"):
+        ta.load_tree(ASSET.parents[1] / "presets" / "beam.toml", leaves="cherry")

@@ -230,11 +230,11 @@ def load_any(name_or_path: str, args=None):
     import dataclasses
 
     import treeanim as ta
-    from treeanim.model.qsm import QSM_SUFFIXES, load_file
+    from treeanim.model.qsm import QSM_SUFFIXES
 
     leaves, modes = getattr(args, "leaves", None), getattr(args, "modes", None)
     if name_or_path.lower().endswith((*QSM_SUFFIXES, ".toml")):
-        tree = load_file(name_or_path, leaves=leaves)
+        tree = ta.load_tree(name_or_path, leaves=leaves)
     elif leaves is not None:
         raise UsageError("--leaves is for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves")
     else:

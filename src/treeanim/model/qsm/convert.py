@@ -14,7 +14,7 @@ from ..lamina import make_lamina
 from ..params import WOOD_TYPES
 from ..tree import Tree
 from .leaves import DEFAULT_PRESET, _leaf_rule, _preset_spec, _scaled_ei_max, parse_leaves
-from .read import COLUMNS, MAX_CYLINDERS, QSM_SUFFIXES, WIDTHS, _problem, _read_text, _widths_text, read_table
+from .read import COLUMNS, MAX_CYLINDERS, WIDTHS, _problem, _read_text, _widths_text, read_table
 
 # ---------------------------------------------------------------------------- checking
 #: A cylinder's radius and length (m): from a tenth of a millimetre (TreeQSM resolves a few
@@ -275,21 +275,3 @@ def load_qsm(path: str | Path, leaves: str | None = None, seed: int = 0) -> Tree
         raise
     except PresetError as e:  # pragma: no cover - a shipped preset that does not read
         raise QSMError(f"{path}: {e}") from None
-
-
-def load_file(path: str | Path, leaves: str | None = None) -> Tree:
-    """A tree from a file: a TreeQSM model by its suffix (:data:`QSM_SUFFIXES`), else a preset
-    TOML file (:func:`~treeanim.model.presets.load_tree`).
-
-    Raises
-    ------
-    PresetError
-        The file's one-line problem (a :class:`QSMError` for a model); ``leaves`` for a preset.
-    """
-    if str(path).lower().endswith(QSM_SUFFIXES):
-        return load_qsm(path, leaves=leaves)
-    if leaves not in (None, "none"):
-        raise PresetError(f"{path}: --leaves is for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves")
-    from ..presets import load_tree
-
-    return load_tree(path)

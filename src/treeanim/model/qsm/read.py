@@ -61,6 +61,9 @@ def _read_text(path: Path) -> tuple[np.ndarray, np.ndarray]:
         text = _read_bytes(path).decode("utf-8-sig")
     except UnicodeDecodeError:
         raise QSMError(f"{path}: not a UTF-8 text file") from None
+    n_lines = text.count("\n")
+    if n_lines > 2 * MAX_CYLINDERS:  # refused unparsed (a row a line; room for comments)
+        raise QSMError(f"{path}: {n_lines:,} lines; a model may have at most {MAX_CYLINDERS:,} cylinders")
     rows, numbers, header = [], [], True
     for n, line in enumerate(text.splitlines(), 1):
         line = line.strip()
