@@ -21,7 +21,7 @@ _EXPORTS = {
     "InputError": "errors",
     "list_presets": "model.presets",
     "load_preset": "model.presets",
-    "load_tree": "model.presets",
+    "load_tree": "model.qsm",
     "load_qsm": "model.qsm",
     "WindField": "physics.wind",
     "fbm_noise": "physics.wind",

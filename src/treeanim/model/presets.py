@@ -109,30 +109,18 @@ def load_preset(name: str) -> Tree:
     if name not in known:
         raise PresetError(f"unknown preset {name!r}; known presets: {', '.join(known)}")
     with resources.as_file(_preset_dir() / f"{name}.toml") as path:
-        return load_tree(path)
+        return read_tree(path)
 
 
-def load_tree(path: str | Path, leaves: str | None = None) -> Tree:
-    """Read a tree file: a TreeQSM model by its suffix (``.txt``, ``.csv``, ``.mat``:
-    :func:`~treeanim.model.qsm.load_qsm`), else a preset TOML file, whose tree it generates.
-
-    Parameters
-    ----------
-    path : str or Path
-    leaves : str or None
-        A TreeQSM model's leaves (:func:`~treeanim.model.qsm.parse_leaves`); a preset has its own.
+def read_tree(path: str | Path) -> Tree:
+    """Read a preset TOML file and generate its tree (``treeanim.load_tree`` reads any tree
+    file: :func:`treeanim.model.qsm.load_tree`).
 
     Raises
     ------
     PresetError
-        One line naming the file, the key or row and what was expected.
+        One line naming the file, the key and what was expected.
     """
-    from .qsm import QSM_SUFFIXES, load_qsm  # (the TreeQSM reader takes its species from presets)
-
-    if str(path).lower().endswith(QSM_SUFFIXES):
-        return load_qsm(path, leaves=leaves)
-    if leaves not in (None, "none"):
-        raise PresetError(f"{path}: --leaves is for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves")
     spec = read_spec(path)
     try:
         tree = generate(spec)
