@@ -346,6 +346,8 @@ BAD = [
     (["export", "beam", "--seconds", "4e4", "--fps", "1", "--out", "x.glb"], "at most 2,000,000"),
     (["view", "beam", "--samples", "3"], "one of 0, 1, 2, 4, 8, 16"),
     (["render", "beam", "--out", "a" * 300 + ".png"], "bytes long"),
+    (["render", "beam", "--fps", "9" * 5000, "--out", "x.png"], "(5,000 characters)"),  # not echoed whole
+    (["render", "beam", "--out", "no/such/a\nb.png"], "a\\nb.png"),  # a newline in a path: still one line
     (["export", "beam", "--out", "b" * 300 + ".glb"], "bytes long"),
 ]
 

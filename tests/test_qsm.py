@@ -446,3 +446,16 @@ def test_load_tree_reads_a_treeqsm_model_by_its_suffix_as_the_command_line_does(
     assert ta.load_tree(ASSET, leaves="cherry").n_objects == load_qsm(ASSET, leaves="cherry").n_objects
     with pytest.raises(PresetError, match="--leaves is for TreeQSM models"):
         ta.load_tree(ASSET.parents[1] / "presets" / "beam.toml", leaves="cherry")
+
+
+def test_a_complex_valued_mat_file_is_refused(tmp_path):
+    """Issue 31: a complex-valued .mat was accepted with a ComplexWarning (its imaginary parts dropped)."""
+    import scipy.io
+
+    t = small_table()
+    cyl = {"radius": t[:, 0] + 1j, "length": t[:, 1], "start": t[:, 2:5], "axis": t[:, 5:8], "parent": t[:, 8],
+           "extension": t[:, 9], "branch": t[:, 10]}
+    scipy.io.savemat(tmp_path / "c.mat", {"cylinder": cyl})
+    with pytest.raises(QSMError, match="cylinder field 'radius' is not an array of 1 number"):
+        load_qsm(tmp_path / "c.mat")
+

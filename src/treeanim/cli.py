@@ -116,7 +116,7 @@ def cmd_render(args) -> int:
     try:
         res = render.run_render(job, tree, sim, log=lambda m: print(m, file=sys.stderr))
     except GLUnavailable as e:
-        print(f"treeanim: error: {e}", file=sys.stderr)
+        print(one_line(f"treeanim: error: {e}"), file=sys.stderr)
         return 1
     if target.kind == "still":
         print(f"wrote {res.path}: {w}×{h}, {tree.name} after {job.start + seconds:g} s, {_mb(res.bytes)}")
@@ -200,7 +200,7 @@ def cmd_bench(args) -> int:
         res = bench.run_bench(keys, w, h, frames=args.frames, steps=args.steps, samples=args.samples,
                               wind=args.wind, quiet=args.quiet)
     except GLUnavailable as e:
-        print(f"treeanim: error: {e}", file=sys.stderr)
+        print(one_line(f"treeanim: error: {e}"), file=sys.stderr)
         return 1
     print(bench.format_bench(res))
     if out is not None:
@@ -423,17 +423,22 @@ def main(argv: list[str] | None = None) -> int:
         _stdout_to_devnull()
         return 141
     except InputError as e:  # UsageError, PresetError, the offline jobs' own
-        print(f"treeanim: error: {e}", file=sys.stderr)
+        print(one_line(f"treeanim: error: {e}"), file=sys.stderr)
         return 2
     except OSError as e:  # a write that failed (disk full, name too long ...): the old file is kept
         if e.filename is None:  # standard output itself (`treeanim list > /dev/full`)
             _stdout_to_devnull()
         where = f"{e.filename}: " if e.filename is not None else ""
-        print(f"treeanim: error: {where}{e.strerror or e}", file=sys.stderr)
+        print(one_line(f"treeanim: error: {where}{e.strerror or e}"), file=sys.stderr)
         return 1
     except KeyboardInterrupt:
         print("treeanim: interrupted", file=sys.stderr)
         return 130
+
+
+def one_line(message: str) -> str:
+    """An error message on one line, whatever it quotes (a path with a newline in it)."""
+    return message.replace("\r", "\\r").replace("\n", "\\n")
 
 
 def _plain_streams() -> None:

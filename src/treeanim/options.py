@@ -16,6 +16,11 @@ MAX_FRAMES = 1_000_000
 MAX_STEPS = 2_000_000
 
 
+def shown(text: str, width: int = 40) -> str:
+    """``text`` as an error message quotes it: its repr, cut to ``width`` characters."""
+    return repr(text) if len(text) <= width else repr(text[:width]) + f"… ({len(text):,} characters)"
+
+
 def number(kind, lo: float, hi: float, lo_open: bool):
     """An argparse type: a ``kind`` (int or float) in (lo, hi] or [lo, hi]."""
     fmt = (lambda x: f"{int(x):,}") if kind is int else (lambda x: f"{x:g}")
@@ -31,7 +36,7 @@ def number(kind, lo: float, hi: float, lo_open: bool):
         except ValueError:
             value = float("nan")
         if not ((value > lo) if lo_open else (value >= lo)) or not value <= hi:
-            raise argparse.ArgumentTypeError(f"expected {what}, got {text!r}")
+            raise argparse.ArgumentTypeError(f"expected {what}, got {shown(text)}")
         return value
 
     return parse
@@ -102,7 +107,7 @@ def physics_setting(text: str) -> tuple[str, float]:
     name, sep, value = text.partition("=")
     name = name.strip().replace("-", "_")
     if not sep or name not in PARAMS:
-        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with NAME one of {', '.join(PARAMS)}, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected NAME=VALUE with NAME one of {', '.join(PARAMS)}, got {shown(text)}")
     try:
         x = float(value)
     except ValueError:
@@ -235,7 +240,7 @@ def finite(text: str) -> float:
     except ValueError:
         value = float("nan")
     if value != value or value in (float("inf"), float("-inf")):
-        raise argparse.ArgumentTypeError(f"expected a finite number, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected a finite number, got {shown(text)}")
     return value
 
 
@@ -250,5 +255,5 @@ def samples(text: str) -> int:
     except ValueError:
         value = -1
     if value not in SAMPLES:
-        raise argparse.ArgumentTypeError(f"expected one of {', '.join(map(str, SAMPLES))}, got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected one of {', '.join(map(str, SAMPLES))}, got {shown(text)}")
     return value

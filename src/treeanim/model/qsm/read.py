@@ -151,6 +151,8 @@ def _from_struct(path: Path, cyl: dict) -> np.ndarray:
                 continue
             raise QSMError(f"{path}: the cylinder struct has no field {name!r}; expected {', '.join(need)}")
         try:
+            if np.iscomplexobj(cyl[name]):
+                raise TypeError
             v = np.asarray(cyl[name], float).reshape(-1, width)
         except (TypeError, ValueError):
             raise QSMError(f"{path}: cylinder field {name!r} is not an array of {width} number(s) a row") from None
