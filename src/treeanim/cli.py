@@ -231,12 +231,13 @@ def load_any(name_or_path: str, args=None):
 
     import treeanim as ta
     from treeanim.model.qsm import QSM_SUFFIXES
+    from treeanim.model.qsm.leaves import LEAVES_FOR_QSM_ONLY
 
     leaves, modes = getattr(args, "leaves", None), getattr(args, "modes", None)
     if name_or_path.lower().endswith((*QSM_SUFFIXES, ".toml")):
         tree = ta.load_tree(name_or_path, leaves=leaves)
     elif leaves is not None:
-        raise UsageError("--leaves is for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves")
+        raise UsageError(LEAVES_FOR_QSM_ONLY)
     else:
         tree = ta.load_preset(name_or_path)
     if modes is not None:

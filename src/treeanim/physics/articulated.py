@@ -449,10 +449,10 @@ def _add_bias(h, b, kap, Om, V, IA, pA, Ib, mom):
         pA[b, i] += h * (a[i] + c[i])
         pA[b, 3 + i] += h * d[i]
     # crf(ν)·I, crf(ν) = [[ω×, v×], [0, ω×]], block by block
-    for c in (0, 3):
-        _add_cross(IA[b], 0, c, h, wx, wy, wz, Ib, 0, c)
-        _add_cross(IA[b], 0, c, h, vx, vy, vz, Ib, 3, c)
-        _add_cross(IA[b], 3, c, h, wx, wy, wz, Ib, 3, c)
+    for col in (0, 3):
+        _add_cross(IA[b], 0, col, h, wx, wy, wz, Ib, 0, col)
+        _add_cross(IA[b], 0, col, h, vx, vy, vz, Ib, 3, col)
+        _add_cross(IA[b], 3, col, h, wx, wy, wz, Ib, 3, col)
     _add_skew(IA[b], 0, 0, -h, n0, n1, n2)
     _add_skew(IA[b], 0, 3, -h, p0, p1, p2)
     _add_skew(IA[b], 3, 0, -h, p0, p1, p2)

@@ -236,7 +236,7 @@ class TreeSim:
         force = np.asarray(force, float).copy()
         n = float(np.linalg.norm(force))
         f_max = self._strength(b, ofs)[1]
-        self._pulls[i] = (b, ofs, force * (f_max / n) if n > f_max else force.copy(), force)
+        self._pulls[i] = (b, ofs, force * (f_max / n) if n > f_max else force, force)
 
     @property
     def pulls(self) -> dict[int, np.ndarray]:

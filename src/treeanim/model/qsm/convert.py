@@ -13,7 +13,7 @@ from ..generate import place_leaves
 from ..lamina import make_lamina
 from ..params import WOOD_TYPES
 from ..tree import Tree
-from .leaves import DEFAULT_PRESET, _leaf_rule, _preset_spec, _scaled_ei_max, parse_leaves
+from .leaves import DEFAULT_PRESET, LEAVES_FOR_QSM_ONLY, _leaf_rule, _preset_spec, _scaled_ei_max, parse_leaves
 from .read import COLUMNS, MAX_CYLINDERS, QSM_SUFFIXES, WIDTHS, _problem, _read_text, _widths_text, read_table
 
 # ---------------------------------------------------------------------------- checking
@@ -296,7 +296,7 @@ def load_tree(path: str | Path, leaves: str | None = None) -> Tree:
     if str(path).lower().endswith(QSM_SUFFIXES):
         return load_qsm(path, leaves=leaves)
     if leaves not in (None, "none"):
-        raise PresetError(f"{path}: --leaves is for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves")
+        raise PresetError(f"{path}: {LEAVES_FOR_QSM_ONLY}")
     from ..presets import read_tree
 
     return read_tree(path)
