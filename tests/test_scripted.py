@@ -59,15 +59,17 @@ def test_overlapping_and_back_to_back_pulls():
     assert rec.held == {}, "everything is let go at the end"
 
 
-def test_frames_reach_their_times_in_fixed_steps():
-    """The viewer's clock (treeanim.clock): every step 1/60 s, each frame within half a step
-    of its time, at a frame rate the step does not divide."""
+@pytest.mark.parametrize("fps,per_frame", [(7, 9), (24, 3), (30, 2), (60, 1), (250, 1)])
+def test_frames_land_on_their_times_in_equal_steps(fps, per_frame):
+    """The frame driver's offline policy (treeanim.driver.step_for): equal steps of at most
+    1/60 s, a whole number of them a frame, so every frame lands on its time."""
     rec = Recorder()
-    times = [rec.time for _ in frames(rec, 2.0, 7, [])]
-    assert len(times) == 14
-    np.testing.assert_allclose(times, np.arange(14) / 7, atol=0.5 / 60 + 1e-12)
+    times = [rec.time for _ in frames(rec, 2.0, fps, [])]
+    assert len(times) == 2 * fps
+    np.testing.assert_allclose(times, np.arange(2 * fps) / fps, atol=1e-9)
     steps = np.diff([t for t, _, _ in rec.log])
-    np.testing.assert_allclose(steps, 1 / 60, rtol=1e-9)
+    np.testing.assert_allclose(steps, 1 / (fps * per_frame), rtol=1e-9)
+    assert steps.max() <= 1 / 60 + 1e-12
 
 
 def test_scripted_pull_matches_hand_stepping():

@@ -159,7 +159,7 @@ def cmd_trace(args) -> int:
     tree, sim = make_simulation(scene)
     if not 0 <= args.object < tree.n_objects:
         raise UsageError(f"--object {args.object}: the tree has objects 0 to {tree.n_objects - 1}")
-    opt.check_frames(args.hold + args.seconds, args.rate, step_rate=0.0)  # a trace steps once a sample
+    opt.check_frames(args.hold + args.seconds, args.rate)
     tr = trace.run_trace(sim, args.object, args.pull, args.hold, args.seconds, args.rate, drag=args.drag)
     trace.write_trace_csv(out, tr)
     if plot is not None:
@@ -376,7 +376,8 @@ def build_parser() -> argparse.ArgumentParser:
                    "grassland)")
     p.add_argument("--size", type=opt.size, default=(1280, 720), metavar="WxH", help="render size (default 1280x720)")
     p.add_argument("--frames", type=opt.positive(int), default=20, help="frames rendered per preset (default 20)")
-    p.add_argument("--steps", type=opt.positive(int), default=200, help="simulation steps per preset (default 200)")
+    p.add_argument("--steps", type=opt.positive(int), default=200,
+                   help="simulated 1/60 s frames timed per preset (default 200)")
     p.add_argument("--samples", type=opt.samples, default=4, help="MSAA samples (default 4)")
     p.add_argument("--wind", type=opt.wind_speed, default=5.0, metavar="SPEED", help="wind speed, m/s (default 5)")
     p.add_argument("--json", default=None, metavar="FILE", help="also write every figure to this .json file")

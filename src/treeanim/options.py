@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import argparse
 
+from .driver import step_for
 from .errors import UsageError
 
 #: Upper bound of times, rates and counts on the command line: large enough for any real use,
@@ -219,14 +220,13 @@ def scheduled(args) -> list:
     return [*getattr(args, "pull", []), *getattr(args, "drag", [])]
 
 
-def check_frames(seconds: float, fps: float, step_rate: float = 60.0) -> int:
+def check_frames(seconds: float, fps: float) -> int:
     """The number of frames ``seconds`` at ``fps`` give; UsageError beyond :data:`MAX_FRAMES`,
-    or beyond :data:`MAX_STEPS` simulation steps (one a frame, and at least ``step_rate`` a
-    second: scripted frames step at most 1/60 s at a time)."""
+    or beyond :data:`MAX_STEPS` simulation steps (the frame driver's, :func:`~treeanim.driver.step_for`)."""
     n = seconds * fps
     if n > MAX_FRAMES:
         raise UsageError(f"--seconds {seconds:g} at --fps {fps:g} is {n:.3g} frames; at most {MAX_FRAMES:,}")
-    steps = seconds * max(fps, step_rate)
+    steps = seconds / step_for(fps)
     if steps > MAX_STEPS:
         raise UsageError(f"--seconds {seconds:g} takes {steps:.3g} simulation steps; at most {MAX_STEPS:,} "
                          f"(about {MAX_STEPS / 3600 / 60:.0f} hours of simulated time at 60 steps a second)")

@@ -18,7 +18,7 @@ from typing import Iterator
 
 import numpy as np
 
-from .clock import STEP, StepClock
+from .driver import STEP, FrameDriver
 
 _PULL = re.compile(r"^\s*(\d+)\s*:\s*([^@]+?)\s*@\s*([^-]+?)\s*-\s*(.+?)\s*$")
 _DRAG = re.compile(r"^\s*(\d+)\s*(?:@\s*([^:]+?)\s*)?:\s*([^@]+?)\s*@\s*([^-]+?)\s*-\s*(.+?)\s*$")
@@ -139,40 +139,56 @@ def check_pulls(pulls: list, n_objects: int, model: str = "tree") -> None:
                              f"the tree holds one drag at a time")
 
 
-def frames(sim, seconds: float, fps: float, pulls: list = (), step: float = STEP) -> Iterator[int]:
-    """Advance ``sim`` to each frame time k / fps for k = 0 .. round(seconds * fps) - 1.
+class Schedule:
+    """Scheduled pulls and drags, a hand of :class:`~treeanim.driver.FrameDriver`.
 
-    Yields the frame index once the simulation is within half a ``step`` of that frame's time:
-    it steps by ``step`` on the viewer's clock (:class:`~treeanim.clock.StepClock`).
-    ``pulls`` holds :class:`Pull` and :class:`Drag` items. Before every step, exactly the
-    pulls and the drag whose interval [T0, T1) holds the step's start time are held (pulls on
-    different objects may overlap; drags may not, see :func:`check_pulls`); the others are let
-    go.
+    ``pulls`` holds :class:`Pull` and :class:`Drag` items, their times counted from the
+    schedule's first step. Before every step, exactly the pulls and the drag whose interval
+    [T0, T1) holds the step's start time are held (pulls on different objects may overlap;
+    drags may not, see :func:`check_pulls`); the others are let go.
     """
-    n = int(round(seconds * fps))
-    clock = StepClock(step)
-    forces = [p for p in pulls if not isinstance(p, Drag)]
-    drags = [p for p in pulls if isinstance(p, Drag)]
-    held: dict[int, tuple[float, float, float]] = {}
-    dragged: Drag | None = None
-    t = 0.0
-    for k in range(n):
-        for _ in range(clock.advance(1.0 / fps if k else 0.0)):
-            want = {p.obj: p.force for p in forces if p.start <= t < p.end}
-            drag = next((d for d in drags if d.start <= t < d.end), None)
-            gone = held.keys() - want.keys()  # release() lets go of an object's pull and drag
-            if dragged is not None and (drag is None or drag.obj != dragged.obj):
-                gone |= {dragged.obj}
-            for obj in sorted(gone):
-                sim.release(obj)
-            for obj, force in want.items():
-                if obj in gone or held.get(obj) != force:
-                    sim.pull(obj, np.asarray(force, float))
-            if drag is not None and (drag != dragged or drag.obj in gone):
-                sim.drag(drag.obj, np.asarray(drag.target, float), drag.s)
-            held, dragged = want, drag
-            sim.step(step)
-            t += step
-        yield k
-    for obj in sorted(held.keys() | ({dragged.obj} if dragged is not None else set())):
-        sim.release(obj)
+
+    def __init__(self, pulls=()) -> None:
+        self.forces = [p for p in pulls if not isinstance(p, Drag)]
+        self.drags = [p for p in pulls if isinstance(p, Drag)]
+        self.held: dict[int, tuple[float, float, float]] = {}
+        self.dragged: Drag | None = None
+        self.time = 0.0
+
+    def step(self, sim, h: float, exact: bool = True) -> None:
+        """Before a step of ``h`` seconds: hold what is due now, let go of the rest."""
+        t = self.time
+        want = {p.obj: p.force for p in self.forces if p.start <= t < p.end}
+        drag = next((d for d in self.drags if d.start <= t < d.end), None)
+        gone = self.held.keys() - want.keys()  # release() lets go of an object's pull and drag
+        if self.dragged is not None and (drag is None or drag.obj != self.dragged.obj):
+            gone |= {self.dragged.obj}
+        for obj in sorted(gone):
+            sim.release(obj)
+        for obj, force in want.items():
+            if obj in gone or self.held.get(obj) != force:
+                sim.pull(obj, np.asarray(force, float))
+        if drag is not None and (drag != self.dragged or drag.obj in gone):
+            sim.drag(drag.obj, np.asarray(drag.target, float), drag.s)
+        self.held, self.dragged = want, drag
+        self.time = t + h
+
+    def release(self, sim) -> None:
+        """Let go of everything held."""
+        held = self.held.keys() | ({self.dragged.obj} if self.dragged is not None else set())
+        for obj in sorted(held):
+            sim.release(obj)
+        self.held, self.dragged = {}, None
+
+
+def frames(sim, seconds: float, fps: float, pulls: list = (), step: float = STEP) -> Iterator[int]:
+    """Advance ``sim`` to each frame time k / fps for k = 0 .. round(seconds * fps) - 1 with
+    the scheduled ``pulls`` (:class:`Schedule`), yielding k there; everything is let go at the
+    end.
+
+    The steps are the frame driver's for frames at ``fps``, of at most ``step`` seconds
+    (:meth:`FrameDriver.at_rate <treeanim.driver.FrameDriver.at_rate>`).
+    """
+    schedule = Schedule(pulls)
+    yield from FrameDriver.at_rate(fps, step).frames(sim, int(round(seconds * fps)), fps, schedule)
+    schedule.release(sim)

@@ -10,14 +10,13 @@ handlers. :meth:`Viewer.frame` advances the simulation by the elapsed time and d
 
 from __future__ import annotations
 
-import math
 import time
 from datetime import datetime
 from pathlib import Path
 
 import numpy as np
 
-from ..clock import STEP, StepClock
+from ..driver import MAX_FRAME_DT, FrameDriver
 from ..model.tree import Tree
 from ..physics.pull import SpringPull, TreeDrag
 from ..physics.pull import grab as grab_object
@@ -34,10 +33,7 @@ from .input import ViewerInput
 from .winddir import wind_direction
 from .window import Window
 
-#: Longest real time one frame advances the simulation by (s): slow frames (a software
-#: renderer at a few frames a second) still keep real time, in sub-steps; a stall (a dragged or
-#: hidden window) never makes a jump.
-MAX_FRAME_DT = 0.5
+__all__ = ["Viewer", "run", "MAX_FRAME_DT"]
 
 
 def _clone_wind(w: WindField | None, **changes) -> WindField:
@@ -116,7 +112,6 @@ class Viewer(ViewerInput):
         self.seed = int(seed)
         self._clock = clock or time.perf_counter
         self.paused = False
-        self.time_scale = 1.0
         self.show_panel = bool(show_panel)
         self.show_trace = True
         self.show_frames = False
@@ -130,7 +125,7 @@ class Viewer(ViewerInput):
         self.sim_ms, self.render_ms, self.frame_s = _Ema(), _Ema(), _Ema(0.05)
         self.real_time = _Ema(0.05)  # simulated seconds per real second (the time scale, if kept up)
         self.last_sim_s = self.last_draw_s = 0.0  # the last frame's advance() and draw(), s
-        self.step_clock = StepClock()
+        self.driver = FrameDriver()  # the clock and the step policy (docs/design.md §10)
         self._last_time: float | None = None
         self._screenshot_pending: list[Path | None] = []
         self._uploaded = None
@@ -190,7 +185,7 @@ class Viewer(ViewerInput):
         self.picker = Picker(tree)
         self.trace.clear()
         self.traced = None
-        self.step_clock.reset()
+        self.driver.reset()
         lo, hi = renderer.bounds()
         self.local_frames = LocalFrames(scale=0.25)
         size = float(np.max(hi - lo))
@@ -248,30 +243,30 @@ class Viewer(ViewerInput):
 
     # ------------------------------------------------------------------ time
     @property
-    def substep(self) -> float:
-        """The simulation's fixed step (s): 1/60 × the time scale, at most 1/60.
+    def time_scale(self) -> float:
+        """Simulated seconds per real second (the frame driver's)."""
+        return self.driver.time_scale
 
-        At 60 frames a second this is one step a frame at any slow-motion scale, and the exact
-        integrator's coefficients stay cached while the scale is unchanged."""
-        return STEP * min(1.0, self.time_scale)
+    @time_scale.setter
+    def time_scale(self, value: float) -> None:
+        self.driver.time_scale = float(value)
+
+    @property
+    def substep(self) -> float:
+        """The simulation's fixed step (s): the frame driver's, 1/60 × the time scale, at most
+        1/60 (one step a frame at 60 frames a second at any slow-motion scale)."""
+        return self.driver.step
 
     def advance(self, real_dt: float) -> int:
-        """Advance the simulation by ``real_dt`` seconds of real time × the time scale, in
-        fixed sub-steps; ``real_dt`` is clamped to :data:`MAX_FRAME_DT`. Returns the steps taken."""
+        """Advance the simulation by ``real_dt`` seconds of real time (the frame driver's
+        :meth:`~treeanim.driver.FrameDriver.advance`, the grab acting before every step and
+        the trace following the grabbed point). Returns the steps taken."""
         if self.paused:
             return 0
-        h = self.step_clock.step = self.substep
-        dt = min(max(float(real_dt), 0.0), MAX_FRAME_DT) * self.time_scale
-        n = self.step_clock.advance(dt, most=int(math.ceil(MAX_FRAME_DT * self.time_scale / h)) + 1)
-        sim = self.sim
-        for j in range(n):
-            if self.grab is not None:
-                self.grab.step(sim, h, exact=j == 0)
-            sim.step(h)
-            if self.traced is not None:
-                self.trace.push(self.traced_point())
+        follow = None if self.traced is None else (lambda: self.trace.push(self.traced_point()))
+        n = self.driver.advance(self.sim, real_dt, self.grab, follow)
         if n:
-            sim.positions, sim.rotations  # the pose is built lazily: count it as simulation
+            self.sim.positions, self.sim.rotations  # the pose is built lazily: count it as simulation
         return n
 
     # ------------------------------------------------------------------ frames
@@ -474,7 +469,7 @@ class Viewer(ViewerInput):
         self.sim.reset()
         self.trace.clear()
         self.traced = None
-        self.step_clock.reset()
+        self.driver.reset()
 
     def release(self) -> None:
         """Free the GL resources (the window stays open)."""

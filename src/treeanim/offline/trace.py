@@ -44,32 +44,33 @@ def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float, dr
         ``seconds`` or ``rate`` not finite and positive, or so small that fewer than 2 samples
         would follow the release (checked before anything is simulated).
     """
-    from ..physics.trace import trace_tips
+    from ..driver import FrameDriver
+    from ..scripted import Drag, Pull, Schedule
 
     try:
         positive_float("--seconds", seconds), positive_float("--rate", rate)
     except ValueError as e:
         raise InputError(str(e)) from None
-    samples = int(round(seconds * rate)) + 1  # trace_tips records the release and every step after it
+    samples = int(round(seconds * rate)) + 1  # the release and every sample after it
     if samples < 2:
         raise InputError(f"--seconds {seconds:g} at --rate {rate:g} Hz gives {samples} sample after release; "
                          f"a trace needs at least 2 samples")
-    dt = 1.0 / rate
     tree = sim.tree
     tip = int(tree.object_start[obj] + tree.object_count[obj] - 1)
-    if drag is not None:
-        sim.drag(obj, np.asarray(drag, float), 1.0)
-    else:
-        sim.pull(obj, np.asarray(force, float))
-    for _ in range(max(1, int(round(hold / dt)))):
-        sim.step(dt)
+    hand = Schedule([Drag(obj, tuple(drag), 0.0, np.inf) if drag is not None
+                     else Pull(obj, tuple(force), 0.0, np.inf)])
+    driver = FrameDriver.at_rate(rate)  # the offline commands' frames, sampled at the rate
+    for _ in driver.frames(sim, max(1, int(round(hold * rate))) + 1, rate, hand):
+        pass
     held = sim.tip_position(obj)
-    sim.release()
-    times, tips = trace_tips(sim, [obj], seconds, dt)
+    hand.release(sim)
+    times, tips = np.empty(samples), np.empty((samples, 3))
+    for k in driver.frames(sim, samples, rate):
+        times[k], tips[k] = sim.time, sim.tip_position(obj)
     f = zeta = None
     if sim.model == "paper":
         f, zeta = np.array(sim.modes.f[obj], float), np.array(sim.modes.zeta[obj], float)
-    return TraceResult(times - times[0], tips[:, 0], np.asarray(tree.rest_positions[tip], float), held, obj,
+    return TraceResult(times - times[0], tips, np.asarray(tree.rest_positions[tip], float), held, obj,
                        str(tree.kind[obj]), f, zeta)
 
 
