@@ -38,7 +38,7 @@ import numpy as np
 
 from .compiled import njit
 
-__all__ = ["theta_of", "forward_kinematics", "articulated_step", "rot_log", "rot_exp", "add_point", "JOINT_STOP"]
+__all__ = ["theta_of", "articulated_step", "rot_log", "rot_exp", "add_point", "JOINT_STOP"]
 
 #: The most a joint turns against its parent (rad): beyond it a segment stops, its outward
 #: speed taken away (a soft grass blade can fold; no joint wraps past π).
@@ -124,55 +124,6 @@ def _orthonormalize(Q):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def forward_kinematics(parent, r0, Q, w, R, P, Om, V):
-    """World rotations ``R``, joint positions ``P``, angular velocities ``Om`` and joint-point
-    velocities ``V`` of every body from its joint's rotation ``Q`` and velocity ``w``.
-
-    Parameters
-    ----------
-    parent : (B,) int64
-        Parent body (−1: the ground).
-    r0 : (B, 3)
-        Rest offset of each joint from its parent's joint (a root's: its world position).
-    Q : (B, 3, 3), w : (B, 3)
-        Joint rotations and angular velocities, in the parent's rest axes.
-    R, P, Om, V : (B, 3, 3), (B, 3), (B, 3), (B, 3)
-        Written.
-    """
-    B = parent.shape[0]
-    for b in range(B):
-        p = parent[b]
-        if p < 0:
-            for i in range(3):
-                for j in range(3):
-                    R[b, i, j] = Q[b, i, j]
-                P[b, i] = r0[b, i]
-                Om[b, i] = 0.0
-                V[b, i] = 0.0
-            for i in range(3):
-                Om[b, i] = w[b, i]
-            continue
-        for i in range(3):
-            for j in range(3):
-                s = 0.0
-                for k in range(3):
-                    s += R[p, i, k] * Q[b, k, j]
-                R[b, i, j] = s
-        rx = R[p, 0, 0] * r0[b, 0] + R[p, 0, 1] * r0[b, 1] + R[p, 0, 2] * r0[b, 2]
-        ry = R[p, 1, 0] * r0[b, 0] + R[p, 1, 1] * r0[b, 1] + R[p, 1, 2] * r0[b, 2]
-        rz = R[p, 2, 0] * r0[b, 0] + R[p, 2, 1] * r0[b, 1] + R[p, 2, 2] * r0[b, 2]
-        P[b, 0] = P[p, 0] + rx
-        P[b, 1] = P[p, 1] + ry
-        P[b, 2] = P[p, 2] + rz
-        cx, cy, cz = _cross(Om[p, 0], Om[p, 1], Om[p, 2], rx, ry, rz)
-        V[b, 0] = V[p, 0] + cx
-        V[b, 1] = V[p, 1] + cy
-        V[b, 2] = V[p, 2] + cz
-        for i in range(3):
-            Om[b, i] = Om[p, i] + R[p, i, 0] * w[b, 0] + R[p, i, 1] * w[b, 1] + R[p, i, 2] * w[b, 2]
-
-
-@njit(cache=True, fastmath=True, error_model="numpy")
 def _inv3(A, out):
     a, b, c = A[0, 0], A[0, 1], A[0, 2]
     d, e, f = A[1, 0], A[1, 1], A[1, 2]
@@ -207,15 +158,15 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
         segment is far stiffer for its inertia than its bend).
     axis : (B, 3)
         Each segment's rest axis (its twist axis, in the parent's rest axes).
-    parent, r0 : see :func:`forward_kinematics`.
+    parent, r0 : see :func:`~treeanim.physics.kinematics.forward_kinematics`.
     m0, h0, J0 : (B,), (B, 3), (B, 3, 3)
         Each body's mass, first and second moments about its joint in rest axes (what it carries
         rigidly — its leaves — included).
     kb, kt, dkk : (B,)
         Each joint's bending and twisting stiffness (N·m/rad) and its damping per unit of
         stiffness (s): K = k_b(1 − aaᵀ) + k_t·aaᵀ about the segment's axis a, D = dkk·K.
-    R, P, Q, w : the state (see :func:`forward_kinematics`); Q and w are advanced in place, R
-        and P are left for :func:`forward_kinematics` to redo.
+    R, P, Q, w : the state (see :func:`~treeanim.physics.kinematics.forward_kinematics`); Q
+        and w are advanced in place, R and P are left for forward kinematics to redo.
     F : (B, 6)
         External spatial force on each body (moment about its joint, force), world.
     kap : (B, 6, 6)
@@ -432,15 +383,17 @@ def _add_bias(h, b, kap, Om, V, IA, pA, Ib, mom):
     its angular velocity (docs/design.md §12)."""
     wx, wy, wz = Om[b, 0], Om[b, 1], Om[b, 2]
     vx, vy, vz = V[b, 0], V[b, 1], V[b, 2]
-    # weighted by (1 + (|ω|h)⁴)⁻¹: a turn of a radian or more a step the linearisation overshoots
-    x2 = h * h * (wx * wx + wy * wy + wz * wz)
-    h = h / (1.0 + x2 * x2)
     nu = (wx, wy, wz, vx, vy, vz)
     mom[:] = 0.0  # Iν = (n, p)
     for i in range(6):
         for j in range(6):
             Ib[i, j] = IA[b, i, j] - kap[b, i, j]
             mom[i] += Ib[i, j] * nu[j]
+    # weighted by (1 + x⁴)⁻¹, x = h·|ν| in radians (|v| over the body's gyration length
+    # ℓ² = tr J/m): a turn or a sweep of a radian or more a step the linearisation overshoots
+    l2 = (Ib[0, 0] + Ib[1, 1] + Ib[2, 2]) / Ib[3, 3]
+    x2 = h * h * (wx * wx + wy * wy + wz * wz + (vx * vx + vy * vy + vz * vz) / l2)
+    h = h / (1.0 + x2 * x2)
     n0, n1, n2, p0, p1, p2 = mom[0], mom[1], mom[2], mom[3], mom[4], mom[5]
     a = _cross(wx, wy, wz, n0, n1, n2)
     c = _cross(vx, vy, vz, p0, p1, p2)

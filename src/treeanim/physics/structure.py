@@ -181,6 +181,8 @@ class Structure:
     axis: np.ndarray        # (B, 3) rest unit axis
     length: np.ndarray      # (B,)
     mid0: np.ndarray        # (B, 3) rest offset of the segment's middle from its joint
+    seg0: np.ndarray        # (B, 3) rest segment, joint to end
+    floor: np.ndarray       # (B,) lowest height of the segment's end: its radius (its rest height if lower)
     m0: np.ndarray          # (B,) mass with the present leaves
     h0: np.ndarray          # (B, 3)
     J0: np.ndarray          # (B, 3, 3)
@@ -378,6 +380,7 @@ class Structure:
         c = np.ascontiguousarray
         return cls(parent=c(parent, np.int64), r0=c(r0), node=c(node, np.int64), tip=c(k_in == count[obj] - 2),
                    tip_node=c(node + 1, np.int64), obj=obj, axis=c(axis), length=length, mid0=c(mid0),
+                   seg0=c(seg), floor=c(np.minimum(0.5 * d1, X1[:, 1])),
                    m0=c(m0), h0=c(h0), J0=c(J0), K=c(K), kb=c(kb), kt=c(kt), dk=c(dk), cda=c(cda), diameter=d0,
                    leaf_obj=leaves, leaf_body=c(leaf_body, np.int64), leaf_on=c(on),
                    leaf_base0=c(base0),

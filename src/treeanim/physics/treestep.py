@@ -9,7 +9,7 @@ and writes the next one. One step:
    segment's own motion, and the leaves' forces of the last step, with the damping of both
    implicit; pulls (constant forces) and a grab (a stiff spring to a target, implicit);
 3. the articulated-body step (:func:`~treeanim.physics.articulated.articulated_step`);
-4. the new pose of every body (:func:`~treeanim.physics.articulated.forward_kinematics`);
+4. the new pose of every body, kept above the ground (:func:`~treeanim.physics.kinematics.ground_contact`);
 5. every leaf's petiole joint (:func:`~treeanim.physics.articulated.leaf_step`), its force
    kept for the twig's next step, and the leaves' flutter phase.
 """
@@ -20,8 +20,9 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from .articulated import add_point, articulated_step, forward_kinematics, rot_log, theta_of
+from .articulated import add_point, articulated_step, rot_log, theta_of
 from .compiled import njit
+from .kinematics import forward_kinematics, ground_contact
 from .leafjoint import leaf_step, pose_nodes
 from .structure import Structure
 
@@ -282,7 +283,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     tb, tt = _thetas(s, dt, work)
     articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.kb, s.kt, s.dk, out.R, out.P, out.Q, out.w,
                      out.Om, out.V, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.Ur, w.u, w.acc)
-    forward_kinematics(s.parent, s.r0, out.Q, out.w, out.R, out.P, out.Om, out.V)
+    ground_contact(s.parent, s.r0, s.seg0, s.floor, out.Q, out.w, out.R, out.P, out.Om, out.V)
     if len(Ul):
         _flutter(s, out, Ul, dt, leaf_flutter)
     leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
