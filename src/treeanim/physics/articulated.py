@@ -391,8 +391,11 @@ def _add_bias(h, b, kap, Om, V, IA, pA, Ib, mom):
             mom[i] += Ib[i, j] * nu[j]
     # weighted by (1 + x⁴)⁻¹, x = h·|ν| in radians (|v| over the body's gyration length
     # ℓ² = tr J/m): a turn or a sweep of a radian or more a step the linearisation overshoots
-    l2 = (Ib[0, 0] + Ib[1, 1] + Ib[2, 2]) / Ib[3, 3]
-    x2 = h * h * (wx * wx + wy * wy + wz * wz + (vx * vx + vy * vy + vz * vz) / l2)
+    x2 = wx * wx + wy * wy + wz * wz
+    tr = Ib[0, 0] + Ib[1, 1] + Ib[2, 2]
+    if tr > 0.0:  # (a body whose inertia underflows has no sweep to speak of)
+        x2 += (vx * vx + vy * vy + vz * vz) * Ib[3, 3] / tr
+    x2 *= h * h
     h = h / (1.0 + x2 * x2)
     n0, n1, n2, p0, p1, p2 = mom[0], mom[1], mom[2], mom[3], mom[4], mom[5]
     a = _cross(wx, wy, wz, n0, n1, n2)

@@ -103,10 +103,10 @@ def ground_contact(parent, r0, seg, floor, Q, w, R, P, Om, V) -> int:
         ex = R[b, 0, 0] * seg[b, 0] + R[b, 0, 1] * seg[b, 1] + R[b, 0, 2] * seg[b, 2]
         ey = R[b, 1, 0] * seg[b, 0] + R[b, 1, 1] * seg[b, 1] + R[b, 1, 2] * seg[b, 2]
         ez = R[b, 2, 0] * seg[b, 0] + R[b, 2, 1] * seg[b, 1] + R[b, 2, 2] * seg[b, 2]
-        if P[b, 1] + ey >= floor[b]:
+        L = np.sqrt(ex * ex + ey * ey + ez * ez)
+        if P[b, 1] + ey >= floor[b] or not L > 0.0:
             continue
         met += 1
-        L = np.sqrt(ex * ex + ey * ey + ez * ez)
         hor = np.sqrt(ex * ex + ez * ez)
         # the end's new direction: up to the floor, its heading across the ground kept
         dy = min(1.0, max(-1.0, (floor[b] - P[b, 1]) / L))

@@ -8,7 +8,7 @@ import numpy as np
 from .articulated import _cross
 from .compiled import njit
 
-__all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP"]
+__all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP", "FLUTTER_STROUHAL"]
 
 #: The most a leaf turns about one of its axes in one step (rad). The step takes the air's
 #: pull on a turning lamina linearised; in a gale a leaf settles in the flow within 10–20 ms
@@ -19,6 +19,14 @@ MAX_TURN = 0.4
 #: The most a petiole bends (rad): past a right angle, so a leaf whose petiole points upwind
 #: trails downwind of it in a gale instead of being held face-on to the flow.
 PETIOLE_STOP = 0.9 * np.pi
+
+#: f·ℓ/U of a lamina's flutter about its midrib (leaves of 5–15 cm flutter at several hertz in
+#: a 10 m/s wind).
+FLUTTER_STROUHAL = 0.05
+#: The flutter's highest frequency (Hz).
+MAX_FLUTTER_HZ = 12.0
+#: The wind speed (m/s) at which the flutter reaches half its amplitude (U²/(U² + U_f²)).
+FLUTTER_SPEED = 4.0
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
@@ -66,8 +74,8 @@ def _leaf_rotation(E, th, G):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, cauchy, R, P, Om, V, U,
-              flutter, th, thd, F, X, Nrm, kap, Uh, kap2, speed):
+def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, cauchy, size, R, P, Om, V, U,
+              amp, phase, flutter, th, thd, F, X, Nrm, kap, Uh, kap2, speed):
     """Advance every leaf's petiole joint (bend about two axes and twist) over one step, and
     give the force it passes to its twig for the next.
 
@@ -99,9 +107,14 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
     cauchy : (L,) — the lamina's scaled Cauchy number C* per (m/s)²: in the flow it folds and
         rolls, its normal force falls by R = (1 + C*|U_rel|²)^(−1/3) (Gosselin et al. 2010:
         a flexible plate's drag grows as U^(4/3) once C* ≫ 1, Vogel's exponent −2/3).
+    size : (L,) — the lamina's length (m).
     R, P, Om, V : the twigs' new kinematics.
-    U : (L, 3) — the wind at each lamina (m/s).
-    flutter : (L,) — the flutter's twist now (rad): its torque k_t·flutter drives the twist.
+    U : (B, 3) — the wind at each twig body (m/s); a leaf takes its twig's.
+    amp : float — the largest flutter angle (rad), reached edge-on in a strong wind.
+    phase, flutter : (L,) — the flutter's phase (rad) and amplitude (rad), advanced in place:
+        a frequency St·|U|/ℓ (:data:`FLUTTER_STROUHAL`; at most :data:`MAX_FLUTTER_HZ` and a
+        quarter of the step rate), an amplitude ``amp``·U²/(U² + :data:`FLUTTER_SPEED`²). The
+        flutter's twist, flutter·sin(phase), drives the twist through its torque k_t·flutter.
     th, thd : (L, 3) — the state, advanced in place.
     F : (L, 3) — written: the lamina's force (world, N) at X.
     X : (L, 3) — written: the lamina's centroid (world) relative to its twig's joint.
@@ -113,12 +126,20 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
     """
     G = np.empty((3, 3))
     RG = np.empty((3, 3))
+    f_max = min(MAX_FLUTTER_HZ, 0.25 / h)
     for l in range(body.shape[0]):
+        b = body[l]
+        # the flutter: its phase and amplitude in the wind at the twig
+        u2 = U[b, 0] * U[b, 0] + U[b, 1] * U[b, 1] + U[b, 2] * U[b, 2]
+        f = min(FLUTTER_STROUHAL * np.sqrt(u2) / max(size[l], 1e-3), f_max)
+        phase[l] = (phase[l] + 2.0 * np.pi * f * h) % (2.0 * np.pi)
         if not on[l]:
+            flutter[l] = 0.0
             F[l, 0] = F[l, 1] = F[l, 2] = 0.0
             kap[l] = 0.0
             continue
-        b = body[l]
+        flutter[l] = amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED)
+        twist = flutter[l] * np.sin(phase[l])
         _leaf_rotation(E[l], th[l], G)
         for i in range(3):
             for j in range(3):
@@ -136,7 +157,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
         X[l, 0], X[l, 1], X[l, 2] = xx, xy, xz
         # the twig's velocity and acceleration there
         o = _cross(Om[b, 0], Om[b, 1], Om[b, 2], xx, xy, xz)
-        ux, uy, uz = U[l, 0] - V[b, 0] - o[0], U[l, 1] - V[b, 1] - o[1], U[l, 2] - V[b, 2] - o[2]
+        ux, uy, uz = U[b, 0] - V[b, 0] - o[0], U[b, 1] - V[b, 1] - o[1], U[b, 2] - V[b, 2] - o[2]
         s = np.sqrt(ux * ux + uy * uy + uz * uz)
         un = ux * nx + uy * ny + uz * nz
         c = cna[l] / np.cbrt(1.0 + cauchy[l] * s * s)  # the folded lamina's
@@ -164,7 +185,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
             kk = k[l, i]
             ka = 0.0
             if i == 0:  # the lamina rolling about its axis: its halves swing through the air
-                tau = kk * flutter[l]
+                tau = kk * twist
                 d = dstr[l, i] + cswing[l] * s * roll2[l]
             else:
                 tau = E[l, 0, i] * tl0 + E[l, 1, i] * tl1 + E[l, 2, i] * tl2

@@ -386,6 +386,6 @@ class Structure:
                    leaf_base0=c(base0),
                    leaf_rc0=c(rc0), leaf_n0=c(n0), leaf_E=c(Eax), leaf_k=c(leaf_k), leaf_J=c(leaf_J),
                    leaf_d=c(leaf_d), leaf_cna=c(cna), leaf_cswing=c(cswing),
-                   leaf_roll2=c(width**2 / 12.0), leaf_cauchy=c(cauchy), leaf_mass=c(leaf_mass), leaf_size=Llam,
+                   leaf_roll2=c(width**2 / 12.0), leaf_cauchy=c(cauchy), leaf_mass=c(leaf_mass), leaf_size=c(Llam, float),
                    leaf_nodes=c(leaf_nodes, np.int64), leaf_first=leaf_first, body_of_obj=first_body,
                    subtree_mass=sm, omega_j=omega_flex, omega_t=omega_t)

@@ -10,8 +10,8 @@ and writes the next one. One step:
    implicit; pulls (constant forces) and a grab (a stiff spring to a target, implicit);
 3. the articulated-body step (:func:`~treeanim.physics.articulated.articulated_step`);
 4. the new pose of every body, kept above the ground (:func:`~treeanim.physics.kinematics.ground_contact`);
-5. every leaf's petiole joint (:func:`~treeanim.physics.articulated.leaf_step`), its force
-   kept for the twig's next step, and the leaves' flutter phase.
+5. every leaf's flutter and petiole joint (:func:`~treeanim.physics.leafjoint.leaf_step`), its
+   force kept for the twig's next step.
 """
 
 from __future__ import annotations
@@ -26,15 +26,7 @@ from .kinematics import forward_kinematics, ground_contact
 from .leafjoint import leaf_step, pose_nodes
 from .structure import Structure
 
-__all__ = ["TreeState", "Grab", "step", "pose", "energy", "sample_points", "FLUTTER_STROUHAL"]
-
-#: f·ℓ/U of a lamina's flutter about its midrib (leaves of 5–15 cm flutter at several hertz in
-#: a 10 m/s wind).
-FLUTTER_STROUHAL = 0.05
-#: The flutter's highest frequency (Hz).
-MAX_FLUTTER_HZ = 12.0
-#: The wind speed (m/s) at which the flutter reaches half its amplitude (U²/(U² + U_f²)).
-FLUTTER_SPEED = 4.0
+__all__ = ["TreeState", "Grab", "step", "pose", "energy", "sample_points"]
 
 
 @dataclass
@@ -256,8 +248,8 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     ----------
     s : Structure
     st, out : TreeState
-    wind : (B + L, 3) float
-        (B, 3): the wind at :func:`sample_points` of ``st`` (m/s).
+    wind : (B, 3) float
+        The wind at :func:`sample_points` of ``st`` (m/s).
     dt : float
         Step length (s), any length: the step is implicit.
     work : Work
@@ -273,7 +265,6 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     w.F[:] = 0.0
     w.kap[:] = 0.0
     Ub = np.ascontiguousarray(wind)
-    Ul = Ub[s.leaf_body]
     _air_forces(dt, out.R, out.Om, out.V, s.mid0, s.axis, s.cda, Ub, s.leaf_body,
                 out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, out.leaf_speed, w.F, w.kap)
     for b, ofs, f in pulls:
@@ -284,12 +275,10 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.kb, s.kt, s.dk, out.R, out.P, out.Q, out.w,
                      out.Om, out.V, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.Ur, w.u, w.acc)
     ground_contact(s.parent, s.r0, s.seg0, s.floor, out.Q, out.w, out.R, out.P, out.Om, out.V)
-    if len(Ul):
-        _flutter(s, out, Ul, dt, leaf_flutter)
     leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
-              s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, s.leaf_cauchy, out.R, out.P, out.Om, out.V, Ul,
-              out.flutter * np.sin(out.phase), out.th, out.thd, out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap,
-              out.leaf_U, out.leaf_kap2, out.leaf_speed)
+              s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, s.leaf_cauchy, s.leaf_size,
+              out.R, out.P, out.Om, out.V, Ub, float(leaf_flutter), out.phase, out.flutter, out.th, out.thd,
+              out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, out.leaf_speed)
     out.time = st.time + dt
 
 
@@ -339,17 +328,6 @@ def _point_force(b: int, r: np.ndarray, f: np.ndarray, h: float, st: TreeState, 
     w.F[b, 3:] += f
     Ka = float(r @ f) * np.eye(3) - np.outer(r, f)
     _add_turn(b, h, Ka, st.Om, w.F, w.kap)
-
-
-def _flutter(s: Structure, st: TreeState, U: np.ndarray, h: float, amp: float) -> None:
-    """Advance the laminas' flutter: a frequency St·|U|/ℓ (at most :data:`MAX_FLUTTER_HZ` and a
-    quarter of the step rate), an amplitude growing as U²/(U² + U_f²)."""
-    speed = np.sqrt(np.einsum("ij,ij->i", U, U))
-    f = np.minimum(FLUTTER_STROUHAL * speed / np.maximum(s.leaf_size, 1e-3), min(MAX_FLUTTER_HZ, 0.25 / h))
-    st.phase += 2 * np.pi * f * h
-    np.mod(st.phase, 2 * np.pi, out=st.phase)
-    u2 = speed * speed
-    st.flutter[:] = amp * u2 / (u2 + FLUTTER_SPEED**2) * s.leaf_on
 
 
 def pose(s: Structure, st: TreeState, rest: np.ndarray, pos: np.ndarray, rot: np.ndarray) -> None:
