@@ -207,6 +207,12 @@ def test_registering_checks_the_class(registry):
 
     with pytest.raises(TypeError, match=r"@settings\(''\)"):
         type("Bad", (WindField,), {"Params": Undeclared, "_sample": lambda self, p, t, out: None})
+    @settings("")
+    class Clash(WindParams):
+        frame: Annotated[float, Param(0.0, 1.0)] = 0.0
+
+    with pytest.raises(TypeError, match="frame would hide WindField's own"):
+        type("Hiding", (WindField,), {"Params": Clash, "_sample": lambda self, p, t, out: None})
     with pytest.raises(ValueError, match="already registered"):
         register_wind_model("paper")(type("Again", (WindField,), {"Params": Own, "_sample": lambda *a: None}))
     assert WIND_MODELS["paper"] is PaperWind

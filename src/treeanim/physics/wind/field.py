@@ -89,6 +89,9 @@ def _check_params(cls) -> None:
         raise TypeError(f"{cls.__name__}.Params must subclass WindParams, got {params!r}")
     if params is not WindParams and "__pydantic_fields__" not in vars(params):
         raise TypeError(f"{cls.__name__}.Params must be decorated with @settings('') (treeanim.model.declare)")
+    taken = [name for name in params_of(params) if name in vars(WindField)]
+    if taken:
+        raise TypeError(f"{cls.__name__}.Params: {', '.join(taken)} would hide WindField's own")
 
 
 def _refusal(cls, name: str) -> str:
