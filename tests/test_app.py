@@ -530,7 +530,8 @@ def test_panel_apply_sets_physics_season_and_time(viewer):
     assert not p.apply("wind_preset", "hurricane")
     assert p.apply("turbulence", 0.45)
     assert p.apply("beta_u", 2.0) and v.sim.wind.beta_u == 2.0
-    assert p.apply("c3", 0.8) and v.sim.wind.c3 == 0.8  # kept (paper only), validated
+    assert not p.apply("c3", 0.8)  # the paper wind's setting: refused by the physical wind, in one line
+    assert v.messages[-1].startswith("error: c3: a setting of the paper wind model")
     assert p.apply("paper_model", True) and v.sim.model == "paper"
     assert p.apply("integrator", "euler") and v.sim.integrator == "euler"
     assert p.apply("coupling", False) and not v.sim.coupling

@@ -83,7 +83,7 @@ def test_same_inputs_same_result(name, seed, speed, steps):
     tree, _, _ = preset(name)
     runs = []
     for _ in range(2):
-        sim = PaperSim(tree, wind=ta.WindField(speed=speed, seed=seed, grid=16), seed=seed)
+        sim = PaperSim(tree, wind=ta.WindField(speed=speed, seed=seed, grid=16, model="paper"), seed=seed)
         for _ in range(steps):
             sim.step(1 / 60)
         runs.append(sim.positions)

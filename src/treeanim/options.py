@@ -150,10 +150,10 @@ def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> Non
 
 def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
     """Wind, season and seed options (the scene around the tree)."""
-    from treeanim.physics.wind import MODELS
+    from treeanim.physics.wind import WIND_MODELS
 
     add_wind_speed_options(p, wind)
-    p.add_argument("--wind-model", choices=list(MODELS), default=None,
+    p.add_argument("--wind-model", choices=list(WIND_MODELS), default=None,
                    help="physical (default: turbulence in metres carried downwind, gusts, canopy profile) "
                    "or paper (Hu, Chiba & He 2012, Eqs. 13-18; the default with --paper)")
     p.add_argument("--wind-dir", type=vector("direction"), default=(1.0, 0.0, 0.0), metavar="X,Y,Z",
@@ -168,8 +168,9 @@ def add_wind_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
 
 
 def wind_settings(args) -> dict:
-    """WindField keyword arguments from :func:`add_wind_options` (speed 0 means calm: no field)."""
-    from treeanim.physics.wind import wind_preset
+    """WindField keyword arguments from :func:`add_wind_options` (speed 0 means calm: no field);
+    ``--seed`` goes to a wind model that has a seed."""
+    from treeanim.physics.wind import wind_model, wind_preset
 
     model = getattr(args, "wind_model", None)
     kw = dict(model=model or ("paper" if getattr(args, "paper", False) else "physical"))
@@ -182,7 +183,9 @@ def wind_settings(args) -> dict:
         kw["speed"] = args.wind
     if getattr(args, "turbulence", None) is not None:
         kw["turbulence"] = args.turbulence
-    kw.update(direction=args.wind_dir, seed=args.seed)
+    kw["direction"] = args.wind_dir
+    if "seed" in wind_model(kw["model"]).parameters():
+        kw["seed"] = args.seed
     return kw
 
 

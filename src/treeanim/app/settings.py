@@ -85,7 +85,7 @@ def _physical(v) -> bool:
 
 
 def _paper(v) -> bool:
-    return v.sim.wind.model != "physical"
+    return v.sim.wind.model == "paper"
 
 
 def _paper_model(v) -> bool:
@@ -106,7 +106,9 @@ def _paper_only(setting: Setting) -> Setting:
 
 
 def _wind(name: str, label: str, lo: float, hi: float, fmt: str = "%.2f", **kw) -> Setting:
-    """A wind field setting, through the WindField's checked setter of ``name``."""
+    """A wind field setting, through the WindField's checked setter of ``name``; shown (by
+    default) for the wind models that have it."""
+    kw.setdefault("shown", lambda v: name in v.sim.wind.parameters())
     return Setting(label, lambda v: getattr(v.sim.wind, name), lambda v, x: v.set_wind(**{name: float(x)}),
                    lo=lo, hi=hi, fmt=fmt, **kw)
 
@@ -185,13 +187,13 @@ SETTINGS: dict[str, Setting] = {
                           lambda v, x: v.set_wind(angle=float(x)), lo=0.0, hi=360.0, fmt="%.0f°"),
     "turbulence": _wind("turbulence", "turbulence", 0.0, 1.0, shown=_physical),  # intensity at the canopy top
     "turbulence_paper": _wind("turbulence", "turbulence λ", 1.0, 2.0, shown=_paper),  # λ of Eq. 17
-    "gust_strength": _wind("gust_strength", "gust strength", 0.0, 2.0, shown=_physical),
-    "gust_rate": _wind("gust_rate", "gust rate", 0.0, 30.0, "%.1f /min", shown=_physical),
-    "length_scale": _wind("length_scale", "length scale", 0.5, 100.0, "%.1f m", log=True, shown=_physical),
+    "gust_strength": _wind("gust_strength", "gust strength", 0.0, 2.0),
+    "gust_rate": _wind("gust_rate", "gust rate", 0.0, 30.0, "%.1f /min"),
+    "length_scale": _wind("length_scale", "length scale", 0.5, 100.0, "%.1f m", log=True),
     "beta_u": _wind("beta_u", "β_u", 0.5, 3.0, deferred=True),
     "beta_vw": _wind("beta_vw", "β_vw", 0.5, 3.0, deferred=True),
-    "c3": _wind("c3", "c3 (vertical)", 0.0, 2.0, shown=_paper),
-    "c4": _wind("c4", "c4 (lateral)", 0.0, 2.0, shown=_paper),
+    "c3": _wind("c3", "c3 (vertical)", 0.0, 2.0),
+    "c4": _wind("c4", "c4 (lateral)", 0.0, 2.0),
     # physics: the range is the preset's value ÷ or × EI_SPAN (Panel.tree_changed)
     "ei_max": _physics("ei_max"),
     **{f"{what}:{kind}": _modes(what, kind) for kind in KINDS for what in ("f", "zeta")},

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
+import operator
 import types
 import typing
 from dataclasses import dataclass
@@ -28,7 +30,9 @@ class Param:
     """The declaration of one number: its bounds, unit, help and how the panel shows it.
 
     ``Annotated[float, Param(0, 1e12, lo_open=True, unit="N·m²", help=...)] = 2.5e4`` declares
-    a float in (0, 1e12] with default 2.5e4; ``tuple[X, X]`` of such an annotation, a pair.
+    a float in (0, 1e12] with default 2.5e4; ``tuple[X, X]`` of such an annotation, a pair;
+    ``X | None`` (default None), a number or None (the owner's "automatic");
+    ``Annotated[int, Param(4, 256, integer=True)]``, an integer.
 
     Attributes
     ----------
@@ -47,6 +51,8 @@ class Param:
         printf format of a widget showing it (the unit is appended).
     log : bool
         A slider over it is logarithmic.
+    integer : bool
+        An integer (any int or numpy integer; bools and floats refused), not a float.
     """
 
     lo: float
@@ -57,16 +63,21 @@ class Param:
     label: str = ""
     fmt: str = "%.3g"
     log: bool = False
+    integer: bool = False
 
     @property
     def interval(self) -> str:
-        """The range as text: ``(0, 1e+12]`` or ``[0, 100]``."""
-        return f"{'(' if self.lo_open else '['}{self.lo:g}, {self.hi:g}]"
+        """The range as text: ``(0, 1e+12]``, ``[0, 100]`` or ``[0, inf)``."""
+        return f"{'(' if self.lo_open else '['}{self.lo:g}, {self.hi:g}{')' if self.hi == math.inf else ']'}"
 
     @property
     def expected(self) -> str:
-        """What a value must be, for messages: ``a number in (0, 1e+12]``."""
-        return f"a number in {self.interval}"
+        """What a value must be, for messages: ``a number in (0, 1e+12]``, ``an integer in [4,
+        256]``, ``a finite number`` (no bounds)."""
+        what = "an integer" if self.integer else "a number"
+        if self.lo == -math.inf and self.hi == math.inf:
+            return f"a finite {what.split()[-1]}"
+        return f"{what} in {self.interval}"
 
     @property
     def widget_format(self) -> str:
@@ -75,10 +86,25 @@ class Param:
 
     def __get_pydantic_core_schema__(self, source, handler):
         # A strict float (bools and strings refused, any int or numpy number taken), finite, in
-        # range; -0.0 stored as 0.0.
+        # range; -0.0 stored as 0.0. An integer: any int or numpy integer (operator.index),
+        # in range; bools, floats and strings refused.
         bound = {"gt" if self.lo_open else "ge": self.lo, "le": self.hi}
+        bound = {k: v for k, v in bound.items() if math.isfinite(v)}
+        if self.integer:
+            return core_schema.no_info_before_validator_function(_index, core_schema.int_schema(strict=True, **bound))
         number = core_schema.float_schema(strict=True, allow_inf_nan=False, **bound)
         return core_schema.no_info_after_validator_function(lambda x: x + 0.0, number)
+
+
+def _index(x):
+    """``x`` as an int where it is an integer of any kind but a bool; else ``x`` unchanged (for
+    the strict integer check to refuse)."""
+    if isinstance(x, bool):
+        return x
+    try:
+        return operator.index(x)
+    except TypeError:
+        return x
 
 
 class SettingError(ValueError):
@@ -106,7 +132,8 @@ def settings(prefix: str):
     ``dataclasses.replace``) raises :class:`SettingError` on the first refused value.
 
     Nested tables may be given as dicts and pairs as lists (as TOML has them); numbers are never
-    converted from strings or bools. Unknown keywords are refused.
+    converted from strings or bools. Unknown keywords are refused. An empty ``prefix`` names
+    the settings by their keys alone (``turbulence: expected ...``).
     """
 
     def wrap(cls):
@@ -132,11 +159,14 @@ def _hints(cls) -> dict:
 
 
 def _param(hint) -> Param | None:
-    """The Param of ``Annotated[float, Param]`` or ``tuple[that, that]``."""
+    """The Param of ``Annotated[float, Param]``, ``tuple[that, that]`` or ``that | None``."""
     if typing.get_origin(hint) is typing.Annotated:
         return next((m for m in hint.__metadata__ if isinstance(m, Param)), None)
     if typing.get_origin(hint) is tuple:
         return _param(typing.get_args(hint)[0])
+    if typing.get_origin(hint) in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(hint) if a is not type(None)]
+        return _param(args[0]) if len(args) == 1 else None
     return None
 
 
@@ -149,6 +179,10 @@ def _table(hint):
 
 def _is_pair(hint) -> bool:
     return typing.get_origin(hint) is tuple
+
+
+def _is_optional(hint) -> bool:
+    return typing.get_origin(hint) in (typing.Union, types.UnionType) and type(None) in typing.get_args(hint)
 
 
 def params_of(cls) -> dict[str, Param]:
@@ -190,7 +224,7 @@ def _error(cls, e: ValidationError) -> SettingError:
         if nested is None or i == len(loc) - 1:
             break
         owner = nested
-    key = ".".join([_PREFIX[cls], *loc]) if loc else _PREFIX[cls]
+    key = ".".join([x for x in (_PREFIX[cls], *loc) if x]) or cls.__name__
     param = _param(hint) if hint is not None else None
     if kind in ("unexpected_keyword_argument", "extra_forbidden"):
         names = ", ".join(f.name for f in dataclasses.fields(owner))
@@ -203,7 +237,8 @@ def _error(cls, e: ValidationError) -> SettingError:
     if pair and (not element or kind == "missing"):
         return SettingError(key, f"expected a pair [min, max] of numbers in {param.interval}, got {describe(value)}")
     if param is not None:
-        return SettingError(key, f"expected {param.expected}, got {describe(value)}")
+        optional = value is not None and _is_optional(hint)
+        return SettingError(key, f"expected {param.expected}{' or None' if optional else ''}, got {describe(value)}")
     if kind.startswith(("dataclass", "model")) or _table(hint) is not None:
         return SettingError(key, f"expected a table, got {describe(value)}")
     return SettingError(key, f"{err['msg']}, got {describe(value)}")

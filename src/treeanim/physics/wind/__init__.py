@@ -1,4 +1,12 @@
-"""Wind over trees: the physical field (default) and the paper's (Hu, Chiba & He 2012).
+"""Wind over trees: wind models behind one base class and a registry.
+
+Every wind model subclasses :class:`WindField` (``field.py``: direction, speed, the fitted
+box, the checks of ``sample``, the settings' properties) and is registered by name in
+:data:`WIND_MODELS` (:func:`register_wind_model`), with its own settings declared once in its
+``Params`` (``model/declare.py``); ``WindField(model=NAME, ...)`` builds one. Registered here:
+``"physical"`` (:class:`PhysicalWind`, ``physical.py``; the default) and ``"paper"``
+(:class:`PaperWind`, ``paper.py``; Hu, Chiba & He 2012). docs/design.md, "Adding a wind model",
+shows how to add one.
 
 ``WindField(model="physical")`` (docs/design.md §12, issue 11) is weather-like wind:
 
@@ -59,10 +67,13 @@ Named winds by Beaufort number (:data:`WIND_PRESETS`, :func:`wind_preset`,
 
 import numpy as np
 
-from .field import WindField
-from .paper import fbm_noise
-from .physical import SIGMA_RATIOS
-from .settings import DEFAULT_BOUNDS, MAX_SPEED, MODELS, WIND_PRESETS, wind_preset
+from .field import DEFAULT_MODEL, WIND_MODELS, WindField, WindParams, register_wind_model, wind_model
+from .paper import PaperParams, PaperWind, fbm_noise
+from .physical import SIGMA_RATIOS, PhysicalParams, PhysicalWind
+from .settings import DEFAULT_BOUNDS, MAX_SPEED, WIND_PRESETS, wind_preset
+
+#: The registry under its older name (the same dict).
+MODELS = WIND_MODELS
 
 
 def fit_to_tree(wind, rest_positions) -> None:
@@ -90,5 +101,6 @@ def fit_to_tree(wind, rest_positions) -> None:
     else:
         wind.bounds = box
 
-__all__ = ["fit_to_tree", "fbm_noise", "WindField", "WIND_PRESETS", "wind_preset", "MODELS", "DEFAULT_BOUNDS", "MAX_SPEED",
-           "SIGMA_RATIOS"]
+__all__ = ["fit_to_tree", "fbm_noise", "WindField", "WindParams", "WIND_MODELS", "DEFAULT_MODEL", "register_wind_model",
+           "wind_model", "PhysicalWind", "PhysicalParams", "PaperWind", "PaperParams", "WIND_PRESETS", "wind_preset",
+           "MODELS", "DEFAULT_BOUNDS", "MAX_SPEED", "SIGMA_RATIOS"]

@@ -1,14 +1,19 @@
-"""The paper's wind field (Hu, Chiba & He 2012, Eqs. 13–18): 1/f^β noise grids and their sampling."""
+"""The paper's wind model (Hu, Chiba & He 2012, Eqs. 13–18): 1/f^β noise grids, their sampling
+and :class:`PaperWind`, the model registered as ``"paper"``."""
 
 from __future__ import annotations
 
 import math
+import threading
 from functools import lru_cache
+from typing import Annotated
 
 import numpy as np
 import scipy.fft
 
-from ...validate import finite_float, float_within
+from ...model.declare import Param, settings
+from ...validate import float_within
+from .field import WindField, WindParams, register_wind_model
 from .settings import _CHUNK, _COORD_CLIP, _GRID_CLIP, MAX_BETA, MAX_COEFF, MAX_GRID, _integer
 
 
@@ -209,14 +214,6 @@ def _corner_offsets(mp: int) -> np.ndarray:
     return off.reshape(8)
 
 
-def check_c2(value) -> float:
-    """c2 of Eq. 16 (1/m), a finite number in [1e-12, 1e12], or ValueError."""
-    c2 = finite_float("c2", value)
-    if not 1e-12 <= c2 <= 1e12:
-        raise ValueError(f"c2 must be in [1e-12, 1e12] (1/m), got {value!r}")
-    return c2
-
-
 def profile_constants(b: np.ndarray, c1: float | None, c2: float | None) -> tuple[float, float]:
     """(c1, c2) of Eq. 16 for the bounds ``b``: None gives the defaults, c2 = 50 / y1 (the
     profile starts at 2 % of the top) and c1 = 1 / ln(c2·y1) (W = 1 at the top). ValueError
@@ -252,28 +249,160 @@ def lookup_tables(grids: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return uv, g[2].astype(np.float32).ravel()
 
 
-def _sample_paper(wind, p: np.ndarray, t: float, out: np.ndarray) -> None:
+def _sample_paper(wind: PaperWind, p: np.ndarray, t: float, out: np.ndarray) -> None:
     """Eqs. 13–18 at the points ``p`` (K, 3) and time ``t``, into ``out`` (K, 3), in chunks."""
     k = p.shape[0]
-    n = wind._grid
+    w = wind._params
+    n = w.grid
     tables = wind._lookup_tables()
     lo = wind._bounds[0]
     scale = (n - 1) / (wind._bounds[1] - wind._bounds[0])
     # Eq. 17: x(N−1) − c5 t, y(N−1), z(N−1) − c6 t, in the wind frame (see module doc):
     # grid coordinates q = M (p − lo) − shift, M = frame · diag(scale). The shifts are
     # reduced modulo the period N first, so no finite t overflows.
-    shift = np.array([_wrap_shift(wind._c5, t, n), 0.0, _wrap_shift(wind._c6, t, n)])
+    shift = np.array([_wrap_shift(w.c5, t, n), 0.0, _wrap_shift(w.c6, t, n)])
     m = wind._frame * scale[None, :]
     offset = -(m @ lo) - shift
-    c1, c2 = wind._profile_constants()
-    c3, c4 = wind._c3, wind._c4
+    c1, c2 = profile_constants(wind._bounds, w.c1, w.c2)
+    c3, c4 = w.c3, w.c4
     consts = (
         m, offset, n, tables,
         c1, -math.log(c2), c3, c4,
         1.0 / math.sqrt(1.0 + 0.25 * c3 * c3 + 0.25 * c4 * c4),  # 1 / s1
-        wind._turbulence, wind._speed, wind._frame,
+        w.turbulence, w.speed, wind._frame,
     )
     ws = wind._workspace(min(k, _CHUNK))
     for start in range(0, k, _CHUNK):
         stop = min(start + _CHUNK, k)
         _sample_chunk(p[start:stop], out[start:stop], ws, consts)
+
+
+def _coefficient(hi: float, help: str, **kw) -> Param:
+    return Param(0.0, hi, help=help, **kw)
+
+
+@settings("")
+class PaperParams(WindParams):
+    """The paper's settings (Eqs. 13–18); ``speed`` is the mean-profile speed at the tree top."""
+
+    grid: Annotated[int, Param(4, MAX_GRID, integer=True, help="Edge N of the three N³ noise grids "
+                               "(rebuilds them when changed).")] = 32
+    beta_u: Annotated[float, Param(-MAX_BETA, MAX_BETA, label="β_u", help="Spectral exponent of the "
+                                   "along-wind noise (Eq. 15; rebuilds the grids).")] = 1.67
+    beta_vw: Annotated[float, Param(-MAX_BETA, MAX_BETA, label="β_vw", help="Spectral exponent of the "
+                                    "vertical and lateral noise (Eq. 15; rebuilds the grids).")] = 1.33
+    turbulence: Annotated[float, Param(1.0, 2.0, label="turbulence λ", help="λ of Eq. 17.")] = 1.5
+    c1: Annotated[float, _coefficient(MAX_COEFF, "c1 of Eq. 16; None: 1 / ln(c2·H), so W(H) = 1.")] | None = None
+    c2: Annotated[float, Param(1e-12, 1e12, unit="1/m", help="c2 of Eq. 16, W = 0 below h = 1/c2; "
+                               "None: 50 / H (2 % of the tree top H).")] | None = None
+    c3: Annotated[float, _coefficient(MAX_COEFF, "Vertical turbulence scale of Eq. 17.")] = 0.5
+    c4: Annotated[float, _coefficient(MAX_COEFF, "Lateral turbulence scale of Eq. 17.")] = 1.0
+    c5: Annotated[float, Param(-math.inf, math.inf, unit="cells/s", help="Downwind speed of the frozen "
+                               "turbulence (Eq. 17).")] = 4.0
+    c6: Annotated[float, Param(-math.inf, math.inf, unit="cells/s", help="Lateral drift of the frozen "
+                               "turbulence (Eq. 17).")] = 0.5
+    seed: Annotated[int, Param(0, math.inf, integer=True, help="Seed of the noise grids (rebuilds them).")] = 0
+
+
+@register_wind_model("paper")
+class PaperWind(WindField):
+    """The paper's wind: Hu, Chiba & He (2012) Eqs. 13–18 exactly as before issue 11 (same
+    samples, bit for bit, for the same settings; ``tests/data/wind_paper_reference.npz``).
+
+    Three periodic N³ 1/f^β noise grids (:func:`fbm_noise`) sampled trilinearly in the wind's
+    frame in the tree's box (``bounds``, N − 1 cells across it), drifting c5 cells/s downwind
+    and c6 across; the log profile W(h) = c1·ln(c2·h) (Eq. 16), Eq. 17's normalisation and
+    Eq. 18's frame. Outside the box the field repeats periodically. Settings: :class:`PaperParams`
+    (``grid``, ``beta_u``, ``beta_vw``, ``turbulence`` = λ, ``c1`` … ``c6``, ``seed``) and
+    :class:`WindField`'s. The bounds' top y1 is H (and must be above the ground while c1 or c2
+    is automatic).
+
+    Notes
+    -----
+    Eq. 17 makes the speed of each sample W·(1 + λ(s2/s1 − 0.5)); the mean of that factor over
+    one seed's grids is near 1 (about 0.85–1.0). The grids are standardised to exactly
+    [−0.5, 0.5], which leaves each a small residual mean, so one seed's mean wind can be a few
+    degrees off ``direction``. Interpolation runs in float32. Changing the direction rotates
+    the sampling frame about the bounds, so the turbulence seen by a fixed point jumps.
+    """
+
+    Params = PaperParams
+
+    def __init__(self, *args, **kwargs):
+        self._tables = None  # padded, raveled float32 grids, built on first use
+        self._local = threading.local()  # per-thread scratch buffers for sample()
+        super().__init__(*args, **kwargs)
+
+    def _check(self, params: PaperParams, bounds: np.ndarray) -> None:
+        profile_constants(bounds, params.c1, params.c2)
+
+    def _changing(self, params: PaperParams, bounds: np.ndarray) -> None:
+        old = self._params
+        if (params.grid, params.beta_u, params.beta_vw, params.seed) != (old.grid, old.beta_u, old.beta_vw, old.seed):
+            self._tables = None
+
+    @property
+    def c1(self) -> float:
+        """Effective c1 of Eq. 16 (set None for 1 / ln(c2·H))."""
+        return profile_constants(self._bounds, self._params.c1, self._params.c2)[0]
+
+    @c1.setter
+    def c1(self, value) -> None:
+        self._set(c1=value)
+
+    @property
+    def c2(self) -> float:
+        """Effective c2 of Eq. 16 in 1/m (set None for 50 / H)."""
+        return profile_constants(self._bounds, self._params.c1, self._params.c2)[1]
+
+    @c2.setter
+    def c2(self, value) -> None:
+        self._set(c2=value)
+
+    def profile(self, h) -> np.ndarray:
+        """Mean wind profile W(h) = c1·ln(c2·h) of Eq. 16: the mean speed at height h over
+        ``speed``; 0 below h = 1/c2, 1 at the top of the bounds by default.
+
+        Parameters
+        ----------
+        h : array_like
+            Heights above the ground in metres (world y).
+
+        Returns
+        -------
+        numpy.ndarray
+            The profile, dimensionless, same shape as h.
+        """
+        h = np.asarray(h, dtype=np.float64)
+        if not np.all(np.isfinite(h)):
+            raise ValueError("h must be finite")
+        c1, c2 = self.c1, self.c2
+        log_h0 = -math.log(c2)
+        # ln(c2·h) = ln h − ln(1/c2), written so that no finite h overflows.
+        return c1 * (np.log(np.maximum(h, math.exp(log_h0))) - log_h0)
+
+    @property
+    def grids(self) -> np.ndarray:
+        """(3, N, N, N) float64 noise grids FBM_u, FBM_v, FBM_w (Eq. 15), read-only.
+
+        Axes are (along wind, vertical, lateral) grid indices, i.e. (i, j, k) of Eq. 15.
+        """
+        w = self._params
+        g = np.stack([_cached_grid(w.grid, w.beta_u, w.seed, 0), _cached_grid(w.grid, w.beta_vw, w.seed, 1),
+                      _cached_grid(w.grid, w.beta_vw, w.seed, 2)])
+        g.setflags(write=False)
+        return g
+
+    def _lookup_tables(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._tables is None:
+            self._tables = lookup_tables(self.grids)
+        return self._tables
+
+    def _workspace(self, n: int) -> _Workspace:
+        ws = getattr(self._local, "ws", None)
+        if ws is None or ws.capacity < n:
+            ws = self._local.ws = _Workspace(max(n, 256))
+        return ws
+
+    def _sample(self, p: np.ndarray, t: float, out: np.ndarray) -> None:
+        _sample_paper(self, p, t, out)

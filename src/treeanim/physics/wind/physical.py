@@ -1,6 +1,7 @@
-"""The physical wind (docs/design.md §12): a von Kármán tile carried downwind, a canopy profile, gusts.
+"""The physical wind (docs/design.md §12): a von Kármán tile carried downwind, a canopy profile,
+gusts; :class:`PhysicalWind`, the model registered as ``"physical"`` (the default).
 
-A call of ``WindField.sample`` works out what is the same for every point in Python (the
+A call of ``PhysicalWind.sample`` works out what is the same for every point in Python (the
 clocks, the two layers' whole-cell offsets and weights, the wind frame, the gusts' widths,
 the cached tile) and hands them to one compiled pass over the points (``_sample_points``):
 each point's cell coordinates, its periodic trilinear look-up of the two blended layers,
@@ -11,17 +12,26 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import TYPE_CHECKING
+from typing import Annotated
 
 import numpy as np
 import scipy.fft
 
+from ...model.declare import Param, settings
 from ..compiled import njit
-from .settings import _COORD_CLIP, _GRID_CLIP
-
-if TYPE_CHECKING:
-    from .field import WindField
-
+from .field import WindField, WindParams, register_wind_model
+from .settings import (
+    _COORD_CLIP,
+    _GRID_CLIP,
+    _MAX_LENGTH,
+    _MIN_LENGTH,
+    _TIME_CLIP,
+    EVOLUTION_LENGTH,
+    MAX_BETA,
+    MAX_GUST_RATE,
+    MAX_GUST_STRENGTH,
+    MIN_AUTO_LENGTH,
+)
 
 #: The physical tile: cells along, up and across the wind; cells per length scale L.
 _TILE = (128, 48, 96)
@@ -160,7 +170,7 @@ def _gust_sum(base: np.uint64, gam: float, sr: float, sd: float) -> float:
     return total - math.sqrt(0.5 * math.pi) * (sr + sd)  # mean of A (1) × area per gust
 
 
-def _gust_params(wind: "WindField", g: float) -> tuple[float, float, float, float, float, float]:
+def _gust_params(wind: PhysicalWind, g: float) -> tuple[float, float, float, float, float, float]:
     """The gusts of one call: (strength, gust clock g, gusts per metre, rise and decay
     widths in gusts, lattice step in metres); strength 0 where there are none."""
     rg = wind.gust_rate / 60.0
@@ -344,7 +354,7 @@ def _sample_points(p, out, frame, cell, shift, table, offsets, weights, inv_top,
             out[i, d] = u * ratio[0, d] + v * ratio[1, d] + w * ratio[2, d]
 
 
-def _sample_physical(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray) -> None:
+def _sample_physical(wind: PhysicalWind, p: np.ndarray, t: float, out: np.ndarray) -> None:
     """The physical wind at the points ``p`` (K, 3) and time ``t`` into ``out`` (K, 3): what
     is the same for every point, then :func:`_sample_points`."""
     length = wind.length_scale
@@ -362,3 +372,145 @@ def _sample_physical(wind: "WindField", p: np.ndarray, t: float, out: np.ndarray
                    table, tuple(offsets), tuple(weights), 1.0 / wind.canopy_height,
                    wind.turbulence * wind.speed, wind.speed / SIGMA_RATIOS[0], _gust_params(wind, g),
                    _stream(wind.seed, 31))
+
+
+def _length(help: str) -> Param:
+    return Param(_MIN_LENGTH, _MAX_LENGTH, unit="m", fmt="%.1f", log=True, help=help)
+
+
+def _beta(help: str) -> Param:
+    return Param(-MAX_BETA, MAX_BETA, help=help + " (rebuilds the tile when changed).")
+
+
+@settings("")
+class PhysicalParams(WindParams):
+    """The physical wind's settings; ``speed`` is the mean speed at the canopy top."""
+
+    turbulence: Annotated[float, Param(0.0, 1.0, help="Along-wind turbulence intensity σ_u/U at the canopy "
+                                       "top.")] = 0.3
+    length_scale: Annotated[float, _length("Along-wind integral length scale L of the "
+                                           "turbulence (L/3 vertically and laterally); None: the canopy "
+                                           "height, at least 1 m.")] | None = None
+    canopy_height: Annotated[float, _length("Canopy height h: the height of speed and of "
+                                            "the canopy profile; None: the top of the bounds.")] | None = None
+    gust_strength: Annotated[float, Param(0.0, MAX_GUST_STRENGTH, help="Mean peak speed of a gust above the "
+                                          "mean, as a fraction of it.")] = 0.3
+    gust_rate: Annotated[float, Param(0.0, MAX_GUST_RATE, unit="per minute", fmt="%.1f",
+                                      help="Gusts per minute passing a point.")] = 4.0
+    beta_u: Annotated[float, _beta("Spectral exponent of the along-wind turbulence")] = 5.0 / 3.0
+    beta_vw: Annotated[float, _beta("Spectral exponent of the vertical and lateral turbulence")] = 5.0 / 3.0
+    seed: Annotated[int, Param(0, math.inf, integer=True, help="Seed of the turbulence and the gusts.")] = 0
+
+
+def _canopy_height(params: PhysicalParams, bounds: np.ndarray) -> float:
+    if params.canopy_height is not None:
+        return params.canopy_height
+    return min(max(float(bounds[1, 1]), _MIN_LENGTH), _MAX_LENGTH)
+
+
+def _length_scale(params: PhysicalParams, bounds: np.ndarray) -> float:
+    if params.length_scale is not None:
+        return params.length_scale
+    return max(_canopy_height(params, bounds), MIN_AUTO_LENGTH)
+
+
+def _rates(params: PhysicalParams, bounds: np.ndarray) -> tuple[float, float, float]:
+    """(downwind travel m/s, evolution cycles/s, gusts/s) at these settings."""
+    u = params.speed
+    return u, u / (EVOLUTION_LENGTH * _length_scale(params, bounds)), params.gust_rate / 60.0
+
+
+@register_wind_model("physical")
+class PhysicalWind(WindField):
+    """Weather-like wind (docs/design.md §12, issue 11): turbulence in metres carried downwind at
+    the wind speed (Taylor), evolving along its way so that it never repeats, with a von Kármán
+    f^−β spectrum, a canopy profile and gusts; see :mod:`treeanim.physics.wind`.
+
+    Settings: :class:`PhysicalParams` (``turbulence`` = σ_u/U, ``length_scale``,
+    ``canopy_height``, ``gust_strength``, ``gust_rate``, ``beta_u``, ``beta_vw``, ``seed``) and
+    :class:`WindField`'s. Only the top of ``bounds`` is used: the canopy height when
+    ``canopy_height`` is None; the turbulence stays in metres whatever the box.
+
+    Notes
+    -----
+    Changing the speed, the length scale or the gust rate (or the canopy height or box they
+    follow) keeps the field continuous in time: the downwind travel, the evolution and the gust
+    clock are integrated piecewise from the last sampled time, so ``sample`` is a pure function
+    of ``t`` between changes. The turbulence repeats every 8 L along the wind, 6 L across and
+    3 L up, in space only; in time it never repeats. Turning the wind rotates the field about
+    the world origin.
+    """
+
+    Params = PhysicalParams
+
+    def __init__(self, *args, **kwargs):
+        # The clocks: (t0, travel a0 in m, evolution s0 in cycles, gusts g0) at t0; each
+        # advances linearly from t0 at its current rate (see _changing).
+        self._clock = (0.0, 0.0, 0.0, 0.0)
+        self._t_last = 0.0
+        super().__init__(*args, **kwargs)
+
+    @property
+    def length_scale(self) -> float:
+        """Along-wind integral length scale L of the turbulence, m (set None for automatic: the
+        canopy height, at least 1 m)."""
+        return _length_scale(self._params, self._bounds)
+
+    @length_scale.setter
+    def length_scale(self, value) -> None:
+        self._set(length_scale=value)
+
+    @property
+    def canopy_height(self) -> float:
+        """Canopy height h, m: the height of ``speed`` and of the profile's displacement (0.7 h)
+        and roughness (0.1 h). Set None for the top of ``bounds``."""
+        return _canopy_height(self._params, self._bounds)
+
+    @canopy_height.setter
+    def canopy_height(self, value) -> None:
+        self._set(canopy_height=value)
+
+    def _clocks(self, t: float) -> tuple[float, float, float]:
+        """(travel a in m, evolution s in cycles, gust count g) at time t."""
+        t0, a0, s0, g0 = self._clock
+        dt = min(max(t - t0, -_TIME_CLIP), _TIME_CLIP)
+        ra, rs, rg = _rates(self._params, self._bounds)
+        return a0 + ra * dt, s0 + rs * dt, g0 + rg * dt
+
+    def _changing(self, params: PhysicalParams, bounds: np.ndarray) -> None:
+        # A rate changes: the clocks start afresh at the last sampled time.
+        if _rates(params, bounds) != _rates(self._params, self._bounds):
+            t = self._t_last
+            self._clock = (t, *self._clocks(t))
+
+    def profile(self, h) -> np.ndarray:
+        """Mean wind profile: the mean speed at height h over ``speed``.
+
+        ln((h − d)/z0) / ln((h_c − d)/z0) above the canopy height h_c (d = 0.7 h_c,
+        z0 = 0.1 h_c) and exp(a(h/h_c − 1)) inside it, with a = 1/(0.3 ln 3) ≈ 3.03 so the two
+        meet smoothly; 1 at h_c.
+
+        Parameters
+        ----------
+        h : array_like
+            Heights above the ground in metres (world y).
+
+        Returns
+        -------
+        numpy.ndarray
+            The profile, dimensionless, same shape as h.
+        """
+        h = np.asarray(h, dtype=np.float64)
+        if not np.all(np.isfinite(h)):
+            raise ValueError("h must be finite")
+        return _canopy_mean(h, self.canopy_height)
+
+    def sample(self, points, t: float) -> np.ndarray:
+        """:meth:`WindField.sample`; the time is kept (calm too): a later change of a rate
+        restarts the clocks there."""
+        out = super().sample(points, t)
+        self._t_last = float(t)  # valid: sample checked it
+        return out
+
+    def _sample(self, p: np.ndarray, t: float, out: np.ndarray) -> None:
+        _sample_physical(self, p, t, out)

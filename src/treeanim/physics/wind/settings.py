@@ -1,4 +1,4 @@
-"""The wind's limits, defaults and named winds (Beaufort), and the checks of its settings."""
+"""The wind's limits, defaults and named winds (Beaufort), and the checks of its box."""
 
 from __future__ import annotations
 
@@ -6,9 +6,6 @@ import operator
 
 import numpy as np
 
-from ...validate import float_within
-
-MODELS = ("physical", "paper")
 #: Default bounds ((x0, y0, z0), (x1, y1, z1)) in metres, until a Simulation fits the field.
 DEFAULT_BOUNDS = ((-5.0, 0.0, -5.0), (5.0, 10.0, 5.0))
 #: Refused above this wind speed (m/s): far beyond any wind, and it keeps the field finite.
@@ -81,14 +78,6 @@ def wind_preset(name: str) -> dict:
     return dict(kw, model="physical")
 
 
-
-
-def _optional_length(name: str, value) -> float | None:
-    if value is None:
-        return None
-    return float_within(name, value, _MIN_LENGTH, _MAX_LENGTH, " m")
-
-
 def _integer(name: str, value, lo: int, hi: int | None = None) -> int:
     if isinstance(value, bool):
         raise ValueError(f"{name} must be an integer, got {value!r}")
@@ -127,37 +116,3 @@ def _check_extent(b: np.ndarray, name: str = "bounds") -> None:
             f"{name} must have a positive extent on every axis (x1 > x0, y1 > y0, z1 > z0), "
             f"got extents {tuple(float(e) for e in ext)}"
         )
-
-
-class Setting:
-    """A checked :class:`~treeanim.physics.wind.field.WindField` setting, kept as ``_<name>``.
-
-    Parameters
-    ----------
-    doc : str
-        What it is (its docstring).
-    check : callable
-        ``check(name, value)`` returns the value to keep or raises ValueError.
-    rebase : bool
-        The field's clocks run at rates that depend on it: they restart at the last sampled
-        time before it changes.
-    regrid : bool
-        The paper's noise grids depend on it: they are rebuilt on next use.
-    """
-
-    def __init__(self, doc: str, check, rebase: bool = False, regrid: bool = False):
-        self.__doc__, self.check, self.rebase, self.regrid = doc, check, rebase, regrid
-
-    def __set_name__(self, owner, name: str) -> None:
-        self.name, self.attr = name, "_" + name
-
-    def __get__(self, obj, owner=None):
-        return self if obj is None else getattr(obj, self.attr)
-
-    def __set__(self, obj, value) -> None:
-        x = self.check(self.name, value)
-        if self.rebase:
-            obj._rebase()
-        setattr(obj, self.attr, x)
-        if self.regrid:
-            obj._tables = None
