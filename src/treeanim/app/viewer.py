@@ -1,11 +1,14 @@
-"""The interactive viewer: a tree in wind in a GLFW window, dragged with the mouse, tuned from an
+"""The interactive viewer: a tree in wind in a window, dragged with the mouse, tuned from an
 imgui panel.
 
-:class:`Viewer` owns the simulation, the renderer, the camera and the panel of one window. The
-window's GLFW callbacks call its input handlers (``on_mouse_button``, ``on_cursor_pos``,
-``on_scroll``, ``on_key``, ``on_char``, ``on_resize``, ``on_focus``); tests call the same
-handlers. :meth:`Viewer.frame` advances the simulation by the elapsed time and draws one frame;
-:func:`run` is the main loop. The controls are the table in :mod:`treeanim.app.keys`.
+:class:`Viewer` owns the simulation, the renderer, the camera and the panel of one window: a
+GLFW window (:class:`~treeanim.app.window.Window`) or a headless one on EGL
+(:class:`~treeanim.app.headless.HeadlessWindow`), anything of the
+:class:`~treeanim.app.protocol.AppWindow` protocol. A GLFW window's callbacks call its input
+handlers (``on_mouse_button``, ``on_cursor_pos``, ``on_scroll``, ``on_key``, ``on_char``,
+``on_resize``, ``on_focus``); tests call the same handlers. :meth:`Viewer.frame` advances the
+simulation by the elapsed time and draws one frame; :func:`run` is the main loop. The controls
+are the table in :mod:`treeanim.app.keys`.
 """
 
 from __future__ import annotations
@@ -31,8 +34,8 @@ from ..render.renderer import Renderer
 from ..render.scene import Scene
 from .gui import Gui
 from .input import ViewerInput
+from .protocol import AppWindow
 from .winddir import wind_direction
-from .window import Window
 
 #: Longest real time one frame advances the simulation by (s): slow frames (a software
 #: renderer at a few frames a second) still keep real time, in sub-steps; a stall (a dragged or
@@ -66,8 +69,9 @@ class Viewer(ViewerInput):
 
     Parameters
     ----------
-    window : Window
-        An open window (its GL context current).
+    window : AppWindow
+        An open window (its GL context current): :class:`~treeanim.app.window.Window` (GLFW) or
+        :class:`~treeanim.app.headless.HeadlessWindow` (EGL, no display).
     tree : Tree
     season : float
         0 summer … 1 winter.
@@ -107,7 +111,7 @@ class Viewer(ViewerInput):
         draw calls, panel), seconds; ``sim_ms`` and ``render_ms`` are their moving averages.
     """
 
-    def __init__(self, window: Window, tree: Tree, *, season: float = 0.0, wind_speed: float | None = None,
+    def __init__(self, window: AppWindow, tree: Tree, *, season: float = 0.0, wind_speed: float | None = None,
                  wind_angle_deg: float = 0.0, seed: int = 0, show_panel: bool = True, clock=None,
                  wind_preset: str | None = None, model: str = "tree") -> None:
         self.window = window
@@ -150,7 +154,7 @@ class Viewer(ViewerInput):
         named.setdefault("speed", 5.0)
         self._wind = _clone_wind(None, direction=wind_direction(wind_angle_deg), seed=self.seed, **named)
         self._season = float(season)
-        self.gui = Gui(window.handle, scale=window.content_scale)
+        self.gui = Gui(window, scale=window.content_scale)
         try:
             from .panel import Panel
 
@@ -183,6 +187,7 @@ class Viewer(ViewerInput):
         self._end_drag()
         sim = Simulation(tree, wind=_clone_wind(self._wind), season=self._season, seed=self.seed, model=self._model,
                          integrator=self._integrator, coupling=self._coupling)
+        self.window.make_current()
         renderer = Renderer(self.ctx, tree, scene=self.scene)
         if self.renderer is not None:
             self.renderer.release()
@@ -235,6 +240,19 @@ class Viewer(ViewerInput):
                 w.direction = wind_direction(v)
             else:
                 setattr(w, k, v)
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def window_size(self) -> tuple[int, int]:
+        """The window's size in screen units as the viewer last heard of it (its handlers:
+        ``on_window_size``, ``on_resize``)."""
+        return self._win
+
+    @property
+    def framebuffer_size(self) -> tuple[int, int]:
+        """The framebuffer's size in pixels as the viewer last heard of it (0 × 0: minimised;
+        at most the GL's largest size)."""
+        return self._fb
 
     # ------------------------------------------------------------------ camera
     def frame_camera(self) -> None:
@@ -315,7 +333,10 @@ class Viewer(ViewerInput):
         if key != self._uploaded:  # the pose is unchanged while paused or between steps
             r.update(pos, sim.rotations, present=sim.shown, highlight=highlight)
             self._uploaded = key
-        self.ctx.screen.use()
+        target = self.window.framebuffer
+        if target is None:  # minimised since the viewer last heard of the size
+            return
+        target.use()
         r.draw(self.camera, fw, fh, season=sim.season, overlays=self.overlays())
         if self.show_panel:
             ww, wh = self._win
@@ -352,8 +373,8 @@ class Viewer(ViewerInput):
 
     # ------------------------------------------------------------------ pixels
     def read_pixels(self) -> np.ndarray:
-        """The back buffer as drawn so far, (height, width, 3) uint8, row 0 at the top
-        (:meth:`Window.read_pixels`)."""
+        """The frame as drawn so far, (height, width, 3) uint8, row 0 at the top
+        (:meth:`AppWindow.read_pixels <treeanim.app.protocol.AppWindow.read_pixels>`)."""
         return self.window.read_pixels(*self._fb)
 
     def request_screenshot(self, path=None) -> None:
@@ -478,6 +499,7 @@ class Viewer(ViewerInput):
 
     def release(self) -> None:
         """Free the GL resources (the window stays open)."""
+        self.window.make_current()
         self.window.release_readback()
         if self.renderer is not None:
             self.renderer.release()
