@@ -505,10 +505,10 @@ def test_panel_light_moves_the_sun_and_its_shadow_and_survives_a_new_tree(viewer
 
 def test_the_save_name_follows_the_preset_unless_typed(viewer):
     v = viewer
-    assert v.panel.path == "small_cherry-custom.toml"
-    assert v.panel.apply("preset", "beam") and v.panel.path == "beam-custom.toml"
-    v.panel.path = "mine.toml"
-    assert v.panel.apply("preset", "small_cherry") and v.panel.path == "mine.toml"
+    assert v.preset_path == "small_cherry-custom.toml"
+    assert v.panel.apply("preset", "beam") and v.preset_path == "beam-custom.toml"
+    v.preset_path = "mine.toml"
+    assert v.panel.apply("preset", "small_cherry") and v.preset_path == "mine.toml"
 
 
 def test_panel_apply_sets_physics_season_and_time(viewer):
@@ -575,14 +575,14 @@ def test_keys_go_to_a_text_field_while_typing(viewer):
     _click(v, *_reveal(v, "Preset file"))
     _click(v, *_reveal(v, "path"))
     assert v.gui.wants_keyboard
-    before = v.panel.path
+    before = v.preset_path
     for key, ch in ((glfw.KEY_SPACE, " "), (glfw.KEY_R, "r"), (glfw.KEY_Q, "q")):
         v.on_key(key, 0, glfw.PRESS, 0)
         v.on_char(ord(ch))
         v.on_key(key, 0, glfw.RELEASE, 0)
         v.frame(DT)
     assert not v.paused and not v.window.should_close
-    assert v.panel.path != before and v.panel.path.replace(" rq", "", 1) == before
+    assert v.preset_path != before and v.preset_path.replace(" rq", "", 1) == before
     _click(v, W - 10, 10)  # click the sky: the field lets go of the keyboard
     assert not v.gui.wants_keyboard
     v.on_key(glfw.KEY_SPACE, 0, glfw.PRESS, 0)
@@ -732,7 +732,7 @@ def test_settings_round_trip_through_the_panel(viewer, tmp_path):
     p.apply("f:leaf", (1.1, 2.3))
     physics = v.sim.physics
     path = tmp_path / "mine.toml"
-    p.path = str(path)
+    v.preset_path = str(path)
     v.on_key(glfw.KEY_S, 0, glfw.PRESS, glfw.MOD_CONTROL)  # Ctrl+S
     assert path.is_file()
     assert [f.name for f in tmp_path.iterdir()] == ["mine.toml"], "no temporary file is left behind"
@@ -752,9 +752,9 @@ def test_settings_round_trip_through_the_panel(viewer, tmp_path):
     assert v.sim.physics == physics
     assert v.frame(DT)
     # a failed save says why and leaves nothing behind
-    assert p.save(str(tmp_path / "nowhere" / "x.toml")) is None
+    assert v.save_preset(str(tmp_path / "nowhere" / "x.toml")) is None
     assert "does not exist" in v.messages[-1]
-    assert not p.load(str(tmp_path / "missing.toml"))
+    assert not v.open_file(str(tmp_path / "missing.toml"))
     assert v.messages[-1].startswith("error")
 
 
@@ -763,7 +763,7 @@ def test_the_panel_opens_a_treeqsm_model_and_shows_its_counts(viewer, tmp_path):
 
     v, p = viewer, viewer.panel
     qsm = Path(__file__).resolve().parents[1] / "assets" / "qsm" / "synthetic_broadleaf.txt"
-    assert p.load(str(qsm))
+    assert v.open_file(str(qsm))
     assert v.tree.name == "synthetic_broadleaf" and v.tree.modes == "physical" and v.sim.model == "tree"
     assert v.stats()["branches"] == 228 and v.stats()["objects"] == 228
     v.show_panel = True
@@ -775,7 +775,7 @@ def test_the_panel_opens_a_treeqsm_model_and_shows_its_counts(viewer, tmp_path):
     assert p.apply("paper_model", False)
     bad = tmp_path / "bad.csv"
     bad.write_text("0.1,1,0,0,0,0,0,1,2,0,1,0,1,0\n")  # its own parent
-    assert not p.load(str(bad))
+    assert not v.open_file(str(bad))
     assert v.messages[-1].startswith("error") and "row 1" in v.messages[-1]
     assert v.tree.name == "synthetic_broadleaf"  # the current tree stays
 
@@ -889,11 +889,11 @@ def test_panel_load_shows_a_simulation_error_and_keeps_the_tree(viewer, monkeypa
     v = viewer
     sim, renderer = v.sim, v.renderer
     monkeypatch.setattr(ta, "load_tree", lambda path: _unsimulable())
-    v.panel.path = "broken.toml"
-    v.on_key(glfw.KEY_O, 0, glfw.PRESS, glfw.MOD_CONTROL)  # Ctrl+O: Panel.load
+    v.preset_path = "broken.toml"
+    v.on_key(glfw.KEY_O, 0, glfw.PRESS, glfw.MOD_CONTROL)  # Ctrl+O: Viewer.open_file
     assert v.messages[-1].startswith("error:") and "no f/zeta range" in v.messages[-1]
     assert v.sim is sim and v.renderer is renderer and v.tree.name == "small_cherry"
-    assert not v.panel.load("broken.toml")
+    assert not v.open_file("broken.toml")
     v.show_panel = True
     assert v.frame(DT) and v.frame(DT)
     assert v.ctx.error == "GL_NO_ERROR"
@@ -920,7 +920,7 @@ def test_panel_load_of_a_file_that_never_ends_or_nests_too_deep_keeps_the_tree(v
         text = Path(v.tree.source).read_text()
         path.write_text(text.replace("[physics.summer]", "[physics]\nleaf_zeta_w_scale = 1e300\n\n[physics.summer]"))
     done = []
-    loader = threading.Thread(target=lambda: done.append(v.panel.load(str(path))), daemon=True)
+    loader = threading.Thread(target=lambda: done.append(v.open_file(str(path))), daemon=True)
     loader.start()
     loader.join(10.0)
     assert done == [False], "the load returned (no hang) and refused the file"
