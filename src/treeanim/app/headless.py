@@ -64,9 +64,12 @@ class HeadlessWindow:
         most = min(int(samples), int(self.ctx.max_samples))
         self.samples = 0 if most <= 1 else 1 << (most.bit_length() - 1)
         self._scale = scale
+        # Bound while our framebuffers are released: moderngl rebinds the framebuffer bound last
+        # after it makes one, and rebinding a deleted one is GL_INVALID_OPERATION.
+        self._default_fbo = self.ctx.detect_framebuffer(0)
         self._size = (0, 0)
         self._fb_size = (0, 0)
-        self._fbos: list = []  # what _build made: the framebuffer drawn into first
+        self._fbos: list = []  # what _set_size made: the framebuffer drawn into first
         self._resolve = None  # the single-sampled framebuffer read back (the drawn one without MSAA)
         self._events: list[tuple[str, tuple]] = []
         self._viewer = None
@@ -84,6 +87,8 @@ class HeadlessWindow:
 
     # ------------------------------------------------------------------ framebuffers
     def _release_fbos(self) -> None:
+        if self._fbos:
+            self._default_fbo.use()
         for o in self._fbos:
             o.release()
         self._fbos = []

@@ -277,7 +277,7 @@ class Viewer(ViewerInput, ViewerActions):
             dt = 0.0 if self._last_time is None else now - self._last_time
         self._last_time = now
         w, h = self._fb
-        if w <= 0 or h <= 0:
+        if w <= 0 or h <= 0 or self.window.framebuffer is None:  # minimised (the window knows first)
             return False
         self.window.make_current()
         t0 = time.perf_counter()
