@@ -554,6 +554,8 @@ def test_switching_the_model_mid_drag_lets_go(viewer):
 
 
 def test_keys_go_to_a_text_field_while_typing(viewer):
+    """Typing in the panel's file field: keys go to the field, not the shortcuts; the window's
+    clipboard pastes into it and copies from it."""
     v = viewer
     v.show_panel = True
     v.frame(DT)
@@ -568,6 +570,22 @@ def test_keys_go_to_a_text_field_while_typing(viewer):
         v.frame(DT)
     assert not v.paused and not v.window.should_close
     assert v.preset_path != before and v.preset_path.replace(" rq", "", 1) == before
+
+    def ctrl(*keys):
+        for key in keys:
+            v.on_key(key, 0, glfw.PRESS, glfw.MOD_CONTROL)
+            v.frame(DT)
+            v.on_key(key, 0, glfw.RELEASE, glfw.MOD_CONTROL)
+
+    # The field pastes from and copies to the window's clipboard (Ctrl+A, Ctrl+V / Ctrl+C).
+    v.window.set_clipboard("pasted.toml")
+    ctrl(glfw.KEY_A, glfw.KEY_V)
+    v.frame(DT)
+    assert v.preset_path == "pasted.toml"
+    v.window.set_clipboard("")
+    ctrl(glfw.KEY_A, glfw.KEY_C)
+    assert v.window.get_clipboard() == "pasted.toml"
+    assert not v.paused and not v.window.should_close
     click(v, W - 10, 10)  # click the sky: the field lets go of the keyboard
     assert not v.gui.wants_keyboard
     v.on_key(glfw.KEY_SPACE, 0, glfw.PRESS, 0)
