@@ -25,10 +25,11 @@ settings.register_profile("treeanim", derandomize=True, deadline=None, max_examp
 settings.load_profile("treeanim")
 
 # --------------------------------------------------------------------------- markers
-#: Modules that draw through OpenGL (EGL offscreen), and those that open a window (Xvfb).
+#: Modules that draw through OpenGL (EGL offscreen; test_app: the app on a headless window), and
+#: those that open a window (Xvfb).
 GL_MODULES = {"test_render_gl", "test_render_look", "test_render_uniforms", "test_junctions", "test_offline",
-              "test_examples"}
-WINDOW_MODULES = {"test_app", "test_render_window"}
+              "test_examples", "test_app"}
+WINDOW_MODULES = {"test_app_window", "test_render_window"}
 #: Each test's measured CPU seconds (node id -> s), written by ``pytest --store-durations``.
 DURATIONS = Path(__file__).with_name("durations.json")
 #: A test measured at this many CPU seconds or more is marked ``slow``: ``-m "not slow"`` is the

@@ -1,11 +1,13 @@
 """The key table (app/keys.py) drives the viewer's handler and the panel's help: every binding
-names a Viewer action, no key is bound twice, and the help lists every binding."""
+names a Viewer action, no key is bound twice, and the help lists every binding. The panel's
+settings table (app/settings.py) names Viewer actions too."""
 
 from __future__ import annotations
 
 import glfw
 
 from treeanim.app.keys import BINDINGS, MOUSE, binding_for, help_lines
+from treeanim.app.settings import SETTINGS
 from treeanim.app.viewer import Viewer
 
 
@@ -19,6 +21,16 @@ def test_every_binding_is_an_action_of_the_viewer_and_in_the_help():
             seen.add((key, b.ctrl))
         assert f"{b.label} {b.does}" in text
     assert all(f"{what}: {does}" in text for what, does in MOUSE)
+
+
+def test_every_setting_of_the_panel_is_applied_by_a_viewer_method():
+    """The panel changes nothing itself: each setting names the public Viewer method that
+    applies it, and reads its value from public attributes (no private field on the way)."""
+    for name, s in SETTINGS.items():
+        assert not s.action.startswith("_") and callable(getattr(Viewer, s.action, None)), (name, s.action)
+        assert getattr(Viewer, s.action).__doc__, (name, s.action)
+        if isinstance(s.get, str):
+            assert not any(part.startswith("_") for part in s.get.split(".")), (name, s.get)
 
 
 def test_ctrl_picks_its_own_bindings():

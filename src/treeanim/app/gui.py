@@ -1,12 +1,16 @@
-"""Dear ImGui (imgui-bundle) on the viewer's window: input fed from our own GLFW callbacks,
-drawing through imgui-bundle's C++ OpenGL 3 backend.
+"""Dear ImGui (imgui-bundle) on the viewer's window: the platform part is ours (input fed from
+the viewer's handlers, the display size and frame time given to :meth:`Gui.new_frame`, the
+clipboard the window's), drawing goes through imgui-bundle's C++ OpenGL 3 backend. So the same
+panel runs in a GLFW window and headless on EGL (:mod:`treeanim.app.headless`).
 
 Why not imgui-bundle's C++ GLFW backend (``imgui.backends.glfw_init_for_opengl``)? It needs the
 ``GLFWwindow*`` of the very libglfw it links; pyGLFW loads that library only when imgui_bundle
 is imported first (it sets ``PYGLFW_LIBRARY``), and otherwise a second copy with a state of its
 own, whose windows the C++ backend must not touch. Feeding ImGui's IO from the viewer's input
 handlers works with either library, and lets tests drive the panel through the same handlers
-as a user. The renderer (``imgui.backends.opengl3_*``) only needs the current GL context.
+as a user, with or without a window system. Key and button codes are GLFW's numbers (plain
+constants: no GLFW call is made here). The renderer (``imgui.backends.opengl3_*``) only needs
+the current GL context, a GLFW window's or an EGL one.
 """
 
 from __future__ import annotations
@@ -50,8 +54,10 @@ class Gui:
 
     Parameters
     ----------
-    window : GLFW window pointer or None
-        For the clipboard (None: no clipboard).
+    clipboard : object or None
+        Where the text fields copy to and paste from: anything with ``get_clipboard()`` and
+        ``set_clipboard(text)`` (the window: :class:`~treeanim.app.protocol.AppWindow`); None:
+        no clipboard.
     scale : float
         UI scale (the monitor's content scale): font size and spacing.
     font_size : float
@@ -64,7 +70,7 @@ class Gui:
     and :meth:`focus` at any time between frames.
     """
 
-    def __init__(self, window=None, scale: float = 1.0, font_size: float = 15.0) -> None:
+    def __init__(self, clipboard=None, scale: float = 1.0, font_size: float = 15.0) -> None:
         self.scale = float(scale)
         self.ctx = imgui.create_context()
         imgui.set_current_context(self.ctx)
@@ -86,19 +92,10 @@ class Gui:
         path = _font_path()
         if path is not None:
             io.fonts.add_font_from_file_ttf(path, font_size * scale)
-        self._window = window
-        if window is not None:
+        if clipboard is not None:
             pio = imgui.get_platform_io()
-
-            def get_clip(_ctx) -> str:
-                s = glfw.get_clipboard_string(window)
-                return s.decode("utf-8", "replace") if s else ""
-
-            def set_clip(_ctx, text: str) -> None:
-                glfw.set_clipboard_string(window, text)
-
-            pio.platform_get_clipboard_text_fn = get_clip
-            pio.platform_set_clipboard_text_fn = set_clip
+            pio.platform_get_clipboard_text_fn = lambda _ctx: clipboard.get_clipboard()
+            pio.platform_set_clipboard_text_fn = lambda _ctx, text: clipboard.set_clipboard(text)
         if not imgui.backends.opengl3_init("#version 330 core"):
             raise RuntimeError("imgui's OpenGL 3 renderer could not start")
         self._released = False

@@ -1,4 +1,5 @@
-"""The viewer's input handlers: what the window's GLFW callbacks (and the tests) call.
+"""The viewer's input handlers: what a GLFW window's callbacks call, and what tests and scripts
+call directly on a headless app. Buttons, actions and keys are GLFW's codes (plain constants).
 
 A left-drag on an object drags it (the tree model; the paper's pulls it with a spring),
 elsewhere it orbits; a right or middle drag pans, the wheel

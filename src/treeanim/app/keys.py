@@ -45,7 +45,7 @@ BINDINGS = (
     Binding((glfw.KEY_S, glfw.KEY_F12), "S/F12", "request_screenshot", "screenshot"),
     Binding((glfw.KEY_F11,), "F11", "toggle_fullscreen", "full screen"),
     Binding((glfw.KEY_S,), "Ctrl+S", "save_preset", "save the preset", ctrl=True),
-    Binding((glfw.KEY_O,), "Ctrl+O", "load_preset", "load it", ctrl=True),
+    Binding((glfw.KEY_O,), "Ctrl+O", "open_file", "load it", ctrl=True),
     Binding((glfw.KEY_ESCAPE, glfw.KEY_Q), "Esc/Q", "quit", "quit"),
 )
 #: The mouse: (what, does).

@@ -3,15 +3,16 @@ its modal ranges, integrator and coupling), stiffness, time, overlays, statistic
 or loading the settings as a preset.
 
 The settings are the table :data:`treeanim.app.settings.SETTINGS`: :meth:`Panel.widget` draws
-one from it, and every change goes through :meth:`Panel.apply`, which applies it through the
-simulation's checked properties and shows any refusal in the panel's status line instead of
-raising.
+one from it, and every change goes through :meth:`Panel.apply`, which calls the viewer's method
+for it (:class:`~treeanim.app.actions.ViewerActions`) and shows any refusal in the panel's status
+line instead of raising. The buttons call the viewer's methods too (``reset``, ``frame_camera``,
+``save_preset``, ``open_file``); the panel reads the viewer's public state and keeps only its
+own (which season's ranges it edits, the widgets' places, a slider's value until it is let go).
 """
 
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
 import numpy as np
 from imgui_bundle import imgui
@@ -19,7 +20,6 @@ from imgui_bundle import imgui
 from ..model.tree import KINDS, PLURAL
 from ..physics.wind import WIND_PRESETS
 from .keys import help_lines
-from .save import save_preset
 from .settings import EI_SPAN, SETTINGS
 
 #: Width of the panel in screen units at UI scale 1.
@@ -40,8 +40,6 @@ class Panel:
 
     Attributes
     ----------
-    path : str
-        The file the Save and Open buttons use (Open also reads TreeQSM models).
     edit_season : {'summer', 'winter'}
         Which season's f and ζ ranges the range widgets edit.
     record_rects : bool
@@ -56,8 +54,6 @@ class Panel:
 
     def __init__(self, viewer) -> None:
         self.viewer = viewer
-        self.path = ""
-        self._default_path = ""
         self.edit_season = "summer"
         self.item_rects: dict[str, tuple[float, float, float, float]] = {}
         self.rect: tuple[float, float, float, float] | None = None
@@ -101,11 +97,8 @@ class Panel:
         return self._presets
 
     def tree_changed(self) -> None:
-        """The viewer shows a new tree: default file name and season table."""
+        """The viewer shows a new tree: the season table edited, the kinds, EI_max's range."""
         v = self.viewer
-        if not self.path or self.path == self._default_path:  # a name the user typed is kept
-            self.path = f"{v.sim.tree.name}-custom.toml"
-        self._default_path = f"{v.sim.tree.name}-custom.toml"
         self.edit_season = "summer" if v.sim.season < 0.5 else "winter"
         self._kinds = [k for k in KINDS if np.any(v.sim.tree.kind == k)]
         ei, st = float(v.sim.tree.physics.ei_max), SETTINGS["ei_max"]
@@ -117,56 +110,18 @@ class Panel:
         """Apply setting ``name`` (a key of :data:`~treeanim.app.settings.SETTINGS`: ``preset``,
         ``season``, the wind's, ``ei_max``, ``f:KIND`` and ``zeta:KIND`` ((min, max) of the
         edited season's table), ``time_scale``, ``paper_model``, the paper model's
-        ``integrator``, ``coupling`` and ``physical_modes``, the switches, the light's);
-        returns whether it was accepted (a refusal is shown in the panel)."""
+        ``integrator``, ``coupling`` and ``physical_modes``, the switches, the light's) through
+        the viewer's method for it; returns whether it was accepted (a refusal is shown in the
+        panel)."""
         v = self.viewer
         try:
             setting = SETTINGS.get(name)
             if setting is None:
                 raise ValueError(f"unknown setting {name!r}")
-            setting.apply(v, value)
+            setting.apply(v, value, **({"season": self.edit_season} if setting.seasonal else {}))
         except (ValueError, OSError) as e:
             v.say(f"error: {' '.join(str(e).split())}")
             return False
-        return True
-
-    def save(self, path: str | None = None) -> Path | None:
-        """Save the current physics (and the tree's seed) as a preset at ``path`` (default
-        :attr:`path`). Returns the file, or None after showing why not."""
-        v = self.viewer
-        target = path or self.path
-        try:
-            out = save_preset(target, v.sim.tree, v.sim.physics)
-        except (ValueError, OSError) as e:
-            v.say(f"error: {' '.join(str(e).split())}")
-            return None
-        v.say(f"saved {out}")
-        print(f"treeanim: saved preset {out}", flush=True)
-        return out
-
-    def load(self, path: str | None = None) -> bool:
-        """Open a preset or TreeQSM model file (default :attr:`path`; .toml, .txt, .csv or .mat)
-        and show its tree (a model's counts in Statistics).
-
-        Returns
-        -------
-        bool
-            Whether the tree is shown. A file that cannot be read or parsed (PresetError), or a
-            tree the simulation refuses (ValueError, e.g. no f/ζ range for a kind the tree
-            has), is reported in the panel's status line; the current tree stays.
-        """
-        import treeanim as ta
-
-        from ..model.qsm import QSM_SUFFIXES
-
-        v = self.viewer
-        target = path or self.path
-        try:
-            v.load_tree(ta.load_qsm(target) if str(target).lower().endswith(QSM_SUFFIXES) else ta.load_tree(target))
-        except (ValueError, OSError) as e:  # PresetError is a ValueError
-            v.say(f"error: {' '.join(str(e).split())}")
-            return False
-        v.say(f"loaded {target}")
         return True
 
     # ------------------------------------------------------------------ drawing
@@ -189,7 +144,7 @@ class Panel:
         v = self.viewer
         if st.shown is not None and not st.shown(v):
             return
-        value = st.get(v)
+        value = st.value(v)
         if st.kind == "check":
             changed, new = imgui.checkbox(st.label, value)
             self._rect(st.label)
@@ -218,7 +173,7 @@ class Panel:
         st = SETTINGS[name]
         if st.shown is not None and not st.shown(self.viewer):
             return
-        r = st.get(self.viewer)
+        r = self.viewer.mode_range(*st.args, season=self.edit_season)
         if r is None:
             return
         changed, lo, hi = imgui.drag_float_range2(st.label, r[0], r[1], speed, st.lo, st.hi, st.fmt, st.fmt,
@@ -232,7 +187,7 @@ class Panel:
         v = self.viewer
         sim = v.sim
         s = v.gui.scale
-        ww, wh = v._win
+        ww, wh = v.window_size
         self.item_rects = {}
         imgui.set_next_window_pos(imgui.ImVec2(PANEL_GAP * s, PANEL_GAP * s), imgui.Cond_.always)
         imgui.set_next_window_size_constraints(imgui.ImVec2(self.width, 0),
@@ -344,16 +299,16 @@ class Panel:
 
         # --- preset file
         if self._header("Preset file"):
-            changed, text = imgui.input_text("##path", self.path)
+            changed, text = imgui.input_text("##path", v.preset_path)
             self._rect("path")
             if changed:
-                self.path = text
+                v.preset_path = text
             if imgui.button("Save"):
-                self.save()
+                v.save_preset()
             self._rect("save")
             imgui.same_line()
             if imgui.button("Open"):  # a preset .toml or a TreeQSM model (.txt, .csv, .mat)
-                self.load()
+                v.open_file()
             self._rect("load")
             imgui.same_line()
             imgui.text_disabled("Ctrl+S / Ctrl+O")

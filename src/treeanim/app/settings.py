@@ -1,9 +1,10 @@
 """The panel's settings in one table: :data:`SETTINGS` (name → :class:`Setting`: its widget's
-label and range, how to read it from the viewer and how to apply it), which drives both the
-panel's drawing (:meth:`Panel.widget <treeanim.app.panel.Panel.widget>`) and
-:meth:`Panel.apply <treeanim.app.panel.Panel.apply>`. A new setting is one entry here.
+label and range, where the viewer keeps its value and which viewer method applies it), which
+drives both the panel's drawing (:meth:`Panel.widget <treeanim.app.panel.Panel.widget>`) and
+:meth:`Panel.apply <treeanim.app.panel.Panel.apply>`. A new setting is one entry here (and, for
+something new to set, one method of :class:`~treeanim.app.actions.ViewerActions`).
 
-Every setter goes through a checked property (``sim.season``, ``sim.physics =
+Every action goes through a checked property (``sim.season``, ``sim.physics =
 dataclasses.replace(...)``, the wind's setters ...) and raises ValueError on a refusal, which
 the panel shows in its status line. Settings of the paper's model alone (its integrator,
 coupling and modal ranges) are shown only while it runs, and refused (ValueError) on the tree
@@ -12,15 +13,14 @@ model.
 
 from __future__ import annotations
 
-import dataclasses
+import operator
 from dataclasses import dataclass
 from typing import Any, Callable
 
-from ..model.params import MODE_PARAMS, PARAMS, ModeRange
+from ..model.params import MODE_PARAMS, PARAMS
 from ..model.tree import KINDS
 from ..physics.oscillator import INTEGRATORS
-from ..render.scene import sun_angles, sun_direction
-from .winddir import wind_angle
+from .actions import SUN_ELEVATIONS, TIME_SCALES
 
 __all__ = ["Setting", "SETTINGS", "EI_SPAN"]
 
@@ -36,13 +36,21 @@ class Setting:
     ----------
     label : str
         The widget's label.
-    get : callable
-        ``get(viewer)``: the current value.
-    set : callable
-        ``set(viewer, value)``: apply a value (ValueError: refused).
+    get : str or callable or None
+        Where the value is: a path of attributes from the viewer (``'sim.wind.speed'``), or
+        ``get(viewer)``; None: no value to show (a list of named winds).
+    action : str
+        The :class:`~treeanim.app.viewer.Viewer` method that applies a value
+        (:class:`~treeanim.app.actions.ViewerActions`; ValueError: refused).
+    keyword : str or None
+        The action takes the value as this keyword (``set_wind(speed=value)``); None: as its
+        last positional argument.
+    args : tuple
+        Arguments the action takes before the value (``set_overlay('trace', value)``).
     kind : {'slider', 'check', 'choice', 'custom'}
         The widget: a float slider, a checkbox, a combo of :attr:`choices`, or drawn by the
-        panel's own code (a preset list, a range pair).
+        panel's own code (a preset list, a range pair). A slider's value is applied as a float,
+        a checkbox's as a bool.
     lo, hi : float
         A slider's range (a value beyond it is clamped where :attr:`clamp`).
     fmt : str
@@ -58,11 +66,18 @@ class Setting:
         ``shown(viewer)``: whether the widget is drawn (None: always).
     choices : tuple of str
         A combo's items.
+    seasonal : bool
+        The action also takes ``season=``: the season table the panel edits.
+    paper_only : bool
+        Shown with the paper's model only; on the tree model, where the simulation has no such
+        attribute, refused with a ValueError naming the setting.
     """
 
     label: str
-    get: Callable[[Any], Any]
-    set: Callable[[Any, Any], None]
+    get: str | Callable[[Any], Any] | None
+    action: str
+    keyword: str | None = None
+    args: tuple = ()
     kind: str = "slider"
     lo: float = 0.0
     hi: float = 1.0
@@ -72,12 +87,37 @@ class Setting:
     clamp: bool = False
     shown: Callable[[Any], bool] | None = None
     choices: tuple[str, ...] = ()
+    seasonal: bool = False
+    paper_only: bool = False
 
-    def apply(self, viewer, value) -> None:
-        """Apply ``value`` (clamped to the range where :attr:`clamp`)."""
-        if self.clamp:
-            value = min(max(float(value), self.lo), self.hi)
-        self.set(viewer, value)
+    def value(self, viewer):
+        """The current value (None where :attr:`get` is None)."""
+        if self.get is None:
+            return None
+        if isinstance(self.get, str):
+            return operator.attrgetter(self.get)(viewer)
+        return self.get(viewer)
+
+    def apply(self, viewer, value, **extra) -> None:
+        """Apply ``value`` through the viewer's :attr:`action` (a slider's as a float clamped to
+        the range where :attr:`clamp`, a checkbox's as a bool); ``extra``: more keywords for the
+        action (``season=`` of a :attr:`seasonal` one)."""
+        if self.kind == "slider":
+            value = float(value)
+            if self.clamp:
+                value = min(max(value, self.lo), self.hi)
+        elif self.kind == "check":
+            value = bool(value)
+        act = getattr(viewer, self.action)
+        try:
+            if self.keyword is None:
+                act(*self.args, value, **extra)
+            else:
+                act(*self.args, **{self.keyword: value}, **extra)
+        except AttributeError as e:
+            if not self.paper_only:
+                raise
+            raise ValueError(f"{self.label}: {e}") from None
 
 
 def _physical(v) -> bool:
@@ -92,99 +132,55 @@ def _paper_model(v) -> bool:
     return v.sim.model == "paper"
 
 
-def _paper_only(setting: Setting) -> Setting:
-    """``setting``, shown with the paper's model only and refused (ValueError, the façade's
-    reason) on the tree model, where its attribute does not exist."""
+def _physical_modes(v) -> bool:
+    return v.sim.modal == "physical"
 
-    def put(v, x):
-        try:
-            setting.set(v, x)
-        except AttributeError as e:
-            raise ValueError(f"{setting.label}: {e}") from None
 
-    return dataclasses.replace(setting, set=put, shown=_paper_model)
+def _sun_azimuth(v) -> float:
+    return v.sun_angles[0]
+
+
+def _sun_elevation(v) -> float:
+    return v.sun_angles[1]
 
 
 def _wind(name: str, label: str, lo: float, hi: float, fmt: str = "%.2f", **kw) -> Setting:
-    """A wind field setting, through the WindField's checked setter of ``name``; shown (by
-    default) for the wind models that have it."""
+    """A wind field setting: ``set_wind(name=value)``, through the wind model's checked
+    setter; shown (by default) for the wind models that have it."""
     kw.setdefault("shown", lambda v: name in v.sim.wind.parameters())
-    return Setting(label, lambda v: getattr(v.sim.wind, name), lambda v, x: v.set_wind(**{name: float(x)}),
-                   lo=lo, hi=hi, fmt=fmt, **kw)
+    return Setting(label, f"sim.wind.{name}", "set_wind", keyword=name, lo=lo, hi=hi, fmt=fmt, **kw)
 
 
-def _flag(owner: Callable[[Any], Any], name: str, label: str) -> Setting:
-    """A checkbox for boolean attribute ``name`` of ``owner(viewer)``."""
-    return Setting(label, lambda v: getattr(owner(v), name), lambda v, x: setattr(owner(v), name, bool(x)),
-                   kind="check")
-
-
-def _set_modal(v, physical) -> None:
-    v.sim.modal = v.tree.modes = "physical" if physical else "paper"
-
-
-def _load_preset(v, name) -> None:
-    from ..model.presets import load_preset
-
-    v.load_tree(load_preset(name))
-    v.say(f"loaded preset {name}")
-
-
-def _wind_preset(v, name) -> None:
-    v.set_wind(preset=str(name))
-    v.say(f"wind: {name}")
+def _check(label: str, get, action: str, **kw) -> Setting:
+    """A checkbox."""
+    return Setting(label, get, action, kind="check", **kw)
 
 
 def _physics(name: str) -> Setting:
     """A slider of the physics setting ``name``: label, unit, format and scale from its
-    declaration (:data:`~treeanim.model.params.PARAMS`), set through ``dataclasses.replace``
-    (which checks it)."""
+    declaration (:data:`~treeanim.model.params.PARAMS`), set through ``set_physics`` (which
+    checks it)."""
     p = PARAMS[name]
-    return Setting(p.label or name, lambda v: getattr(v.sim.physics, name),
-                   lambda v, x: setattr(v.sim, "physics", dataclasses.replace(v.sim.physics, **{name: float(x)})),
+    return Setting(p.label or name, f"sim.physics.{name}", "set_physics", keyword=name,
                    lo=p.lo, hi=p.hi, fmt=p.widget_format, log=p.log)
 
 
-def _set_sun(v, azimuth=None, elevation=None) -> None:
-    az, el = sun_angles(v.scene.sun_direction)
-    az = az if azimuth is None else float(azimuth)
-    el = el if elevation is None else float(elevation)
-    lo, hi = SETTINGS["sun_elevation"].lo, SETTINGS["sun_elevation"].hi
-    v.scene.sun_direction = sun_direction(az % 360.0, min(max(el, lo), hi))
-
-
 def _modes(what: str, kind: str) -> Setting:
-    """The (min, max) f or ζ range of ``kind`` in the season table the panel edits."""
-
-    def table(v):
-        return getattr(v.sim.physics, v.panel.edit_season)
-
-    def get(v):
-        r = table(v).of(kind) or v.sim.physics.modes(kind, v.sim.season)
-        return None if r is None else getattr(r, what)
-
-    def put(v, value):
-        p = v.sim.physics
-        cur = table(v).of(kind) or p.modes(kind, v.sim.season)
-        lo, hi = sorted(float(x) for x in value)
-        new = ModeRange((lo, hi), cur.zeta) if what == "f" else ModeRange(cur.f, (lo, hi))
-        v.sim.physics = dataclasses.replace(p, **{v.panel.edit_season: dataclasses.replace(table(v), **{kind: new})})
-
-    # the ranges are the preset's (saved with it) on either model; only the paper's uses them
+    """The (min, max) f or ζ range of ``kind`` in the season table the panel edits
+    (``Viewer.mode_range``, ``Viewer.set_mode_range``; drawn by the panel's own code)."""
     p = MODE_PARAMS[what]
-    return Setting(f"{p.label} {kind}" + (f" ({p.unit})" if p.unit else ""), get, put, kind="custom",
-                   lo=p.lo, hi=p.hi, fmt=p.fmt, shown=_paper_model)
+    return Setting(f"{p.label} {kind}" + (f" ({p.unit})" if p.unit else ""), None, "set_mode_range",
+                   args=(kind, what), kind="custom", lo=p.lo, hi=p.hi, fmt=p.fmt, shown=_paper_model, seasonal=True)
 
 
 #: Every setting the panel shows or :meth:`Panel.apply` takes, by name.
 SETTINGS: dict[str, Setting] = {
-    "preset": Setting("preset", lambda v: v.sim.tree.name, _load_preset, kind="custom"),
-    "season": Setting("season", lambda v: v.sim.season, lambda v, x: setattr(v.sim, "season", float(x))),
+    "preset": Setting("preset", "sim.tree.name", "open_preset", kind="custom"),
+    "season": Setting("season", "sim.season", "set_season"),
     # wind
-    "wind_preset": Setting("named wind", lambda v: None, _wind_preset, kind="custom", shown=_physical),
+    "wind_preset": Setting("named wind", None, "set_wind_preset", kind="custom", shown=_physical),
     "wind_speed": _wind("speed", "speed", 0.0, 30.0, "%.1f m/s"),
-    "wind_angle": Setting("direction", lambda v: wind_angle(v.sim.wind.direction),
-                          lambda v, x: v.set_wind(angle=float(x)), lo=0.0, hi=360.0, fmt="%.0f°"),
+    "wind_angle": Setting("direction", "wind_angle", "set_wind", keyword="angle", lo=0.0, hi=360.0, fmt="%.0f°"),
     "turbulence": _wind("turbulence", "turbulence", 0.0, 1.0, shown=_physical),  # intensity at the canopy top
     "turbulence_paper": _wind("turbulence", "turbulence λ", 1.0, 2.0, shown=_paper),  # λ of Eq. 17
     "gust_strength": _wind("gust_strength", "gust strength", 0.0, 2.0),
@@ -198,29 +194,25 @@ SETTINGS: dict[str, Setting] = {
     "ei_max": _physics("ei_max"),
     **{f"{what}:{kind}": _modes(what, kind) for kind in KINDS for what in ("f", "zeta")},
     # simulation
-    "time_scale": Setting("time scale", lambda v: v.time_scale, lambda v, x: setattr(v, "time_scale", float(x)),
-                          lo=0.05, hi=2.0, fmt="%.2f×", log=True, clamp=True),
+    "time_scale": Setting("time scale", "time_scale", "set_time_scale", lo=TIME_SCALES[0], hi=TIME_SCALES[1],
+                          fmt="%.2f×", log=True, clamp=True),
     # the model: the whole tree as one structure (default), or the paper's independent objects
-    "paper_model": Setting("paper's model (Hu et al. 2012)", _paper_model,
-                           lambda v, x: v.set_model("paper" if x else "tree"), kind="check"),
-    "integrator": _paper_only(Setting("integrator", lambda v: v.sim.integrator,
-                                      lambda v, x: setattr(v.sim, "integrator", x), kind="choice",
-                                      choices=tuple(INTEGRATORS))),
-    "coupling": _paper_only(_flag(lambda v: v.sim, "coupling", "coupling")),
+    "paper_model": _check("paper's model (Hu et al. 2012)", _paper_model, "set_paper_model"),
+    "integrator": Setting("integrator", "sim.integrator", "set_integrator", kind="choice",
+                          choices=tuple(INTEGRATORS), shown=_paper_model, paper_only=True),
+    "coupling": _check("coupling", "sim.coupling", "set_coupling", shown=_paper_model, paper_only=True),
     # the paper's branch modes: beam theory, or the preset's ranges (Eqs. 20–22)
-    "physical_modes": _paper_only(Setting("physical modes (beam theory)", lambda v: v.sim.modal == "physical",
-                                          _set_modal, kind="check")),
-    "paused": _flag(lambda v: v, "paused", "paused"),
+    "physical_modes": _check("physical modes (beam theory)", _physical_modes, "set_physical_modes",
+                             shown=_paper_model, paper_only=True),
+    "paused": _check("paused", "paused", "set_paused"),
     # overlays
-    "show_trace": _flag(lambda v: v, "show_trace", "grab trace"),
-    "show_frames": _flag(lambda v: v, "show_frames", "local frames"),
-    "show_wind": _flag(lambda v: v, "show_wind", "wind slices + arrow"),
+    "show_trace": _check("grab trace", "show_trace", "set_overlay", args=("trace",)),
+    "show_frames": _check("local frames", "show_frames", "set_overlay", args=("frames",)),
+    "show_wind": _check("wind slices + arrow", "show_wind", "set_overlay", args=("wind",)),
     # light
-    "sun_azimuth": Setting("sun azimuth", lambda v: sun_angles(v.scene.sun_direction)[0],
-                           lambda v, x: _set_sun(v, azimuth=x), lo=0.0, hi=360.0, fmt="%.0f°"),
-    "sun_elevation": Setting("sun elevation", lambda v: sun_angles(v.scene.sun_direction)[1],
-                             lambda v, x: _set_sun(v, elevation=x), lo=5.0, hi=90.0, fmt="%.0f°"),
-    "translucency": Setting("translucency", lambda v: v.scene.translucency,
-                            lambda v, x: setattr(v.scene, "translucency", float(x)), clamp=True),
-    "shadows": _flag(lambda v: v.scene, "shadow", "shadows"),
+    "sun_azimuth": Setting("sun azimuth", _sun_azimuth, "set_sun", keyword="azimuth", lo=0.0, hi=360.0, fmt="%.0f°"),
+    "sun_elevation": Setting("sun elevation", _sun_elevation, "set_sun", keyword="elevation",
+                             lo=SUN_ELEVATIONS[0], hi=SUN_ELEVATIONS[1], fmt="%.0f°"),
+    "translucency": Setting("translucency", "scene.translucency", "set_translucency", clamp=True),
+    "shadows": _check("shadows", "scene.shadow", "set_shadows"),
 }

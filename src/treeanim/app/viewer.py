@@ -1,17 +1,21 @@
-"""The interactive viewer: a tree in wind in a GLFW window, dragged with the mouse, tuned from an
+"""The interactive viewer: a tree in wind in a window, dragged with the mouse, tuned from an
 imgui panel.
 
-:class:`Viewer` owns the simulation, the renderer, the camera and the panel of one window. The
-window's GLFW callbacks call its input handlers (``on_mouse_button``, ``on_cursor_pos``,
-``on_scroll``, ``on_key``, ``on_char``, ``on_resize``, ``on_focus``); tests call the same
-handlers. :meth:`Viewer.frame` advances the simulation by the elapsed time and draws one frame;
-:func:`run` is the main loop. The controls are the table in :mod:`treeanim.app.keys`.
+:class:`Viewer` owns the simulation, the renderer, the camera and the panel of one window: a
+GLFW window (:class:`~treeanim.app.window.Window`) or a headless one on EGL
+(:class:`~treeanim.app.headless.HeadlessWindow`), anything of the
+:class:`~treeanim.app.protocol.AppWindow` protocol. Everything it does is a plain method: its
+input handlers (``on_mouse_button``, ``on_cursor_pos``, ``on_scroll``, ``on_key``, ``on_char``,
+``on_resize``, ``on_focus``: :mod:`~treeanim.app.input`), which a GLFW window's callbacks call
+and tests call directly; its actions (open, save, the model, the settings, the light, the
+overlays, screenshots: :mod:`~treeanim.app.actions`), which the panel, the keys and scripts
+call; and :meth:`Viewer.frame`, which advances the simulation by the elapsed time and draws one
+frame. :func:`run` is the main loop. The controls are the table in :mod:`treeanim.app.keys`.
 """
 
 from __future__ import annotations
 
 import time
-from datetime import datetime
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +24,7 @@ from ..driver import MAX_FRAME_DT, FrameDriver
 from ..model.tree import Tree
 from ..physics.pull import SpringPull, TreeDrag
 from ..physics.pull import grab as grab_object
-from ..physics.simulation import MODELS, Simulation
+from ..physics.simulation import Simulation
 from ..physics.wind import WindField
 from ..physics.wind import wind_preset as wind_preset_kwargs
 from ..render.camera import TREE_ELEVATION, OrbitCamera, frame_tree
@@ -28,10 +32,11 @@ from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
 from ..render.picking import Picker
 from ..render.renderer import Renderer
 from ..render.scene import Scene
+from .actions import ViewerActions
 from .gui import Gui
 from .input import ViewerInput
+from .protocol import AppWindow
 from .winddir import wind_direction
-from .window import Window
 
 __all__ = ["Viewer", "run", "MAX_FRAME_DT"]
 
@@ -57,13 +62,14 @@ class _Ema:
         self.value = x if self.value is None else self.value + self.w * (x - self.value)
 
 
-class Viewer(ViewerInput):
+class Viewer(ViewerInput, ViewerActions):
     """A tree in wind in a window: simulation, renderer, camera, mouse and keys, panel.
 
     Parameters
     ----------
-    window : Window
-        An open window (its GL context current).
+    window : AppWindow
+        An open window (its GL context current): :class:`~treeanim.app.window.Window` (GLFW) or
+        :class:`~treeanim.app.headless.HeadlessWindow` (EGL, no display).
     tree : Tree
     season : float
         0 summer … 1 winter.
@@ -92,6 +98,11 @@ class Viewer(ViewerInput):
         The OpenGL renderer's name.
     show_trace, show_frames, show_wind : bool
         Overlays: the grabbed point's trace, the local frames, the wind slices and arrow.
+    preset_path : str
+        The file Save and Open use (Ctrl+S, Ctrl+O, the panel's buttons and text field); it
+        follows the tree shown (``NAME-custom.toml``) until another name is set.
+    messages : list of str
+        The status line's last lines (newest last).
     grab : TreeDrag or SpringPull or None
         The grab in progress (:mod:`treeanim.physics.pull`): a drag solved inside the tree
         model's step, or the paper model's spring pull.
@@ -103,7 +114,7 @@ class Viewer(ViewerInput):
         draw calls, panel), seconds; ``sim_ms`` and ``render_ms`` are their moving averages.
     """
 
-    def __init__(self, window: Window, tree: Tree, *, season: float = 0.0, wind_speed: float | None = None,
+    def __init__(self, window: AppWindow, tree: Tree, *, season: float = 0.0, wind_speed: float | None = None,
                  wind_angle_deg: float = 0.0, seed: int = 0, show_panel: bool = True, clock=None,
                  wind_preset: str | None = None, model: str = "tree") -> None:
         self.window = window
@@ -121,6 +132,7 @@ class Viewer(ViewerInput):
         self.trace = PullTrace(capacity=2400)
         self.camera = OrbitCamera(azimuth=20.0, elevation=TREE_ELEVATION)
         self.messages: list[str] = []  # lines for the panel's status line (newest last)
+        self.preset_path = self._default_path = ""
         self.screenshots: list[Path] = []
         self.sim_ms, self.render_ms, self.frame_s = _Ema(), _Ema(), _Ema(0.05)
         self.real_time = _Ema(0.05)  # simulated seconds per real second (the time scale, if kept up)
@@ -145,7 +157,7 @@ class Viewer(ViewerInput):
         named.setdefault("speed", 5.0)
         self._wind = _clone_wind(None, direction=wind_direction(wind_angle_deg), seed=self.seed, **named)
         self._season = float(season)
-        self.gui = Gui(window.handle, scale=window.content_scale)
+        self.gui = Gui(window, scale=window.content_scale)
         try:
             from .panel import Panel
 
@@ -178,6 +190,7 @@ class Viewer(ViewerInput):
         self._end_drag()
         sim = Simulation(tree, wind=_clone_wind(self._wind), season=self._season, seed=self.seed, model=self._model,
                          integrator=self._integrator, coupling=self._coupling)
+        self.window.make_current()
         renderer = Renderer(self.ctx, tree, scene=self.scene)
         if self.renderer is not None:
             self.renderer.release()
@@ -192,44 +205,25 @@ class Viewer(ViewerInput):
         self.wind_slices = WindSlices(self._wind_at, (lo, hi), resolution=9, reference_speed=None)
         self.wind_arrow = WindArrow(length=0.35 * size, reference_speed=10.0)
         self._wind_arrow_anchor = (0.5 * (lo + hi), 0.65 * size)
+        self._follow_file_name()
         self.frame_camera()
         self.panel.tree_changed()
-
-    def set_model(self, name: str) -> None:
-        """Switch the simulation to model ``name`` ('tree' or 'paper'; ValueError otherwise):
-        any grab is let go and the trace cleared; the tree restarts from rest (time, wind,
-        season and physics are kept)."""
-        if name == self.sim.model:
-            return
-        if name not in MODELS:
-            raise ValueError(f"model must be one of {tuple(MODELS)}, got {name!r}")
-        if self.sim.model == "paper":
-            self._integrator, self._coupling = self.sim.integrator, self.sim.coupling
-        self._end_drag()
-        self.sim.model = name
-        self._model = self.sim.model
-        self.trace.clear()
-        self.traced = None
-        self._uploaded = None
 
     def _wind_at(self, points: np.ndarray) -> np.ndarray:
         return self.sim.wind.sample(points, self.sim.time)
 
-    def set_wind(self, **changes) -> None:
-        """Change wind settings: ``speed``, ``angle`` (degrees), ``turbulence``, ``beta_u``,
-        ``beta_vw``, ``c3``, ``c4``, ``gust_strength``, ``gust_rate``, ``length_scale``
-        (each through the WindField's checked setters), or ``preset`` (a named wind of
-        :data:`treeanim.physics.wind.WIND_PRESETS`: its speed, turbulence and gusts)."""
-        w = self.sim.wind
-        if "preset" in changes:
-            changes = {**wind_preset_kwargs(changes.pop("preset")), **changes}
-            if w.model != changes.pop("model"):
-                raise ValueError("preset: the named winds are for the physical wind model")
-        for k, v in changes.items():
-            if k == "angle":
-                w.direction = wind_direction(v)
-            else:
-                setattr(w, k, v)
+    # ------------------------------------------------------------------ sizes
+    @property
+    def window_size(self) -> tuple[int, int]:
+        """The window's size in screen units as the viewer last heard of it (its handlers:
+        ``on_window_size``, ``on_resize``)."""
+        return self._win
+
+    @property
+    def framebuffer_size(self) -> tuple[int, int]:
+        """The framebuffer's size in pixels as the viewer last heard of it (0 × 0: minimised;
+        at most the GL's largest size)."""
+        return self._fb
 
     # ------------------------------------------------------------------ camera
     def frame_camera(self) -> None:
@@ -278,7 +272,7 @@ class Viewer(ViewerInput):
             dt = 0.0 if self._last_time is None else now - self._last_time
         self._last_time = now
         w, h = self._fb
-        if w <= 0 or h <= 0:
+        if w <= 0 or h <= 0 or self.window.framebuffer is None:  # minimised (the window knows first)
             return False
         self.window.make_current()
         t0 = time.perf_counter()
@@ -310,7 +304,10 @@ class Viewer(ViewerInput):
         if key != self._uploaded:  # the pose is unchanged while paused or between steps
             r.update(pos, sim.rotations, present=sim.shown, highlight=highlight)
             self._uploaded = key
-        self.ctx.screen.use()
+        target = self.window.framebuffer
+        if target is None:  # minimised since the viewer last heard of the size
+            return
+        target.use()
         r.draw(self.camera, fw, fh, season=sim.season, overlays=self.overlays())
         if self.show_panel:
             ww, wh = self._win
@@ -347,43 +344,9 @@ class Viewer(ViewerInput):
 
     # ------------------------------------------------------------------ pixels
     def read_pixels(self) -> np.ndarray:
-        """The back buffer as drawn so far, (height, width, 3) uint8, row 0 at the top
-        (:meth:`Window.read_pixels`)."""
+        """The frame as drawn so far, (height, width, 3) uint8, row 0 at the top
+        (:meth:`AppWindow.read_pixels <treeanim.app.protocol.AppWindow.read_pixels>`)."""
         return self.window.read_pixels(*self._fb)
-
-    def request_screenshot(self, path=None) -> None:
-        """Write a screenshot after the next frame is drawn (see :meth:`screenshot`)."""
-        self._screenshot_pending.append(None if path is None else Path(path))
-
-    def screenshot(self, path=None) -> Path:
-        """Write the back buffer as a PNG and print its path.
-
-        Parameters
-        ----------
-        path : path-like or None
-            None: ``treeanim-YYYYmmdd-HHMMSS.png`` in the current folder (``-2``, ``-3`` … if
-            taken within the same second).
-        """
-        import imageio.v3 as iio
-
-        if path is None:
-            stem = "treeanim-" + datetime.now().strftime("%Y%m%d-%H%M%S")
-            path = Path(stem + ".png")
-            k = 2
-            while path.exists():
-                path = Path(f"{stem}-{k}.png")
-                k += 1
-        path = Path(path)
-        iio.imwrite(path, self.read_pixels())
-        self.screenshots.append(path)
-        self.say(f"screenshot: {path}")
-        print(f"treeanim: screenshot {path.resolve()}", flush=True)
-        return path
-
-    def say(self, line: str) -> None:
-        """Show one line in the panel's status line."""
-        self.messages.append(line)
-        del self.messages[:-4]
 
     # ------------------------------------------------------------------ picking and grabbing
     def _ray(self, x: float, y: float):
@@ -436,33 +399,7 @@ class Viewer(ViewerInput):
             self.grab.release(self.sim)
             self.grab = None
 
-    # ------------------------------------------------------------------ actions (keys.BINDINGS)
-    def toggle_pause(self) -> None:
-        """Pause or resume the simulation."""
-        self.paused = not self.paused
-
-    def toggle_panel(self) -> None:
-        """Hide or show the panel."""
-        self.show_panel = not self.show_panel
-        if self.show_panel:
-            self.gui.mouse_pos(*self._cursor)
-
-    def toggle_fullscreen(self) -> None:
-        """Full screen on the window's monitor, or back."""
-        self.window.toggle_fullscreen()
-
-    def save_preset(self) -> None:
-        """Save the settings as a preset at the panel's file name (:meth:`Panel.save`)."""
-        self.panel.save()
-
-    def load_preset(self) -> None:
-        """Load the preset at the panel's file name (:meth:`Panel.load`)."""
-        self.panel.load()
-
-    def quit(self) -> None:
-        """Close the window (the main loop ends)."""
-        self.window.request_close()
-
+    # ------------------------------------------------------------------ actions (the rest: actions.py)
     def reset(self) -> None:
         """Back to rest: the simulation at time 0, no grab, no trace."""
         self._end_drag()
@@ -473,6 +410,7 @@ class Viewer(ViewerInput):
 
     def release(self) -> None:
         """Free the GL resources (the window stays open)."""
+        self.window.make_current()
         self.window.release_readback()
         if self.renderer is not None:
             self.renderer.release()

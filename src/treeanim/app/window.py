@@ -1,5 +1,6 @@
 """The viewer's GLFW window: OpenGL 3.3 core (forward-compatible), MSAA where available, vsync,
-and a moderngl context made from it.
+and a moderngl context made from it; one of the two :class:`~treeanim.app.protocol.AppWindow`
+implementations (the other: :class:`~treeanim.app.headless.HeadlessWindow`).
 
 Anything that keeps the window from opening (no display, no GLFW, no OpenGL 3.3) is raised as
 :class:`ViewerUnavailable` carrying one line that says what is missing and points to the
@@ -21,6 +22,7 @@ import numpy as np
 
 from ..errors import ViewerUnavailable
 from .display import HEADLESS_HINT, check_display
+from .protocol import gl_max_pixels
 
 __all__ = ["Window", "ViewerUnavailable", "HEADLESS_HINT", "SOFTWARE_RENDERER"]
 
@@ -172,12 +174,15 @@ class Window:
         return tuple(glfw.get_framebuffer_size(self.handle))
 
     @property
+    def framebuffer(self) -> moderngl.Framebuffer:
+        """The window's default framebuffer (its back buffer), which a frame is drawn into."""
+        return self.ctx.screen
+
+    @property
     def max_pixels(self) -> int:
         """The largest side, in pixels, the GL can draw and read back (viewport, renderbuffer and
         texture limits): a larger window is drawn only up to it."""
-        info = self.ctx.info
-        dims = info.get("GL_MAX_VIEWPORT_DIMS", (16384, 16384))
-        return int(min(min(dims), info.get("GL_MAX_RENDERBUFFER_SIZE", 16384), info.get("GL_MAX_TEXTURE_SIZE", 16384)))
+        return gl_max_pixels(self.ctx)
 
     def shrink_to(self, most: int) -> None:
         """Make the window at most ``most`` pixels a side (where no window manager did)."""
@@ -305,6 +310,15 @@ class Window:
             for o in self._readback[1:]:
                 o.release()
             self._readback = None
+
+    def get_clipboard(self) -> str:
+        """The system clipboard's text ('' when it holds none)."""
+        text = glfw.get_clipboard_string(self.handle)
+        return text.decode("utf-8", "replace") if text else ""
+
+    def set_clipboard(self, text: str) -> None:
+        """Put ``text`` on the system clipboard."""
+        glfw.set_clipboard_string(self.handle, text)
 
     def close(self) -> None:
         """Destroy the window and stop GLFW (idempotent)."""

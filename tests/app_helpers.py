@@ -1,0 +1,97 @@
+"""Driving a viewer from a test, on either window (test_app: headless on EGL; test_app_window:
+GLFW under Xvfb): the mouse and the panel through the viewer's own handlers, a branch to grab,
+the pixels the tree covers."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import glfw
+import numpy as np
+
+import treeanim as ta
+
+#: The apps' size in screen units, and a 60 Hz frame.
+W, H = 480, 360
+DT = 1.0 / 60.0
+
+
+def press(v, x, y, button=glfw.MOUSE_BUTTON_LEFT):
+    """Move the cursor to (x, y) and press ``button`` there."""
+    v.on_cursor_pos(x, y)
+    v.on_mouse_button(button, glfw.PRESS, 0)
+
+
+def click(v, x, y):
+    """A click on the panel: imgui sees the move, the press and the release in separate frames."""
+    v.on_cursor_pos(x, y)
+    v.frame(DT)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.PRESS, 0)
+    v.frame(DT)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    v.frame(DT)
+
+
+def centre(rect):
+    """The centre of an (x0, y0, x1, y1) rectangle."""
+    return 0.5 * (rect[0] + rect[2]), 0.5 * (rect[1] + rect[3])
+
+
+def reveal(v, label, height=H):
+    """Scroll the panel with the wheel until ``label`` is in view; its centre."""
+    for _ in range(12):
+        r = v.panel.item_rects.get(label)
+        if r is not None and r[1] > 4 and r[3] < height - 4:
+            return centre(r)
+        v.on_cursor_pos(150, height / 2)
+        v.frame(DT)
+        v.on_scroll(0.0, -2.0 if r is None or r[3] >= height - 4 else 2.0)
+        v.frame(DT)
+        v.frame(DT)
+    raise AssertionError(f"{label} never came into view")
+
+
+def tree_pixels(v, w, h, threshold):
+    """Pixels where the tree differs by more than ``threshold`` from the same view without it
+    (the renderer told that nothing is present; the panel not drawn), and the view with it."""
+    v.show_panel, shown = False, v.show_panel
+    v.frame(DT)
+    scene = v.read_pixels()
+    r = v.renderer
+    r.update(v.sim.positions, v.sim.rotations, present=np.zeros(v.tree.n_objects, bool))
+    v.window.framebuffer.use()
+    r.draw(v.camera, w, h, season=v.sim.season)
+    empty = v.read_pixels()
+    v._uploaded = None  # the viewer uploads its pose again on its next frame
+    v.show_panel = shown
+    return np.abs(scene.astype(int) - empty.astype(int)).max(axis=2) > threshold, scene
+
+
+def branch_on_screen(v, w=W, h=H):
+    """A branch whose tip region is visible and picks as itself: (object, x, y)."""
+    tree, P = v.tree, v.sim.positions
+    branches = [i for i in np.flatnonzero(tree.kind == "branch") if tree.level[i] >= 2]
+
+    def length(i):
+        return np.linalg.norm(np.diff(tree.rest_positions[tree.object_nodes(i)], axis=0), axis=1).sum()
+
+    for i in sorted(branches, key=length, reverse=True):
+        nodes = tree.object_nodes(i)
+        for f in (0.75, 0.6, 0.9):
+            pt = P[nodes[0]] + f * (P[nodes[-1]] - P[nodes[0]])
+            x, y, z = v.camera.project(pt, w, h)[0]
+            if not (40 < x < w - 40 and 40 < y < h - 40 and 0 < z < 1):
+                continue
+            hit = v.pick(x, y)
+            if hit is not None and hit.object == i:
+                return int(i), float(x), float(y)
+    raise AssertionError("no branch of the small cherry is visible on its own")
+
+
+def unsimulable(name="beam"):
+    """A preset's tree whose physics has no f/ζ range for its branches (Simulation: ValueError)."""
+    tree = ta.load_preset(name)
+    p = tree.physics
+    physics = dataclasses.replace(p, summer=dataclasses.replace(p.summer, branch=None),
+                                  winter=dataclasses.replace(p.winter, branch=None))
+    return dataclasses.replace(tree, physics=physics)
