@@ -67,6 +67,28 @@ def tree_pixels(v, w, h, threshold):
     return np.abs(scene.astype(int) - empty.astype(int)).max(axis=2) > threshold, scene
 
 
+def check_tree_and_panel(v, samples):
+    """Draw two frames with the panel and check the picture: the tree in the middle of the
+    window, the panel over the scene at the left where its rectangle says, nothing else
+    changed; ``samples`` the MSAA sample counts the window may have."""
+    v.show_panel = True
+    assert v.frame(DT)
+    assert v.frame(DT)  # imgui sizes a new window to its content over its first frames
+    with_panel = v.read_pixels()
+    assert with_panel.shape == (H, W, 3)
+    assert v.window.samples in samples
+    tree_px, scene = tree_pixels(v, W, H, 24)
+    assert v.ctx.error == "GL_NO_ERROR"
+    assert tree_px.mean() > 0.03, "the tree covers too little of the window"
+    ys, xs = np.nonzero(tree_px)
+    assert 0.1 * W < xs.mean() < 0.9 * W and 0.1 * H < ys.mean() < 0.9 * H
+    x0, y0, x1, y1 = (int(round(c)) for c in v.panel.rect)
+    assert x0 < 20 and x1 > 200 and y1 > 100
+    differs = np.abs(with_panel.astype(int) - scene.astype(int)).max(axis=2) > 24
+    assert differs[y0 + 2:y1 - 2, x0 + 2:x1 - 2].mean() > 0.5
+    assert differs[:, x1 + 4:].mean() < 0.01
+
+
 def branch_on_screen(v, w=W, h=H):
     """A branch whose tip region is visible and picks as itself: (object, x, y)."""
     tree, P = v.tree, v.sim.positions

@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 import treeanim as ta
-from app_helpers import DT, H, W, branch_on_screen, centre, click, press, reveal, tree_pixels, unsimulable
+from app_helpers import DT, H, W, branch_on_screen, centre, check_tree_and_panel, click, press, reveal, tree_pixels, unsimulable
 from treeanim.app.gui import Gui
 from treeanim.app.headless import HeadlessWindow
 from treeanim.app.save import physics_toml, preset_text, save_preset
@@ -72,24 +72,7 @@ def viewer(cherry):
 
 # ---------------------------------------------------------------------------- drawing
 def test_the_app_draws_the_tree_and_the_panel(viewer):
-    v = viewer
-    v.show_panel = True
-    assert v.frame(DT)
-    assert v.frame(DT)  # imgui sizes a new window to its content over its first frames
-    with_panel = v.read_pixels()
-    assert with_panel.shape == (H, W, 3)
-    assert v.window.samples == 0
-    tree_px, scene = tree_pixels(v, W, H, 24)
-    assert v.ctx.error == "GL_NO_ERROR"
-    assert tree_px.mean() > 0.03, "the tree covers too little of the window"
-    ys, xs = np.nonzero(tree_px)
-    assert 0.1 * W < xs.mean() < 0.9 * W and 0.1 * H < ys.mean() < 0.9 * H
-    # The panel is drawn over the scene at the left, where its rectangle says.
-    x0, y0, x1, y1 = (int(round(c)) for c in v.panel.rect)
-    assert x0 < 20 and x1 > 200 and y1 > 100
-    differs = np.abs(with_panel.astype(int) - scene.astype(int)).max(axis=2) > 24
-    assert differs[y0 + 2:y1 - 2, x0 + 2:x1 - 2].mean() > 0.5
-    assert differs[:, x1 + 4:].mean() < 0.01
+    check_tree_and_panel(viewer, (0,))
 
 
 # ---------------------------------------------------------------------------- pulling

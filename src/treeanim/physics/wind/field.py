@@ -265,6 +265,10 @@ class WindField(ABC):
         """Called with the new settings and box, checked, just before they replace the current
         ones (``self._params``, ``self._bounds``): for caches and clocks. Nothing by default."""
 
+    def _profile(self, h: np.ndarray) -> np.ndarray:
+        """The mean profile at the finite heights ``h`` (see :meth:`profile`)."""
+        raise NotImplementedError(f"the {self.model} wind model has no mean profile")
+
     @abstractmethod
     def _sample(self, p: np.ndarray, t: float, out: np.ndarray) -> None:
         """Write the wind (m/s, world) at the points ``p`` (K, 3), K ≥ 1, finite, at the finite
@@ -357,6 +361,25 @@ class WindField(ABC):
         self.bounds = b
 
     # -- sampling ------------------------------------------------------------------------------------
+
+    def profile(self, h) -> np.ndarray:
+        """The mean wind profile: the mean speed at height ``h`` over ``speed`` (the model's
+        own law, 1 at its reference height).
+
+        Parameters
+        ----------
+        h : array_like
+            Heights above the ground in metres (world y), finite.
+
+        Returns
+        -------
+        numpy.ndarray
+            The profile, dimensionless, same shape as h.
+        """
+        h = np.asarray(h, dtype=np.float64)
+        if not np.all(np.isfinite(h)):
+            raise ValueError("h must be finite")
+        return self._profile(h)
 
     def sample(self, points, t: float) -> np.ndarray:
         """World wind velocity at ``points`` and time ``t``.

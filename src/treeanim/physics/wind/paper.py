@@ -359,23 +359,8 @@ class PaperWind(WindField):
     def c2(self, value) -> None:
         self._set(c2=value)
 
-    def profile(self, h) -> np.ndarray:
-        """Mean wind profile W(h) = c1·ln(c2·h) of Eq. 16: the mean speed at height h over
-        ``speed``; 0 below h = 1/c2, 1 at the top of the bounds by default.
-
-        Parameters
-        ----------
-        h : array_like
-            Heights above the ground in metres (world y).
-
-        Returns
-        -------
-        numpy.ndarray
-            The profile, dimensionless, same shape as h.
-        """
-        h = np.asarray(h, dtype=np.float64)
-        if not np.all(np.isfinite(h)):
-            raise ValueError("h must be finite")
+    def _profile(self, h: np.ndarray) -> np.ndarray:
+        """W(h) = c1·ln(c2·h) of Eq. 16: 0 below h = 1/c2, 1 at the top of the bounds by default."""
         c1, c2 = self.c1, self.c2
         log_h0 = -math.log(c2)
         # ln(c2·h) = ln h − ln(1/c2), written so that no finite h overflows.

@@ -483,26 +483,10 @@ class PhysicalWind(WindField):
             t = self._t_last
             self._clock = (t, *self._clocks(t))
 
-    def profile(self, h) -> np.ndarray:
-        """Mean wind profile: the mean speed at height h over ``speed``.
-
-        ln((h − d)/z0) / ln((h_c − d)/z0) above the canopy height h_c (d = 0.7 h_c,
+    def _profile(self, h: np.ndarray) -> np.ndarray:
+        """ln((h − d)/z0) / ln((h_c − d)/z0) above the canopy height h_c (d = 0.7 h_c,
         z0 = 0.1 h_c) and exp(a(h/h_c − 1)) inside it, with a = 1/(0.3 ln 3) ≈ 3.03 so the two
-        meet smoothly; 1 at h_c.
-
-        Parameters
-        ----------
-        h : array_like
-            Heights above the ground in metres (world y).
-
-        Returns
-        -------
-        numpy.ndarray
-            The profile, dimensionless, same shape as h.
-        """
-        h = np.asarray(h, dtype=np.float64)
-        if not np.all(np.isfinite(h)):
-            raise ValueError("h must be finite")
+        meet smoothly; 1 at h_c."""
         return _canopy_mean(h, self.canopy_height)
 
     def sample(self, points, t: float) -> np.ndarray:
