@@ -349,6 +349,11 @@ BAD = [
     (["render", "beam", "--fps", "9" * 5000, "--out", "x.png"], "(5,000 characters)"),  # not echoed whole
     (["render", "beam", "--out", "no/such/a\nb.png"], "a\\nb.png"),  # a newline in a path: still one line
     (["export", "beam", "--out", "b" * 300 + ".glb"], "bytes long"),
+    # a trailing '/' names a folder: export wrote x.gltf (these commands write one file; only
+    # render takes a folder, for its frames)
+    (["export", "beam", "--out", "x.gltf/"], "x.gltf/: ends in '/', a folder's name; name a file (e.g. x.gltf)"),
+    (["trace", "beam", "--pull", "1,0,0", "--out", "t.csv/"], "ends in '/'"),
+    (["bench", "--presets", "beam", "--json", "b.json/"], "--json b.json/: ends in '/'"),
 ]
 
 
