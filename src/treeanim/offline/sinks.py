@@ -11,16 +11,19 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError
-from ..files import atomic_path, temp_beside
+from ..files import atomic_path, remove_stale, temp_beside
 
 #: Name pattern of the frames written into a folder.
 FRAME_NAME = "frame_{:05d}.png"
+#: Any frame file's name (whose stale temporary files a new run removes once, not per frame).
+FRAME_RE = re.compile(r"frame_\d{5,}\.png")
 #: The still's extension.
 STILL_SUFFIX = ".png"
 
@@ -199,11 +202,12 @@ class VideoSink:
         self.tmp.unlink(missing_ok=True)
 
 
-def write_png(path: Path, img: np.ndarray) -> None:
-    """One PNG, written beside ``path`` and renamed over it (never a half-written file)."""
+def write_png(path: Path, img: np.ndarray, clean: bool = True) -> None:
+    """One PNG, written beside ``path`` and renamed over it (never a half-written file);
+    ``clean``: first remove the stale temporary files of ``path`` (:func:`~treeanim.files.remove_stale`)."""
     import imageio.v3 as iio
 
-    with atomic_path(path, ".png") as tmp:
+    with atomic_path(path, ".png", clean=clean) as tmp:
         iio.imwrite(tmp, img, extension=".png")
 
 
@@ -218,11 +222,12 @@ class FrameSink:
         self.size = (int(width), int(height))
         self.created = not self.path.exists()
         self.path.mkdir(exist_ok=True)
+        remove_stale(self.path, FRAME_RE)  # once for every frame name (not a folder scan per frame)
         self.count = 0
 
     def write(self, img: np.ndarray) -> None:
         """Write ``img`` ((height, width, 3) uint8, row 0 at the top) as the next frame file."""
-        write_png(self.path / FRAME_NAME.format(self.count), img)
+        write_png(self.path / FRAME_NAME.format(self.count), img, clean=False)
         self.count += 1
 
     def nbytes(self) -> int:
