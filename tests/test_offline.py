@@ -454,6 +454,35 @@ def test_a_write_that_fails_part_way_keeps_the_old_file_and_says_so(tmp_path, ou
     assert sorted(p.name for p in tmp_path.iterdir()) == [out]
 
 
+FFMPEG_SAYS = ("[out#0/mp4 @ 0x55d0c0a1b2c0] Error writing trailer: No space left on device",
+               "[out#0/mp4 @ 0x55d0c0a1b2c0] Error closing file: No space left on device")
+
+
+@pytest.mark.parametrize("when", ["at the end", "at once"])
+def test_a_failing_encoder_is_our_one_line_not_ffmpegs(tmp_path, monkeypatch, capfd, when):
+    """Issue 31: on a full disk ffmpeg's own two lines came before ours. An ffmpeg that says
+    those two lines and exits 1, after reading every frame (the trailer did not fit) or at
+    once (the pipe breaks under our writes): standard error is our one line, with its reason;
+    the previous file is kept and no temporary file is left. (A real full tmpfs gives the same
+    line: 'the video encoder failed (Error writing trailer: No space left on device)'.)"""
+    fake = tmp_path / "ffmpeg"
+    drain = "cat > /dev/null\n" if when == "at the end" else ""
+    fake.write_text("#!/bin/sh\n" + drain + "".join(f"echo '{line}' >&2\n" for line in FFMPEG_SAYS) + "exit 1\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("IMAGEIO_FFMPEG_EXE", str(fake))
+    out = tmp_path / "clip.mp4"
+    out.write_bytes(b"the previous video")
+    code = cli.main(["render", "beam", "--seconds", "0.5", "--fps", "30", "--size", "64x48", "--quiet",
+                     "--out", str(out)])
+    captured = capfd.readouterr()
+    assert code == 1
+    assert captured.err.splitlines() == [
+        f"treeanim: error: {out}: the video encoder failed (Error writing trailer: No space left on device); "
+        "any previous file is kept"], captured.err
+    assert out.read_bytes() == b"the previous video"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["clip.mp4", "ffmpeg"]
+
+
 def test_sigterm_during_a_render_leaves_no_temporary_file(tmp_path):
     out = tmp_path / "clip.mp4"
     proc = subprocess.Popen([sys.executable, "-m", "treeanim", "render", "small_cherry", "--out", str(out),
