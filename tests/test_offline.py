@@ -309,6 +309,49 @@ def test_bench_json_reports_every_preset(tmp_path):
     assert "| large_cherry (winter) |" in res.stdout and doc["gl_renderer"] in res.stdout
 
 
+def test_ctrl_c_in_bench_keeps_the_finished_rows_printed_and_in_the_json(tmp_path, monkeypatch, capsys):
+    """Issue 31: a Ctrl-C threw away every finished row (the table and the JSON came only at the
+    end). Ctrl-C, raised while the second preset steps: the first row was already printed when
+    it came, it is in the JSON with ``interrupted``, and the exit status is 130."""
+    real = bench.bench_row
+    seen = {}
+
+    def row(key, *a, progress=None, **kw):
+        if key != "small_cherry":
+            return real(key, *a, progress=progress, **kw)
+
+        def ctrl_c():
+            seen["stdout"] = capsys.readouterr().out  # what was printed before the interruption
+            raise KeyboardInterrupt
+
+        return real(key, *a, progress=ctrl_c, **kw)
+
+    monkeypatch.setattr(bench, "bench_row", row)
+    out = tmp_path / "bench.json"
+    code = cli.main(["bench", "--presets", "beam", "small_cherry", "--size", "32x24", "--frames", "1", "--steps", "2",
+                     "--quiet", "--json", str(out)])
+    rest = capsys.readouterr()
+    assert code == 130
+    assert "| beam | 1 / — |" in seen["stdout"] and "| preset |" in seen["stdout"]  # printed as it finished
+    assert "small_cherry" not in seen["stdout"] + rest.out
+    doc = json.loads(out.read_text())
+    assert doc["interrupted"] is True and [r["key"] for r in doc["rows"]] == ["beam"]
+    assert doc["rows"][0]["sim_ms"] > 0 and doc["gl_renderer"]
+    assert rest.out.strip() == f"wrote {out} (1 of 2 rows)"
+    assert rest.err.strip() == "interrupted: 1 of 2 rows measured"
+
+
+def test_ctrl_c_in_bench_before_any_row_writes_nothing(tmp_path, monkeypatch, capsys):
+    def interrupted(*a, **kw):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(bench, "bench_row", interrupted)
+    out = tmp_path / "bench.json"
+    code = cli.main(["bench", "--presets", "beam", "--size", "32x24", "--quiet", "--json", str(out)])
+    assert code == 130 and not out.exists() and os.listdir(tmp_path) == []
+    assert capsys.readouterr().err.strip() == f"interrupted: 0 of 1 row measured; nothing written to {out}"
+
+
 # ------------------------------------------------------------------------------ bad input
 BAD = [
     (["render", "small_cherry", "--out", "clip.avi"], "unknown extension"),

@@ -196,16 +196,20 @@ def cmd_bench(args) -> int:
             raise UsageError(f"--presets {k}: unknown; expected some of {', '.join(known)}")
     out = output_path(args.json, (".json",), "--json") if args.json else None
     w, h = args.size
-    try:
+    try:  # each row is printed as it finishes; Ctrl-C keeps the finished ones, in the JSON too
         res = bench.run_bench(keys, w, h, frames=args.frames, steps=args.steps, samples=args.samples,
-                              wind=args.wind, quiet=args.quiet)
+                              wind=args.wind, quiet=args.quiet, emit=lambda text: print(text, flush=True))
     except GLUnavailable as e:
         print(one_line(f"treeanim: error: {e}"), file=sys.stderr)
         return 1
-    print(bench.format_bench(res))
-    if out is not None:
+    if out is not None and res["rows"]:
         write_text(out, json.dumps(res, indent=2) + "\n")
-        print(f"wrote {out}")
+        print(f"wrote {out}" + (f" ({len(res['rows'])} of {len(keys)} rows)" if res["interrupted"] else ""))
+    if res["interrupted"]:
+        done = len(res["rows"])
+        print(f"interrupted: {done} of {len(keys)} row{'s' * (len(keys) != 1)} measured"
+              + ("" if done or out is None else f"; nothing written to {out}"), file=sys.stderr)
+        return 130
     return 0
 
 
