@@ -5,8 +5,6 @@ keys (``treeanim view --help``)."""
 
 from __future__ import annotations
 
-import numpy as np
-
 
 def preset_lines() -> list[str]:
     """One line per shipped preset: its name, height, objects and triangles (summer), and its
@@ -39,13 +37,11 @@ def _count(n: int, what: str) -> str:
 def object_lines(tree) -> list[str]:
     """A table of ``tree``'s objects by number: kind, level, parent, nodes, length along its
     nodes (m), base diameter (cm) and tip (x, y, z in m, y up)."""
+    from .model.geometry import object_lengths
+
     P = tree.rest_positions
-    seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
-    within = np.ones(len(seg), bool)
     ends = tree.object_start + tree.object_count - 1
-    within[ends[:-1]] = False  # no segment from one object's tip to the next one's base
-    cum = np.concatenate([[0.0], np.cumsum(np.where(within, seg, 0.0))])
-    length = cum[ends] - cum[tree.object_start]
+    length = object_lengths(tree)
     lines = [f"{'object':>7}  {'kind':<6}{'level':>6}{'parent':>8}{'nodes':>7}{'length m':>10}{'base cm':>9}"
              f"   tip x, y, z (m)"]
     for i in range(tree.n_objects):
