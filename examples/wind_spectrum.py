@@ -1,16 +1,23 @@
-"""Plot the wind field's measured spectra and a vertical slice of wind speed (paper Fig. 7b).
+"""Plot the wind's measured spectra and a vertical slice of wind speed, for the default
+physical wind (the one the viewer and every command use) or, with ``--paper``, the paper's
+field (its Fig. 7b).
 
-    .venv/bin/python examples/wind_spectrum.py --out out/
+    .venv/bin/python examples/wind_spectrum.py --out out/            # the physical wind
+    .venv/bin/python examples/wind_spectrum.py --paper --out out/    # the paper's field
 
 writes two PNGs:
 
-* ``wind_spectrum.png`` — the 1-D power spectra of the three noise components (u along the
-  wind, v vertical, w lateral), averaged over all grid lines and the three axes, against
-  k^−β reference lines, with the slope fitted over k = 2 … N/8;
-* ``wind_slice.png`` — wind speed on the vertical plane through the middle of the default
-  bounds (10 m × 10 m) with arrows, and beside it the mean speed per height against the log
-  profile c1·ln(c2·h) of Eq. 16, averaged over 8 seeds (drawn at the nominal speed, and
-  least-squares scaled: Eq. 17's turbulence factor averages a little below 1).
+* ``wind_spectrum.png`` — physical: the power spectra of the three components (u along the
+  wind, v vertical, w lateral) at fixed points at the canopy top over ``--seconds`` of wind,
+  against the von Kármán shape (f² + f0²)^−β/2 of each component's length scale (f0 =
+  U / (2π·1.339·L_c), L_c = L for u and L/3 for v, w), with the slope fitted in the inertial
+  range. Paper: the 1-D power spectra of the three noise grids, averaged over all grid lines
+  and the three axes, against k^−β, with the slope fitted over k = 2 … N/8;
+* ``wind_slice.png`` — wind speed on the vertical plane through the wind, with arrows, and
+  beside it the mean speed per height: physical, the mean along-wind speed and σ_u against
+  the canopy profile (exponential inside the canopy, logarithmic above); paper, the mean speed
+  against the log profile c1·ln(c2·h) of Eq. 16, averaged over 8 seeds (drawn at the nominal
+  speed, and least-squares scaled: Eq. 17's turbulence factor averages a little below 1).
 
 Needs matplotlib: ``.venv/bin/pip install -e '.[plots]'`` from the repository, then
 ``.venv/bin/python examples/wind_spectrum.py``.
@@ -41,27 +48,94 @@ def axis_spectrum(field: np.ndarray) -> np.ndarray:
     return np.mean(out, axis=0)
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--out", type=Path, default=Path("out"), help="output directory")
-    parser.add_argument("--grid", type=int, default=64, help="noise grid edge N (default 64)")
-    parser.add_argument("--speed", type=float, default=8.0, help="wind speed at the top, m/s")
-    parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--time", type=float, default=0.0, help="time of the slice, s")
-    args = parser.parse_args(argv)
+def physical_plots(args, plt) -> tuple[Path, Path]:
+    """The default physical wind: spectra at fixed points over time, a slice and the profile."""
+    from scipy.signal import welch
 
-    try:
-        import matplotlib
+    wind = WindField(speed=args.speed, seed=args.seed)  # the default field, as the commands make it
+    H, L, U = wind.canopy_height, wind.length_scale, wind.speed
 
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        from treeanim.offline.trace import PLOTS_HINT
+    # -- spectra at fixed points at the canopy top, across the wind ---------------------------
+    rate = args.rate
+    n = max(int(round(args.seconds * rate)), 64)
+    across = np.linspace(0.0, 6 * L, 24, endpoint=False)  # the tile is 6 L across the wind
+    pts = np.column_stack([np.zeros_like(across), np.full_like(across, H), across])
+    uvw = np.empty((n, len(pts), 3))
+    for k in range(n):
+        uvw[k] = wind.sample(pts, k / rate) @ wind.frame.T  # (along, vertical, lateral)
+    f, psd = welch(uvw - uvw.mean(axis=0), fs=rate, nperseg=min(n, 1024), axis=0)
+    psd = psd.mean(axis=1)  # (frequency, component), averaged over the points
+    fig, ax = plt.subplots(figsize=(6.4, 4.8), dpi=120)
+    names = ("u (along wind)", "v (vertical)", "w (lateral)")
+    betas = (wind.beta_u, wind.beta_vw, wind.beta_vw)
+    scales = (L, L / 3, L / 3)
+    colors = ("tab:blue", "tab:orange", "tab:green")
+    top = U * 16 / (4 * L)  # half the tile's Nyquist frequency at a fixed point (16 cells per L)
+    for i, (name, beta, lc, color) in enumerate(zip(names, betas, scales, colors)):
+        f0 = U / (2 * np.pi * 1.339 * lc)
+        band = (f >= 3 * f0) & (f <= top)
+        spec = psd[1:, i] * 10.0 ** (-i)  # offset the curves so they do not overlap
+        ff = f[1:]
+        slope = np.polyfit(np.log(f[band]), np.log(psd[band, i]), 1)[0] if band.sum() > 2 else float("nan")
+        ax.loglog(ff, spec, "-", lw=1, color=color, label=f"{name}: σ = {uvw[:, :, i].std():.2f} m/s, "
+                                                          f"slope {slope:.2f} above {3 * f0:.2f} Hz")
+        shape = (ff ** 2 + f0 ** 2) ** (-beta / 2)
+        ref = shape * np.exp(np.mean(np.log(spec[band[1:]] / shape[band[1:]]))) if band.sum() else shape
+        ax.loglog(ff, ref, "--", color=color, lw=1, label=f"von Kármán, β = {beta:.3g}, L_c = {lc:.3g} m")
+    ax.axvline(top, color="0.6", lw=0.8)
+    ax.set_xlabel("frequency f (Hz)")
+    ax.set_ylabel("power spectral density (m²/s² per Hz; offset by decades)")
+    ax.set_title(f"Physical wind at the canopy top: U = {U:g} m/s, L = {L:g} m, {n / rate:g} s")
+    ax.legend(fontsize=6.5, loc="lower left")
+    fig.tight_layout()
+    spectrum_png = args.out / "wind_spectrum.png"
+    fig.savefig(spectrum_png)
+    plt.close(fig)
 
-        print(f"wind_spectrum.py {PLOTS_HINT}", file=sys.stderr)
-        return 1
+    # -- a vertical slice along the wind, and the mean profile ---------------------------------
+    xs = np.linspace(-2 * L, 2 * L, 200)
+    ys = np.linspace(0.02 * H, 2 * H, 100)
+    gx, gy = np.meshgrid(xs, ys)
+    pts = np.column_stack([gx.ravel(), gy.ravel(), np.zeros(gx.size)])
+    u = wind.sample(pts, args.time)
+    speed = np.linalg.norm(u, axis=1).reshape(gx.shape)
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(11, 4.8), dpi=120, gridspec_kw={"width_ratios": [2, 1]})
+    im = ax.pcolormesh(gx, gy, speed, shading="auto", cmap="viridis")
+    fig.colorbar(im, ax=ax, label="wind speed (m/s)")
+    sx, sy = 12, 10
+    ax.quiver(gx[::sy, ::sx], gy[::sy, ::sx], u[:, 0].reshape(gx.shape)[::sy, ::sx],
+              u[:, 1].reshape(gx.shape)[::sy, ::sx], color="white", scale=30 * U, width=0.003)
+    ax.axhline(H, color="white", lw=0.8, ls=":")
+    ax.set_xlabel("x (m), wind along +x")
+    ax.set_ylabel("height y (m)")
+    ax.set_title(f"Wind speed on the plane z = 0, t = {args.time:g} s (dotted: canopy height)")
+    ax.set_aspect("equal")
 
-    args.out.mkdir(parents=True, exist_ok=True)
+    heights = np.linspace(0.02 * H, 2 * H, 40)
+    rng = np.random.default_rng(1)
+    samples = []
+    for t in np.linspace(0.0, 20 * L / U, 40):  # many eddies pass
+        p = np.column_stack([np.repeat(rng.uniform(-4 * L, 4 * L, 40), len(heights)),
+                             np.tile(heights, 40), np.repeat(rng.uniform(0, 6 * L, 40), len(heights))])
+        samples.append((wind.sample(p, t) @ wind.frame[0]).reshape(40, len(heights)))
+    along = np.concatenate(samples)
+    bx.plot(along.mean(axis=0), heights, "o", ms=3, label="measured mean along-wind speed")
+    bx.plot(U * wind.profile(heights), heights, "-", color="tab:red", label="U · canopy profile")
+    bx.plot(along.std(axis=0), heights, "s", ms=3, color="tab:green", label="measured σ_u")
+    bx.axhline(H, color="0.5", lw=0.8, ls=":")
+    bx.set_xlabel("speed (m/s)")
+    bx.set_ylabel("height y (m)")
+    bx.set_title("Mean profile")
+    bx.legend(fontsize=7, loc="lower right")
+    fig.tight_layout()
+    slice_png = args.out / "wind_slice.png"
+    fig.savefig(slice_png)
+    plt.close(fig)
+    return spectrum_png, slice_png
+
+
+def paper_plots(args, plt) -> tuple[Path, Path]:
+    """The paper's field (Eqs. 13–18): its noise grids' spectra and a slice with the log profile."""
     wind = WindField(model="paper", speed=args.speed, grid=args.grid, seed=args.seed)
     n = wind.grid
 
@@ -144,9 +218,41 @@ def main(argv: list[str] | None = None) -> int:
     fig.savefig(slice_png)
     plt.close(fig)
 
-    print(f"wrote {spectrum_png} and {slice_png}")
-    return 0
+    return spectrum_png, slice_png
 
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", type=Path, default=Path("out"), help="output directory")
+    parser.add_argument("--paper", action="store_true",
+                        help="plot the paper's field (Eqs. 13-18) instead of the default physical wind")
+    parser.add_argument("--speed", type=float, default=5.0,
+                        help="wind speed at the canopy top (paper: the top), m/s (default 5)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--time", type=float, default=0.0, help="time of the slice, s")
+    parser.add_argument("--seconds", type=float, default=400.0,
+                        help="physical: seconds of wind the spectra are measured over (default 400)")
+    parser.add_argument("--rate", type=float, default=10.0, help="physical: samples per second (default 10)")
+    parser.add_argument("--grid", type=int, default=64, help="paper: noise grid edge N (default 64)")
+    args = parser.parse_args(argv)
+
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        from treeanim.offline.trace import PLOTS_HINT
+
+        print(f"wind_spectrum.py {PLOTS_HINT}", file=sys.stderr)
+        return 1
+
+    args.out.mkdir(parents=True, exist_ok=True)
+    spectrum_png, slice_png = (paper_plots if args.paper else physical_plots)(args, plt)
+    which = "the paper's field" if args.paper else "the physical wind"
+    print(f"wrote {spectrum_png} and {slice_png} ({which})")
+    return 0
 
 if __name__ == "__main__":
     sys.exit(main())

@@ -14,7 +14,7 @@ EXAMPLES = ROOT / "examples"
 
 RUNS = {
     "lissajous.py": (["--seconds", "4"], ["fig4a.png", "fig4b.png", "fig4.png"]),
-    "wind_spectrum.py": (["--grid", "16"], None),
+    "wind_spectrum.py": (["--seconds", "60"], ["wind_spectrum.png", "wind_slice.png"]),
     "batch_render.py": (["--size", "64x48"], None),
 }
 
@@ -35,6 +35,15 @@ def test_example_runs(tmp_path, name):
         assert set(files) <= set(made), made
     if name == "batch_render.py":  # each still is named once, by treeanim render
         assert len(res.stdout.splitlines()) == len(made) == 2 * 5
+
+
+@pytest.mark.parametrize("args,wind", [([], "the physical wind"), (["--paper", "--grid", "16"], "the paper's field")])
+def test_wind_spectrum_plots_the_default_wind_or_the_papers(tmp_path, args, wind):
+    """Issue 31: it plotted the paper's field only, not the physical wind every command uses."""
+    res = subprocess.run([sys.executable, str(EXAMPLES / "wind_spectrum.py"), "--out", "out", "--seconds", "30",
+                          *args], cwd=tmp_path, capture_output=True, text=True, timeout=600)
+    assert res.returncode == 0, res.stderr[-2000:]
+    assert res.stdout.strip() == "wrote out/wind_spectrum.png and out/wind_slice.png (" + wind + ")"
 
 
 @pytest.mark.parametrize("name", ["lissajous.py", "wind_spectrum.py"])

@@ -309,6 +309,49 @@ def test_bench_json_reports_every_preset(tmp_path):
     assert "| large_cherry (winter) |" in res.stdout and doc["gl_renderer"] in res.stdout
 
 
+def test_ctrl_c_in_bench_keeps_the_finished_rows_printed_and_in_the_json(tmp_path, monkeypatch, capsys):
+    """Issue 31: a Ctrl-C threw away every finished row (the table and the JSON came only at the
+    end). Ctrl-C, raised while the second preset steps: the first row was already printed when
+    it came, it is in the JSON with ``interrupted``, and the exit status is 130."""
+    real = bench.bench_row
+    seen = {}
+
+    def row(key, *a, progress=None, **kw):
+        if key != "small_cherry":
+            return real(key, *a, progress=progress, **kw)
+
+        def ctrl_c():
+            seen["stdout"] = capsys.readouterr().out  # what was printed before the interruption
+            raise KeyboardInterrupt
+
+        return real(key, *a, progress=ctrl_c, **kw)
+
+    monkeypatch.setattr(bench, "bench_row", row)
+    out = tmp_path / "bench.json"
+    code = cli.main(["bench", "--presets", "beam", "small_cherry", "--size", "32x24", "--frames", "1", "--steps", "2",
+                     "--quiet", "--json", str(out)])
+    rest = capsys.readouterr()
+    assert code == 130
+    assert "| beam | 1 / — |" in seen["stdout"] and "| preset |" in seen["stdout"]  # printed as it finished
+    assert "small_cherry" not in seen["stdout"] + rest.out
+    doc = json.loads(out.read_text())
+    assert doc["interrupted"] is True and [r["key"] for r in doc["rows"]] == ["beam"]
+    assert doc["rows"][0]["sim_ms"] > 0 and doc["gl_renderer"]
+    assert rest.out.strip() == f"wrote {out} (1 of 2 rows)"
+    assert rest.err.strip() == "interrupted: 1 of 2 rows measured"
+
+
+def test_ctrl_c_in_bench_before_any_row_writes_nothing(tmp_path, monkeypatch, capsys):
+    def interrupted(*a, **kw):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(bench, "bench_row", interrupted)
+    out = tmp_path / "bench.json"
+    code = cli.main(["bench", "--presets", "beam", "--size", "32x24", "--quiet", "--json", str(out)])
+    assert code == 130 and not out.exists() and os.listdir(tmp_path) == []
+    assert capsys.readouterr().err.strip() == f"interrupted: 0 of 1 row measured; nothing written to {out}"
+
+
 # ------------------------------------------------------------------------------ bad input
 BAD = [
     (["render", "small_cherry", "--out", "clip.avi"], "unknown extension"),
@@ -349,6 +392,11 @@ BAD = [
     (["render", "beam", "--fps", "9" * 5000, "--out", "x.png"], "(5,000 characters)"),  # not echoed whole
     (["render", "beam", "--out", "no/such/a\nb.png"], "a\\nb.png"),  # a newline in a path: still one line
     (["export", "beam", "--out", "b" * 300 + ".glb"], "bytes long"),
+    # a trailing '/' names a folder: export wrote x.gltf (these commands write one file; only
+    # render takes a folder, for its frames)
+    (["export", "beam", "--out", "x.gltf/"], "x.gltf/: ends in '/', a folder's name; name a file (e.g. x.gltf)"),
+    (["trace", "beam", "--pull", "1,0,0", "--out", "t.csv/"], "ends in '/'"),
+    (["bench", "--presets", "beam", "--json", "b.json/"], "--json b.json/: ends in '/'"),
 ]
 
 
@@ -447,6 +495,35 @@ def test_a_write_that_fails_part_way_keeps_the_old_file_and_says_so(tmp_path, ou
     assert "wrote" not in res.stdout
     assert target.read_bytes() == old
     assert sorted(p.name for p in tmp_path.iterdir()) == [out]
+
+
+FFMPEG_SAYS = ("[out#0/mp4 @ 0x55d0c0a1b2c0] Error writing trailer: No space left on device",
+               "[out#0/mp4 @ 0x55d0c0a1b2c0] Error closing file: No space left on device")
+
+
+@pytest.mark.parametrize("when", ["at the end", "at once"])
+def test_a_failing_encoder_is_our_one_line_not_ffmpegs(tmp_path, monkeypatch, capfd, when):
+    """Issue 31: on a full disk ffmpeg's own two lines came before ours. An ffmpeg that says
+    those two lines and exits 1, after reading every frame (the trailer did not fit) or at
+    once (the pipe breaks under our writes): standard error is our one line, with its reason;
+    the previous file is kept and no temporary file is left. (A real full tmpfs gives the same
+    line: 'the video encoder failed (Error writing trailer: No space left on device)'.)"""
+    fake = tmp_path / "ffmpeg"
+    drain = "cat > /dev/null\n" if when == "at the end" else ""
+    fake.write_text("#!/bin/sh\n" + drain + "".join(f"echo '{line}' >&2\n" for line in FFMPEG_SAYS) + "exit 1\n")
+    fake.chmod(0o755)
+    monkeypatch.setenv("IMAGEIO_FFMPEG_EXE", str(fake))
+    out = tmp_path / "clip.mp4"
+    out.write_bytes(b"the previous video")
+    code = cli.main(["render", "beam", "--seconds", "0.5", "--fps", "30", "--size", "64x48", "--quiet",
+                     "--out", str(out)])
+    captured = capfd.readouterr()
+    assert code == 1
+    assert captured.err.splitlines() == [
+        f"treeanim: error: {out}: the video encoder failed (Error writing trailer: No space left on device); "
+        "any previous file is kept"], captured.err
+    assert out.read_bytes() == b"the previous video"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["clip.mp4", "ffmpeg"]
 
 
 def test_sigterm_during_a_render_leaves_no_temporary_file(tmp_path):

@@ -4,6 +4,7 @@ Run from the repository root: ``python assets/qsm/make_synthetic.py``. Determini
 files every time.
 """
 
+import io
 from pathlib import Path
 
 import numpy as np
@@ -21,11 +22,26 @@ def cylinder_struct(table: np.ndarray) -> dict:
             "BranchOrder": table[:, 11:12], "PositionInBranch": table[:, 12:13], "added": table[:, 13:14]}
 
 
-def main() -> None:
+#: The .mat file's 116-byte text header. scipy writes "Platform: posix, Created on: <date>"
+#: there, so the file changed at every run (and dirtied the checkout): a fixed one instead.
+MAT_HEADER = b"MATLAB 5.0 MAT-file, written by treeanim's assets/qsm/make_synthetic.py".ljust(116)
+
+
+def mat_bytes(variables: dict) -> bytes:
+    """``variables`` as a compressed MATLAB 5 file, the same bytes at every run."""
+    buf = io.BytesIO()
+    savemat(buf, variables, do_compression=True)
+    data = buf.getvalue()
+    assert data[:19] == b"MATLAB 5.0 MAT-file" and len(MAT_HEADER) == 116
+    return MAT_HEADER + data[116:]
+
+
+def main(folder: Path = HERE) -> None:
+    """Write ``synthetic_broadleaf.txt`` and ``.mat`` into ``folder`` (this one by default)."""
     table = synthetic_table(height=15.0, dbh=0.4, limbs=12, twigs=5, sub_twigs=3, seed=0)
-    write_table(HERE / "synthetic_broadleaf.txt", table)
-    savemat(HERE / "synthetic_broadleaf.mat", {"QSM": {"cylinder": cylinder_struct(table)}}, do_compression=True)
-    print(f"wrote {len(table)} cylinders to {HERE / 'synthetic_broadleaf.txt'} and .mat")
+    write_table(folder / "synthetic_broadleaf.txt", table)
+    (folder / "synthetic_broadleaf.mat").write_bytes(mat_bytes({"QSM": {"cylinder": cylinder_struct(table)}}))
+    print(f"wrote {len(table)} cylinders to {folder / 'synthetic_broadleaf.txt'} and .mat")
 
 
 if __name__ == "__main__":

@@ -196,16 +196,20 @@ def cmd_bench(args) -> int:
             raise UsageError(f"--presets {k}: unknown; expected some of {', '.join(known)}")
     out = output_path(args.json, (".json",), "--json") if args.json else None
     w, h = args.size
-    try:
+    try:  # each row is printed as it finishes; Ctrl-C keeps the finished ones, in the JSON too
         res = bench.run_bench(keys, w, h, frames=args.frames, steps=args.steps, samples=args.samples,
-                              wind=args.wind, quiet=args.quiet)
+                              wind=args.wind, quiet=args.quiet, emit=lambda text: print(text, flush=True))
     except GLUnavailable as e:
         print(one_line(f"treeanim: error: {e}"), file=sys.stderr)
         return 1
-    print(bench.format_bench(res))
-    if out is not None:
+    if out is not None and res["rows"]:
         write_text(out, json.dumps(res, indent=2) + "\n")
-        print(f"wrote {out}")
+        print(f"wrote {out}" + (f" ({len(res['rows'])} of {len(keys)} rows)" if res["interrupted"] else ""))
+    if res["interrupted"]:
+        done = len(res["rows"])
+        print(f"interrupted: {done} of {len(keys)} row{'s' * (len(keys) != 1)} measured"
+              + ("" if done or out is None else f"; nothing written to {out}"), file=sys.stderr)
+        return 130
     return 0
 
 
@@ -248,13 +252,26 @@ def load_any(name_or_path: str, args=None):
     return tree
 
 
+def cmd_list(args) -> int:
+    """The shipped presets, a line each: name, size and description."""
+    from treeanim.describe import preset_lines
+
+    print("\n".join(preset_lines()))
+    return 0
+
+
 def cmd_info(args) -> int:
-    """Print a preset's statistics beside the paper's Table 1 row."""
+    """Print a preset's statistics beside the paper's Table 1 row (or, --objects, its objects)."""
     import treeanim as ta
     from treeanim.model.params import ModeRange
     from treeanim.model.tree import PLURAL
 
     tree = load_any(args.preset, args)
+    if args.objects:
+        from treeanim.describe import object_lines
+
+        print("\n".join(object_lines(tree)))
+        return 0
     stats = tree.stats(args.season)
     key = tree.name + ("@winter" if args.season >= 1.0 and tree.name == "large_cherry" else "")
     paper = {row[0]: row for row in TABLE1.get(key, [])}
@@ -286,6 +303,8 @@ def cmd_info(args) -> int:
               f"ζ {modal.zeta[0, 0]:.3f}")
     if key in TABLE1_FPS:
         print(f"paper's frame rate: {TABLE1_FPS[key]} FPS (2012, Core2 Duo 2.8 GHz, GeForce 9500 GT)")
+    print(f"objects are numbered 0 to {tree.n_objects - 1}, root first, for --pull OBJECT:... and --drag "
+          "OBJECT...; --objects lists them")
     return 0
 
 
@@ -301,10 +320,16 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"treeanim {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
 
-    p = sub.add_parser("info", help="print a preset's statistics beside the paper's Table 1",
-                       description="Print a preset's objects, nodes and triangles beside the paper's Table 1 row.")
-    p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
+    p = sub.add_parser("info", help="print a tree's statistics beside the paper's Table 1 (or list its objects)",
+                       description="Print a tree's objects, nodes and triangles beside the paper's Table 1 row: a "
+                       "shipped preset, a preset .toml file, or a TreeQSM cylinder model (a .txt or .csv table, or "
+                       "a .mat file, as TreeQSM saves it; --leaves adds leaves along its twigs). --objects lists "
+                       "every object by the number that --pull, --drag and trace --object take.")
+    p.add_argument("preset", help=opt.PRESET_HELP)
     opt.add_season_option(p)
+    p.add_argument("--objects", action="store_true",
+                   help="list every object instead: its number, kind, level, parent, nodes, length, base diameter "
+                   "and tip")
     p.set_defaults(func=cmd_info)
 
     p = sub.add_parser("export", help="bake the animation into a glTF 2.0 file (.glb or .gltf)",
@@ -347,8 +372,10 @@ def build_parser() -> argparse.ArgumentParser:
         "the tree model only) until it sits at its static deflection, let go, and record the tip's position "
         "(t, x, y, z) for --seconds at --rate samples per second: the Lissajous / harmonograph trace of the "
         "paper's Figs. 1 and 4.")
-    p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
-    p.add_argument("--object", type=int, default=0, metavar="I", help="object index (default 0, e.g. the beam)")
+    p.add_argument("preset", help=opt.PRESET_HELP)
+    p.add_argument("--object", type=int, default=0, metavar="I",
+                   help="the object pulled (default 0: the trunk, or the beam); "
+                   + opt.OBJECT_HELP.replace("OBJECT is", "I is"))
     held = p.add_mutually_exclusive_group(required=True)
     held.add_argument("--pull", type=opt.vector("force", force=True), metavar="FX,FY,FZ",
                       help="world force on the tip in newtons, e.g. 1.5,0,1.2 for the beam")
@@ -388,8 +415,7 @@ def build_parser() -> argparse.ArgumentParser:
         "view", help="open the interactive viewer (what plain 'treeanim' does)",
         description="Open the viewer: the tree in wind; drag a branch or leaf to pull it and let go to watch it "
         "swing; sliders for wind, season and physics. Needs a display and OpenGL 3.3.")
-    p.add_argument("preset", nargs="?", default="small_cherry",
-                   help="preset name (see 'treeanim list') or path to a preset .toml (default small_cherry)")
+    p.add_argument("preset", nargs="?", default="small_cherry", help=opt.PRESET_HELP + " (default small_cherry)")
     opt.add_season_option(p)
     opt.add_wind_speed_options(p)
     p.add_argument("--size", type=opt.size, default=(1280, 720), metavar="WxH",
@@ -400,12 +426,27 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--frames", type=opt.positive(int), default=None, metavar="N",
                    help="quit after N frames (for scripted runs)")
     p.set_defaults(func=cmd_view)
+    _help_ends_with(p, lambda: __import__("treeanim.describe").describe.viewer_controls())
 
-    p = sub.add_parser("list", help="list the shipped presets", description="List the shipped presets.")
-    p.set_defaults(func=lambda args: print("\n".join(__import__("treeanim").list_presets())) or 0)
+    p = sub.add_parser("list", help="list the shipped presets: size and description",
+                       description="List the shipped presets, a line each: name, height, objects and triangles "
+                       "(in summer) and what it is.")
+    p.set_defaults(func=cmd_list)
     for p in (parser, *sub.choices.values()):
         _one_line_errors(p)
     return parser
+
+
+def _help_ends_with(p: argparse.ArgumentParser, make) -> None:
+    """``p``'s help ends with the paragraph ``make()``, made only when the help is shown (the
+    viewer's keys import GLFW, which no other command line needs)."""
+    plain = p.format_help
+
+    def format_help() -> str:
+        p.epilog = make()
+        return plain()
+
+    p.format_help = format_help
 
 
 def main(argv: list[str] | None = None) -> int:

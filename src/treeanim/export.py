@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,7 +21,7 @@ from pathlib import Path
 import numpy as np
 import pygltflib as gl
 
-from .files import write_bytes
+from .files import remove_stale, write_bytes
 from .model.tree import Tree
 from .physics.rotation import matrix_to_quat
 from .render import palette
@@ -334,6 +335,8 @@ def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
     bin_path = path.with_name(f"{path.stem}-{hashlib.sha1(data).hexdigest()[:8]}.bin")
     doc.buffers[0].uri = urllib.parse.quote(bin_path.name)
     old_bin = _buffer_file(path)
+    # A killed export's buffer was named after other content: its stale temporary files too
+    remove_stale(path.parent, re.compile(re.escape(path.stem) + r"-[0-9a-f]{8}\.bin"))
     write_bytes(bin_path, data)
     write_bytes(path, doc.to_json(separators=(",", ":")).encode())
     if old_bin is not None and old_bin != bin_path:

@@ -15,6 +15,12 @@ LIMIT = 1e6
 MAX_FRAMES = 1_000_000
 #: Most simulation steps one command may take (hours of work at a few ms a step).
 MAX_STEPS = 2_000_000
+#: The help of every command's tree argument.
+PRESET_HELP = ("a preset's name (see 'treeanim list'), a preset .toml file, or a TreeQSM cylinder model: "
+               "a .txt or .csv table or a .mat file (see --leaves)")
+#: How ``--pull``, ``--drag`` and ``trace --object`` name an object, for their help.
+OBJECT_HELP = ("OBJECT is an object's number, root first and level by level (0 is the trunk, or a meadow's "
+               "first blade); 'treeanim info PRESET --objects' lists them with their kind, length and tip")
 
 
 def shown(text: str, width: int = 40) -> str:
@@ -192,16 +198,18 @@ def wind_settings(args) -> dict:
 def add_scene_options(p: argparse.ArgumentParser, seconds: float | None = 5.0, fps: float = 30.0,
                       seconds_help: str | None = None) -> None:
     """Options shared by the offline commands: the preset, timing, wind, season and pulls."""
-    p.add_argument("preset", help="preset name (see 'treeanim list') or path to a preset .toml")
+    p.add_argument("preset", help=PRESET_HELP)
     p.add_argument("--seconds", type=positive(float), default=seconds,
                    help=seconds_help or f"duration in seconds (default {seconds:g})")
     p.add_argument("--fps", type=positive(float), default=fps, help=f"frames per second (default {fps:g})")
     add_wind_options(p)
     p.add_argument("--pull", type=pull, action="append", default=[], metavar="OBJECT:FX,FY,FZ@T0-T1",
-                   help="pull OBJECT's tip with a world force in newtons from T0 to T1 s, then let go; repeatable")
+                   help="pull OBJECT's tip with a world force in newtons from T0 to T1 s, then let go; repeatable. "
+                   + OBJECT_HELP)
     p.add_argument("--drag", type=drag, action="append", default=[], metavar="OBJECT[@S]:X,Y,Z@T0-T1",
                    help="drag OBJECT's tip (or the point at fraction S of its length) toward the world point "
-                   "X,Y,Z (m) from T0 to T1 s, then let go; repeatable, one at a time; the tree model only")
+                   "X,Y,Z (m) from T0 to T1 s, then let go; repeatable, one at a time; the tree model only. "
+                   + OBJECT_HELP)
     add_model_option(p)
 
 

@@ -102,9 +102,19 @@ def bench_row(key: str, off, width: int, height: int, frames: int, steps: int, w
 
 
 def run_bench(keys, width: int = 1280, height: int = 720, frames: int = 20, steps: int = 200, samples: int = 4,
-              wind: float = 5.0, quiet: bool = False) -> dict:
+              wind: float = 5.0, quiet: bool = False, emit=None) -> dict:
     """The Table 1 benchmark over ``keys`` (see :data:`treeanim.table1.ROWS`): a dict with the machine,
     the GL renderer and one row per key.
+
+    Ctrl-C keeps the rows already measured: the result then holds those, with ``interrupted``
+    True (the row being measured is dropped).
+
+    Parameters
+    ----------
+    emit : callable, optional
+        Called with text as soon as there is some to show: the table's head once the GL
+        renderer is known (:func:`format_head`), then each row's line as it finishes
+        (:func:`format_row`), so a long run shows its rows as they come.
 
     Raises
     ------
@@ -126,35 +136,39 @@ def run_bench(keys, width: int = 1280, height: int = 720, frames: int = 20, step
         raise InputError(str(e)) from None
 
     started = datetime.datetime.now().astimezone().isoformat(timespec="seconds")
-    machine = machine_info()
+    result = {"date": started, "machine": machine_info(), "size": [width, height], "wind": wind,
+              "paper_machine": "Core2 Duo 2.8 GHz, GeForce 9500 GT (2012)", "interrupted": False, "rows": []}
     with offscreen(width, height, samples) as off:
         with off.ctx:
             info = dict(off.ctx.info)
+        result.update(gl_renderer=info.get("GL_RENDERER"), gl_version=info.get("GL_VERSION"),
+                      gl_vendor=info.get("GL_VENDOR"), samples=off.samples)
         bar = tqdm(total=len(keys) * (steps + frames + 2), desc="bench", unit="step", disable=quiet, leave=False)
-        rows = []
+
+        def show(text: str) -> None:
+            if emit is not None:
+                with bar.external_write_mode():  # the bar steps aside for the line
+                    emit(text)
+
+        show(format_head(result))
         try:
             for key in keys:
                 bar.set_description(f"bench {key}")
-                rows.append(bench_row(key, off, width, height, frames, steps, wind=wind, progress=bar.update))
+                row = bench_row(key, off, width, height, frames, steps, wind=wind, progress=bar.update)
+                result["rows"].append(row)
+                show(format_row(row))
+        except KeyboardInterrupt:  # keep what finished
+            result["interrupted"] = True
         finally:
             bar.close()
-        samples_used = off.samples
-    return {
-        "date": started,
-        "machine": machine,
-        "gl_renderer": info.get("GL_RENDERER"), "gl_version": info.get("GL_VERSION"),
-        "gl_vendor": info.get("GL_VENDOR"),
-        "size": [width, height], "samples": samples_used, "wind": wind,
-        "paper_machine": "Core2 Duo 2.8 GHz, GeForce 9500 GT (2012)",
-        "rows": rows,
-    }
+    return result
 
 
-def format_bench(result: dict) -> str:
-    """The benchmark as a Markdown table with its machine line."""
+def format_head(result: dict) -> str:
+    """The benchmark's machine line and the table's header."""
     m = result["machine"]
     w, h = result["size"]
-    lines = [
+    return "\n".join([
         f"{result['date']} — {m['cpu']}, {m['cores']} cores"
         + (f" (load {m['load_average'][0]:.2f} at start)" if m.get("load_average") else "")
         + f"; GL: {result['gl_renderer']} ({result['gl_version']}); {w}×{h}, {result['samples']}× MSAA; "
@@ -163,17 +177,23 @@ def format_bench(result: dict) -> str:
         "| preset | objects (ours / paper) | nodes (ours / paper) | triangles (ours / paper) "
         "| sim ms/frame | render ms/frame | FPS (ours / paper) |",
         "|---|---:|---:|---:|---:|---:|---:|",
-    ]
+    ])
+
+
+def format_row(r: dict) -> str:
+    """One row of the table (:func:`bench_row`'s dict) as a Markdown line."""
 
     def pair(a, b):
         return f"{a:,} / {b:,}" if b else f"{a:,} / —"
 
-    for r in result["rows"]:
-        name = r["key"].replace("@winter", " (winter)") if "@" in r["key"] else \
-            r["key"] + (" (summer)" if r["key"] == "large_cherry" else "")
-        pf = r["paper_fps"]
-        lines.append(
-            f"| {name} | {pair(r['objects'], r['paper_objects'])} | {pair(r['nodes'], r['paper_nodes'])} "
+    name = r["key"].replace("@winter", " (winter)") if "@" in r["key"] else \
+        r["key"] + (" (summer)" if r["key"] == "large_cherry" else "")
+    pf = r["paper_fps"]
+    return (f"| {name} | {pair(r['objects'], r['paper_objects'])} | {pair(r['nodes'], r['paper_nodes'])} "
             f"| {pair(r['triangles'], r['paper_triangles'])} | {r['sim_ms']:.1f} | {r['render_ms']:.1f} "
             f"| {r['fps']:.1f} / {pf if pf is not None else '—'} |")
-    return "\n".join(lines)
+
+
+def format_bench(result: dict) -> str:
+    """The benchmark as a Markdown table with its machine line."""
+    return "\n".join([format_head(result), *map(format_row, result["rows"])])

@@ -11,16 +11,19 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import InputError
-from ..files import atomic_path, temp_beside
+from ..files import atomic_path, remove_stale, temp_beside
 
 #: Name pattern of the frames written into a folder.
 FRAME_NAME = "frame_{:05d}.png"
+#: Any frame file's name (whose stale temporary files a new run removes once, not per frame).
+FRAME_RE = re.compile(r"frame_\d{5,}\.png")
 #: The still's extension.
 STILL_SUFFIX = ".png"
 
@@ -67,16 +70,104 @@ def pad_even(img: np.ndarray) -> np.ndarray:
     return np.pad(img, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
 
 
-class _Abort(BaseException):
-    """Thrown into imageio-ffmpeg's writer to make it kill ffmpeg rather than finish the file."""
+class Encoder:
+    """One ffmpeg process encoding raw RGB frames from its standard input into a file.
+
+    ffmpeg's own messages go to a temporary file, never to our standard error: when it fails
+    (a full disk) :meth:`reason` reads back why, and the caller says so in one line of its own.
+    It runs in its own session, so a Ctrl-C at the terminal reaches only us.
+
+    Parameters
+    ----------
+    path : Path
+        The file ffmpeg writes (its suffix picks the container).
+    size : (int, int)
+        Width and height of every frame.
+    fps : float
+    fmt : VideoFormat
+    """
+
+    def __init__(self, path: Path, size: tuple[int, int], fps: float, fmt: VideoFormat) -> None:
+        import subprocess
+        import tempfile
+        from fractions import Fraction
+
+        import imageio_ffmpeg
+
+        w, h = size
+        cmd = [imageio_ffmpeg.get_ffmpeg_exe(), "-hide_banner", "-nostats", "-loglevel", "error", "-y",
+               "-f", "rawvideo", "-vcodec", "rawvideo", "-s", f"{w}x{h}", "-pix_fmt", "rgb24",
+               "-r", str(Fraction(float(fps)).limit_denominator()), "-i", "-", "-an",
+               "-vcodec", fmt.codec, "-pix_fmt", fmt.pix_fmt, *fmt.params, str(path)]
+        try:
+            self.log = tempfile.TemporaryFile()
+        except OSError:  # no room for even that: ffmpeg's messages are dropped
+            self.log = None
+        try:
+            self.proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.DEVNULL,
+                                         stderr=self.log if self.log is not None else subprocess.DEVNULL,
+                                         start_new_session=True)
+        except BaseException:
+            self._close_log()
+            raise
+
+    def write(self, img: np.ndarray) -> bool:
+        """Send one (height, width, 3) uint8 frame; False if ffmpeg is gone (it failed)."""
+        try:
+            self.proc.stdin.write(np.ascontiguousarray(img, np.uint8))
+        except (OSError, ValueError):  # a broken pipe: ffmpeg exited
+            return False
+        return True
+
+    def close(self) -> int:
+        """End of input: wait for ffmpeg to finish the file; its exit status (0: done)."""
+        try:
+            self.proc.stdin.close()  # flushes: fails where ffmpeg has already gone
+        except (OSError, ValueError):
+            pass
+        return self.proc.wait()
+
+    def kill(self) -> None:
+        """Stop ffmpeg at once (no trailer) and drop its messages."""
+        self.proc.kill()
+        try:
+            self.proc.stdin.close()
+        except (OSError, ValueError):
+            pass
+        self.proc.wait()
+        self._close_log()
+
+    def reason(self, most: int = 120) -> str:
+        """ffmpeg's first message, without its ``[muxer @ 0x…]`` tag, on one line of at most
+        ``most`` characters ('' if it said nothing)."""
+        if self.log is None:
+            return ""
+        try:
+            self.log.seek(0)
+            text = self.log.read(16384).decode("utf-8", "replace")
+        except (OSError, ValueError):
+            return ""
+        for line in text.splitlines():
+            line = re.sub(r"^(\[[^\]]*\]\s*)+", "", line).strip()
+            if line:
+                return line if len(line) <= most else line[:most - 1] + "…"
+        return ""
+
+    def _close_log(self) -> None:
+        if self.log is not None:
+            self.log.close()
+            self.log = None
 
 
 class VideoSink:
     """Frames into an .mp4 (H.264, yuv420p, CRF 18) or a .gif (one palette for the whole clip)
-    through imageio-ffmpeg, via a temporary file renamed over ``path`` by :meth:`finish`.
+    through ffmpeg (:class:`Encoder`), via a temporary file renamed over ``path`` by
+    :meth:`finish`.
 
     The format is :data:`VIDEO_FORMATS` [the suffix]; frames of odd width or height are padded
-    to even by repeating the last row/column where it needs even sides (MP4).
+    to even by repeating the last row/column where it needs even sides (MP4). ffmpeg's own
+    messages never reach the terminal: a failure is one OSError naming ``path`` and ffmpeg's
+    reason (``No space left on device``).
 
     The temporary file comes from :func:`treeanim.files.temp_beside` rather than
     :func:`~treeanim.files.atomic_path`: an interrupted render keeps the frames encoded so far
@@ -97,8 +188,6 @@ class VideoSink:
     """
 
     def __init__(self, path: Path, width: int, height: int, fps: float) -> None:
-        import imageio_ffmpeg
-
         self.path = Path(path)
         self.format = VIDEO_FORMATS.get(self.path.suffix.lower())
         if self.format is None:
@@ -109,11 +198,7 @@ class VideoSink:
         self.size = (width + width % 2, height + height % 2) if even else (width, height)
         self.tmp = temp_beside(self.path, self.path.suffix.lower())
         try:
-            self._gen = imageio_ffmpeg.write_frames(
-                str(self.tmp), self.size, fps=float(fps), macro_block_size=1, ffmpeg_log_level="error",
-                codec=self.format.codec, pix_fmt_out=self.format.pix_fmt, quality=None,
-                output_params=list(self.format.params))
-            self._gen.send(None)  # starts ffmpeg
+            self._enc = Encoder(self.tmp, self.size, fps, self.format)
         except BaseException:
             self.tmp.unlink(missing_ok=True)
             raise
@@ -129,17 +214,15 @@ class VideoSink:
 
         Raises
         ------
-        Exception
-            Whatever ffmpeg's writer raised; the sink is then :attr:`broken` and its file is
-            not kept.
+        OSError
+            ffmpeg failed (naming ``path`` and why); the sink is then :attr:`broken` and its
+            file is not kept.
         """
         if self.format.even:
             img = pad_even(img)
-        try:
-            self._gen.send(np.ascontiguousarray(img))
-        except Exception:
-            self.broken = True  # ffmpeg failed: the file is not worth keeping
-            raise
+        if not self._enc.write(img):
+            self._enc.close()
+            raise self._failed(self._enc)
         self.count += 1
 
     def finish(self) -> bool:
@@ -148,14 +231,18 @@ class VideoSink:
         if self.count == 0:
             self.abort()
             return False
-        gen, self._gen = self._gen, None
+        enc, self._enc = self._enc, None
         try:
-            if gen is not None:
-                gen.close()  # ffmpeg gets EOF and writes the trailer (a playable file)
-            self._check()
+            if enc is not None:
+                if enc.close() != 0:  # ffmpeg gets EOF and writes the trailer (a playable file)
+                    raise self._failed(enc)
+                self._check(enc)
         except BaseException:
             self.tmp.unlink(missing_ok=True)
             raise
+        finally:
+            if enc is not None:
+                enc.kill()  # (it has exited: this only drops its messages)
         os.replace(self.tmp, self.path)
         return True
 
@@ -167,9 +254,17 @@ class VideoSink:
         """Older files this run left beside its own (none: a video replaces the file)."""
         return 0
 
-    def _check(self) -> None:
-        """OSError unless the file ffmpeg wrote holds every frame: imageio-ffmpeg does not report
-        an encoder that died on a write error (a full disk), which leaves a truncated file."""
+    def _failed(self, enc: Encoder) -> OSError:
+        """The one error of a failed encoder: the file named, ffmpeg's reason if it gave one."""
+        self.broken = True
+        why = enc.reason()
+        what = f"the video encoder failed ({why})" if why else \
+            "the video encoder could not finish it (is the disk full?)"
+        return OSError(errno.EIO, f"{what}; any previous file is kept", str(self.path))
+
+    def _check(self, enc: Encoder) -> None:
+        """OSError unless the file ffmpeg wrote holds every frame (an encoder that exited 0
+        yet wrote a truncated file)."""
         import imageio_ffmpeg
 
         try:
@@ -177,33 +272,22 @@ class VideoSink:
         except Exception:  # noqa: BLE001 - ffmpeg cannot read it back: it is broken
             frames = -1
         if frames != self.count:
-            self.broken = True
-            raise OSError(errno.EIO, "the video encoder could not finish it (is the disk full?); "
-                                     "any previous file is kept", str(self.path))
+            raise self._failed(enc)
 
     def abort(self) -> None:
         """Stop the encoder and drop the file, quietly."""
-        import logging
-
-        gen, self._gen = self._gen, None
-        if gen is not None:
-            log = logging.getLogger("imageio_ffmpeg")
-            level = log.level
-            log.setLevel(logging.CRITICAL)  # not "no frames have been written"
-            try:
-                gen.throw(_Abort())  # a BaseException: imageio-ffmpeg kills ffmpeg, no trailer
-            except BaseException:
-                pass
-            finally:
-                log.setLevel(level)
+        enc, self._enc = self._enc, None
+        if enc is not None:
+            enc.kill()
         self.tmp.unlink(missing_ok=True)
 
 
-def write_png(path: Path, img: np.ndarray) -> None:
-    """One PNG, written beside ``path`` and renamed over it (never a half-written file)."""
+def write_png(path: Path, img: np.ndarray, clean: bool = True) -> None:
+    """One PNG, written beside ``path`` and renamed over it (never a half-written file);
+    ``clean``: first remove the stale temporary files of ``path`` (:func:`~treeanim.files.remove_stale`)."""
     import imageio.v3 as iio
 
-    with atomic_path(path, ".png") as tmp:
+    with atomic_path(path, ".png", clean=clean) as tmp:
         iio.imwrite(tmp, img, extension=".png")
 
 
@@ -218,11 +302,12 @@ class FrameSink:
         self.size = (int(width), int(height))
         self.created = not self.path.exists()
         self.path.mkdir(exist_ok=True)
+        remove_stale(self.path, FRAME_RE)  # once for every frame name (not a folder scan per frame)
         self.count = 0
 
     def write(self, img: np.ndarray) -> None:
         """Write ``img`` ((height, width, 3) uint8, row 0 at the top) as the next frame file."""
-        write_png(self.path / FRAME_NAME.format(self.count), img)
+        write_png(self.path / FRAME_NAME.format(self.count), img, clean=False)
         self.count += 1
 
     def nbytes(self) -> int:

@@ -66,9 +66,13 @@ def _exists(path: Path, folder: bool = False) -> bool:
 
 
 def check_file(path: Path, text: str) -> None:
-    """InputError unless ``path`` can be written as a file: its folder takes new files
-    (:func:`check_folder`), its name fits the file system's limit, and it is not a folder."""
+    """InputError unless ``path`` can be written as a file: ``text`` (the name as given) does
+    not end in '/' (a folder's name, which ``Path`` would drop: ``x.gltf/`` wrote ``x.gltf``),
+    its folder takes new files (:func:`check_folder`), its name fits the file system's limit,
+    and it is not a folder."""
     path = Path(path)
+    if text.endswith(("/", os.sep)):
+        raise InputError(f"--out {text}: ends in '/', a folder's name; name a file (e.g. {path.name or 'out'})")
     folder = path.parent if str(path.parent) else Path(".")
     check_folder(folder, text)
     try:

@@ -24,6 +24,8 @@ MIN_RADIUS, MAX_RADIUS, MAX_LENGTH = 1e-4, 10.0, 150.0
 MAX_COORDINATE = 1e7
 #: How far apart a tree's cylinders may start (m).
 MAX_SPAN = 1000.0
+#: Largest branch number (every whole number up to it is exact in a float and fits an int64).
+MAX_BRANCH = 2.0 ** 53
 
 
 def _jump(pointer: np.ndarray, steps: int) -> np.ndarray:
@@ -74,11 +76,14 @@ def _check(table: np.ndarray, path, lines) -> tuple[np.ndarray, ...]:
     span = float(np.max(np.ptp(table[:, 2:5], axis=0)))
     if span > MAX_SPAN:
         raise QSMError(f"{path}: the cylinders' starts span {span:.6g} m; one tree spans at most {MAX_SPAN:g} m")
-    axis = table[:, 5:8]
-    norm = np.linalg.norm(axis, axis=1)
-    k = np.flatnonzero(norm < 1e-9)
+    # The axis is a direction: scaled by its largest component before its length is taken, so
+    # that neither 1e300 (its square overflowed) nor a subnormal one loses it
+    scale = np.abs(table[:, 5:8]).max(axis=1)
+    k = np.flatnonzero(scale == 0)
     if len(k):
         raise _problem(path, k[0], "the axis is (0, 0, 0); expected a direction", lines)
+    axis = table[:, 5:8] / scale[:, None]
+    axis /= np.linalg.norm(axis, axis=1)[:, None]
     parent_raw = table[:, 8]
     k = np.flatnonzero((parent_raw != np.round(parent_raw)) | (parent_raw < 0) | (parent_raw > n))
     if len(k):
@@ -100,10 +105,11 @@ def _check(table: np.ndarray, path, lines) -> tuple[np.ndarray, ...]:
     if len(k):
         raise _problem(path, k[0], "its parents lead round a cycle and never reach the stem's base", lines)
     branch = table[:, 10]
-    k = np.flatnonzero(branch != np.round(branch))
-    if len(k):
-        raise _problem(path, k[0], f"branch {float(branch[k[0]])!r}; expected an integer", lines)
-    return table[:, 0], table[:, 1], table[:, 2:5], axis / norm[:, None], parent, branch.astype(np.int64)
+    k = np.flatnonzero((branch != np.round(branch)) | (np.abs(branch) > MAX_BRANCH))
+    if len(k):  # (1e300 is a whole number too, but none an int64 holds)
+        raise _problem(path, k[0], f"branch {float(branch[k[0]])!r}; expected an integer of at most "
+                                   f"{MAX_BRANCH:.0f} (a branch number)", lines)
+    return table[:, 0], table[:, 1], table[:, 2:5], axis, parent, branch.astype(np.int64)
 
 # ---------------------------------------------------------------------------- building
 def _z_up_to_y_up(p: np.ndarray) -> np.ndarray:
