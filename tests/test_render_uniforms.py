@@ -85,6 +85,10 @@ def test_the_blocks_hold_their_members_where_glsl_reads_them(offscreen):
     rng = np.random.default_rng(0)
     ctx = offscreen.ctx
     with ctx:
+        # transform feedback draws too: a complete framebuffer must be bound (a fresh context's
+        # own is not; the test failed when it was the first to use the session's context)
+        target = ctx.simple_framebuffer((1, 1))
+        target.use()
         for name, members in BLOCKS.items():
             outs, body, varyings = [], [], []
             for gl_type, member, _ in members:
@@ -120,6 +124,7 @@ def test_the_blocks_hold_their_members_where_glsl_reads_them(offscreen):
                 for o in (vao, out, block, prog):
                     o.release()
         assert ctx.error == "GL_NO_ERROR"
+        target.release()
 
 
 def test_every_sampler_has_its_own_unit():
