@@ -265,6 +265,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     joints[:, 1] = np.where(single, 0, j2)
     weights[:, 1] = np.where(single, 0, np.round(w2 * 255)).astype(np.uint8)
     weights[:, 0] = 255 - weights[:, 1]
+    joints[weights == 0] = 0  # a joint listed with no weight is noise to clients (and the validator)
     index = remap[mesh.indices[keep_tris]].astype(np.uint32)
 
     attrs = gl.Attributes(
