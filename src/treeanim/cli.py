@@ -59,7 +59,7 @@ def cmd_export(args) -> int:
 
     out = output_path(args.out, (".glb", ".gltf"))
     tree, sim = make_simulation(args)
-    skel = export.skeleton(tree)
+    skel = export.skeleton(tree, sim.present)
     n = opt.check_frames(args.seconds, args.fps)
     fade = opt.check_frames(args.loop, args.fps)
     if n < 2:
