@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import treeanim as ta
-from gltf_readback import accessor, joint_world_positions, load
+from gltf_readback import accessor, clip, joint_world_positions, load, play
 from treeanim import scripted
-from treeanim.export import skeleton
+from treeanim.export import local_rotations, skeleton
 
 ROOT = Path(__file__).resolve().parents[1]
 NODE_MODULES = Path(os.environ.get("TREEANIM_NODE_MODULES", ROOT / ".venv" / "node" / "node_modules"))
@@ -35,10 +35,12 @@ def export(*args):
 
 
 def simulate(preset, seconds, fps, wind, pulls=(), season=0.0):
-    """The node positions the exporter should have baked, frame by frame."""
+    """The node positions the exporter should have baked, frame by frame: the frames at
+    0, 1/fps, ..., ``seconds`` (both ends included)."""
     tree = ta.load_preset(preset)
     sim = ta.Simulation(tree, wind=ta.WindField(speed=wind) if wind else None, season=season)
-    return tree, [sim.positions.copy() for _ in scripted.frames(sim, seconds, fps, [scripted.parse_pull(p) for p in pulls])]
+    frames = scripted.frames(sim, seconds + 1 / fps, fps, [scripted.parse_pull(p) for p in pulls])
+    return tree, [sim.positions.copy() for _ in frames]
 
 
 CASES = [
@@ -64,10 +66,11 @@ def test_export_validates_and_plays_back(tmp_path, preset, name, seconds, fps, w
     n = int(round(seconds * fps))
     assert len(doc.skins[0].joints) == skel.count
     times = accessor(doc, blob, doc.animations[0].samplers[0].input)[:, 0]
-    assert len(times) == n == len(frames)
-    assert times[-1] == pytest.approx((n - 1) / fps)
+    assert len(times) == n + 1 == len(frames), "n frames: keys at 0, 1/fps, ..., seconds"
+    assert times[-1] == np.float32(seconds), "the clip lasts exactly --seconds"
+    assert np.allclose(np.diff(times), 1 / fps, rtol=1e-5)
     assert len(doc.animations[0].channels) == skel.count - 1
-    for k in (n // 2, n - 1):
+    for k in (n // 2, n):
         baked = joint_world_positions(doc, blob, k)[1:]
         truth = frames[k][skel.joint_node[1:]]
         assert np.max(np.linalg.norm(baked - truth, axis=1)) < 1e-3, f"frame {k} joints off by more than 1 mm"
@@ -119,28 +122,62 @@ def test_winter_export_drops_leaves(tmp_path):
     doc, blob = load(winter)
     _, frames = simulate("small_cherry", 0.4, 5, 6.0, season=1.0)
     skel = skeleton(tree, tree.leaves_present(1.0))
-    baked = joint_world_positions(doc, blob, 1)[1:]
-    assert np.max(np.linalg.norm(baked - frames[1][skel.joint_node[1:]], axis=1)) < 1e-3
+    baked = joint_world_positions(doc, blob, 2)[1:]
+    assert np.max(np.linalg.norm(baked - frames[2][skel.joint_node[1:]], axis=1)) < 1e-3
 
 
-def test_loop_cross_fades_end_into_start(tmp_path):
-    looped, plain = tmp_path / "loop.glb", tmp_path / "plain.glb"
-    common = ["small_cherry", "--seconds", "3", "--fps", "20", "--wind", "12"]
-    assert export(*common, "--loop", "1", "--out", str(looped)).returncode == 0
-    assert export(*common, "--out", str(plain)).returncode == 0
+def _angles(a, b):
+    """Degrees between the rotations of unit quaternions (..., 4)."""
+    d = np.abs(np.sum(np.asarray(a, float) * np.asarray(b, float), axis=-1))
+    return np.degrees(2 * np.arccos(np.clip(d, 0, 1)))
 
-    def wrap_jump(path):
-        doc, blob = load(path)
-        first, last = joint_world_positions(doc, blob, 0), joint_world_positions(doc, blob, 59)
-        before = joint_world_positions(doc, blob, 58)
-        return np.abs(first - last).max(), np.abs(last - before).max()
 
-    loop_jump, loop_step = wrap_jump(looped)
-    plain_jump, _ = wrap_jump(plain)
-    assert loop_jump < 2.5 * loop_step, "the looped clip's end runs on into its start like one more frame"
-    assert plain_jump > 2 * loop_jump
-    report = validate(looped)
+def _largest_elsewhere(steps):
+    """(K,) for each step k, how many joints step further there than at every other step."""
+    return np.array([np.sum(steps[k] > np.delete(steps, k, axis=0).max(axis=0) + 1e-3) for k in range(len(steps))])
+
+
+def test_loop_closes_at_exactly_the_asked_length_without_a_seam(tmp_path):
+    """--loop: played as a client plays a looping clip (the time modulo the clip's length,
+    sampled at the key rate), the step across the loop point is as ordinary as any other
+    frame's; the key at T repeats the first, and T is --seconds. The cross-fade over the
+    clip's start adds less to a frame's step than any joint's typical (median) step."""
+    fps, seconds, fade = 20, 3.0, 20
+    n = int(seconds * fps)
+    out = tmp_path / "loop.glb"
+    res = export("small_cherry", "--seconds", str(seconds), "--fps", str(fps), "--wind", "12", "--loop", "1",
+                 "--out", str(out))
+    assert res.returncode == 0, res.stderr
+    assert "loop seam:" in res.stdout
+    report = validate(out)
     assert (report["numErrors"], report["numWarnings"]) == (0, 0), report["messages"][:5]
+    times, keys = clip(*load(out))
+    assert times[-1] == np.float32(seconds), "the loop lasts exactly --seconds"
+    assert np.array_equal(keys[-1], keys[0]), "the key at T repeats the first"
+
+    played = play(times, keys, np.arange(n + 1) / fps)  # one loop, the loop point included
+    steps = _angles(played[:-1], played[1:])
+    wrap = int(np.searchsorted(np.arange(n + 1) / fps, times[-1], side="left")) - 1  # the step that crosses T
+    counts = _largest_elsewhere(steps)
+    assert counts[wrap] <= np.delete(counts, wrap).max(), (counts[wrap], np.delete(counts, wrap).max())
+
+    # The key at T is the simulation's frame at T, and frames fade .. n - 1 are its own.
+    doc, blob = load(out)
+    tree, frames = simulate("small_cherry", seconds + fade / fps, fps, 12.0)
+    skel = skeleton(tree)
+    for k in (fade, n - 1, n):
+        baked = joint_world_positions(doc, blob, k)[1:]
+        assert np.max(np.linalg.norm(baked - frames[k][skel.joint_node[1:]], axis=1)) < 1e-3, k
+
+    # Over the fade the clip blends the motion after T into its own start: each frame's step
+    # is at most what either motion steps, plus less than the joint's median step.
+    tree = ta.load_preset("small_cherry")
+    sim = ta.Simulation(tree, wind=ta.WindField(speed=12.0))
+    raw = np.array([local_rotations(skel, sim.rotations)[1:] for _ in scripted.frames(sim, seconds + (fade + 1) / fps, fps)])
+    own = np.maximum(_angles(raw[:fade], raw[1:fade + 1]), _angles(raw[n:n + fade], raw[n + 1:n + fade + 1]))
+    added = np.max(steps[:fade] - own, axis=0)
+    median = np.median(steps, axis=0)
+    assert np.all(added <= median + 1e-3), np.max(added - median)
 
 
 @pytest.mark.parametrize("args,words", [
@@ -150,6 +187,7 @@ def test_loop_cross_fades_end_into_start(tmp_path):
     (["--out", "x.glb", "--seconds", "-1"], "positive"),
     (["--out", "x.glb", "--fps", "0"], "positive"),
     (["--out", "x.glb", "--loop", "9"], "shorter"),
+    (["--out", "x.glb", "--seconds", "2.05", "--fps", "24"], "whole frames"),
 ])
 def test_export_bad_input(tmp_path, args, words):
     res = subprocess.run([sys.executable, "-m", "treeanim", "export", "small_cherry", *args], capture_output=True,

@@ -8,6 +8,9 @@ simulation keeps segment lengths exactly and children sit exactly on their paren
 each joint's translation relative to its parent is constant: the animation holds rotations
 only, one float32 quaternion key per joint and frame, sharing one time accessor. Objects not
 present at the season (fallen leaves) have no joints and no triangles.
+
+A clip of n frames holds n + 1 keys, at 0, 1/fps, …, n/fps: it lasts n/fps in a client, which
+plays from the first key to the last (a loop's last key repeats its first: :mod:`treeanim.loop`).
 """
 
 from __future__ import annotations
@@ -113,21 +116,6 @@ def local_rotations(skel: Skeleton, rotations: np.ndarray) -> np.ndarray:
     local = np.einsum("jki,jkl->jil", parent, world)
     local[0] = np.eye(3)
     return quaternions(local)
-
-
-def crossfade_loop(keys: np.ndarray, fade: int) -> np.ndarray:
-    """Make keys (F + fade, J, 4) loop: the first ``fade`` frames blend from the frames after
-    the end into the start, so the last frame runs smoothly on into the first. Returns (F, J, 4)."""
-    if fade <= 0:
-        return keys
-    out = keys[:-fade].copy()
-    tail = keys[-fade:]
-    a = (np.arange(fade) / fade)[:, None, None]
-    head = out[:fade]
-    tail = np.where(np.sum(tail * head, axis=-1, keepdims=True) < 0, -tail, tail)
-    mix = (1 - a) * tail + a * head  # normalised lerp between matching hemispheres
-    out[:fade] = mix / np.linalg.norm(mix, axis=-1, keepdims=True)
-    return out
 
 
 # ---------------------------------------------------------------------------- mesh
@@ -249,7 +237,8 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     tree : Tree
     keys : (F, J, 4) float
         Local joint rotations per frame (from :func:`local_rotations`) of the joints of
-        :func:`skeleton` ``(tree, present)``.
+        :func:`skeleton` ``(tree, present)``; key k plays at k / ``fps``, so the clip lasts
+        (F − 1) / ``fps``.
     fps : float
         Frames per second of ``keys``.
     season : float
