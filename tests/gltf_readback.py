@@ -33,6 +33,32 @@ def accessor(doc, blob, index):
     return a
 
 
+def clip(doc, blob):
+    """The first animation's key times (F,) and rotation keys (F, C, 4), one per channel."""
+    anim = doc.animations[0]
+    times = accessor(doc, blob, anim.samplers[anim.channels[0].sampler].input)[:, 0]
+    keys = np.stack([accessor(doc, blob, anim.samplers[ch.sampler].output) for ch in anim.channels], axis=1)
+    return times, keys
+
+
+def play(times, keys, t):
+    """Rotations (T, C, 4) a client shows at times ``t`` (T,) of a looping clip: the time modulo
+    the clip's length (three.js's LoopRepeat), then a slerp between the keys around it."""
+    t = np.mod(np.asarray(t, float), float(times[-1]))
+    i = np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2)
+    u = np.clip((t - times[i]) / (times[i + 1] - times[i]), 0.0, 1.0)[:, None, None]
+    a, b = keys[i].astype(float), keys[i + 1].astype(float)
+    d = np.sum(a * b, axis=-1, keepdims=True)
+    b = np.where(d < 0, -b, b)
+    angle = np.arccos(np.clip(np.abs(d), 0.0, 1.0))
+    s = np.sin(angle)
+    small = s < 1e-6
+    wa = np.where(small, 1 - u, np.sin((1 - u) * angle) / np.where(small, 1, s))
+    wb = np.where(small, u, np.sin(u * angle) / np.where(small, 1, s))
+    q = wa * a + wb * b
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
+
+
 def quat_to_matrix(q):
     x, y, z, w = np.moveaxis(np.asarray(q, float), -1, 0)
     return np.stack([

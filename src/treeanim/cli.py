@@ -54,28 +54,35 @@ def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
 
 
 def cmd_export(args) -> int:
-    """Bake the simulated motion into a glTF 2.0 file."""
-    from treeanim import export
+    """Bake the simulated motion into a glTF 2.0 file: n frames at --fps make n + 1 keys, the
+    last at exactly --seconds (a loop's repeats its first: :mod:`treeanim.loop`)."""
+    from treeanim import export, loop
 
     out = output_path(args.out, (".glb", ".gltf"))
-    tree, sim = make_simulation(args)
-    skel = export.skeleton(tree)
     n = opt.check_frames(args.seconds, args.fps)
-    fade = opt.check_frames(args.loop, args.fps)
+    if abs(args.seconds * args.fps - n) > 1e-6 * max(n, 1):
+        whole = sorted({max(int(args.seconds * args.fps), 1), int(args.seconds * args.fps) + 1})
+        raise UsageError(f"--seconds {args.seconds:g} at --fps {args.fps:g} is {args.seconds * args.fps:.4g} frames; a clip "
+                         f"holds whole frames: try --seconds {' or '.join(f'{k / args.fps:.6g}' for k in whole)}")
     if n < 2:
         raise UsageError(f"--seconds {args.seconds:g} at --fps {args.fps:g} gives fewer than 2 frames")
+    fade = max(opt.check_frames(args.loop, args.fps), 1) if args.loop > 0 else 0
     if fade >= n:
         raise UsageError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
+    tree, sim = make_simulation(args)
+    skel = export.skeleton(tree, sim.present)
     try:
-        keys = export.bake(sim, skel, n + fade, args.fps, opt.scheduled(args), quiet=args.quiet)
+        raw = export.bake(sim, skel, n + max(fade, 1), args.fps, opt.scheduled(args), quiet=args.quiet)
     except ValueError as e:
         raise UsageError(str(e)) from None
-    doc, data = export.build_gltf(tree, export.crossfade_loop(keys, fade), args.fps, season=args.season,
-                                  present=sim.present)
+    keys = loop.close_loop(raw, n) if fade else raw
+    doc, data = export.build_gltf(tree, keys, args.fps, season=args.season, present=sim.present)
     files = export.write_gltf(out, doc, data)
     size = sum(f.stat().st_size for f in files)
-    print(f"wrote {', '.join(map(str, files))}: {skel.count} joints, {n} frames at {args.fps:g} fps "
-          f"({n / args.fps:.2f} s), {size / 1e6:.1f} MB")
+    print(f"wrote {', '.join(map(str, files))}: {skel.count} joints, {n} frames at {args.fps:g} fps, "
+          f"{n + 1} keys from 0 to {n / args.fps:.2f} s, {size / 1e6:.1f} MB")
+    if fade:
+        print(loop.seam(keys, raw).line())
     return 0
 
 
@@ -338,7 +345,8 @@ def build_parser() -> argparse.ArgumentParser:
     opt.add_scene_options(p)
     p.add_argument("--out", required=True, help="output file: tree.glb, or tree.gltf (+ tree.bin)")
     p.add_argument("--loop", type=opt.non_negative, default=0.0, metavar="SECONDS",
-                   help="make the clip loop by cross-fading this many seconds of its end into its start (default 0)")
+                   help="make the clip loop: the simulation runs this many seconds past the end and cross-fades into the "
+                   "clip's start; the last key repeats the first (default 0: no loop)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_export)
 

@@ -6,7 +6,11 @@ parent is the previous segment's joint, or for an object's base the joint that c
 parent's attach node; every object root hangs under one root joint at the origin. Because the
 simulation keeps segment lengths exactly and children sit exactly on their parents' nodes,
 each joint's translation relative to its parent is constant: the animation holds rotations
-only, one float32 quaternion key per joint and frame, sharing one time accessor.
+only, one float32 quaternion key per joint and frame, sharing one time accessor. Objects not
+present at the season (fallen leaves) have no joints and no triangles.
+
+A clip of n frames holds n + 1 keys, at 0, 1/fps, …, n/fps: it lasts n/fps in a client, which
+plays from the first key to the last (a loop's last key repeats its first: :mod:`treeanim.loop`).
 """
 
 from __future__ import annotations
@@ -39,7 +43,8 @@ class Skeleton:
     joint_parent : (J,) int
         Parent joint (-1 for the root joint).
     node_joint : (N,) int
-        The joint each node moves with (a tip node: its last segment's joint).
+        The joint each node moves with (a tip node: its last segment's joint; -1 for the
+        nodes of objects left out).
     """
 
     joint_node: np.ndarray
@@ -52,15 +57,35 @@ class Skeleton:
         return len(self.joint_node)
 
 
-def skeleton(tree: Tree) -> Skeleton:
-    """The joint hierarchy of ``tree`` (see the module docstring)."""
+def skeleton(tree: Tree, present: np.ndarray | None = None) -> Skeleton:
+    """The joint hierarchy of ``tree`` (see the module docstring).
+
+    Parameters
+    ----------
+    tree : Tree
+    present : (M,) bool, optional
+        Objects on the tree (:meth:`Tree.leaves_present`): the others' joints are left out,
+        so a winter tree has no joints for its fallen leaves. Default: every object.
+
+    Raises
+    ------
+    ValueError
+        If a present object hangs on one that is not.
+    """
     N = tree.n_nodes
     tip = np.zeros(N, bool)
     tip[tree.object_start + tree.object_count - 1] = True
     nodes = np.flatnonzero(~tip)
-    node_joint = np.zeros(N, np.int64)
+    if present is not None:
+        present = np.asarray(present, bool)
+        hung = tree.parent[present]
+        if np.any((hung >= 0) & ~present[np.maximum(hung, 0)]):
+            raise ValueError("a present object hangs on an object that is not present")
+        nodes = nodes[present[tree.node_object[nodes]]]
+    node_joint = np.full(N, -1, np.int64)
     node_joint[nodes] = np.arange(1, len(nodes) + 1)
-    node_joint[tip] = node_joint[np.flatnonzero(tip) - 1]
+    tips = np.flatnonzero(tip)
+    node_joint[tips] = node_joint[tips - 1]
     parent_node = nodes - 1  # the previous node of the same object...
     is_base = tree.node_index[nodes] == 0
     obj = tree.node_object[nodes[is_base]]
@@ -92,21 +117,6 @@ def local_rotations(skel: Skeleton, rotations: np.ndarray) -> np.ndarray:
     local = np.einsum("jki,jkl->jil", parent, world)
     local[0] = np.eye(3)
     return quaternions(local)
-
-
-def crossfade_loop(keys: np.ndarray, fade: int) -> np.ndarray:
-    """Make keys (F + fade, J, 4) loop: the first ``fade`` frames blend from the frames after
-    the end into the start, so the last frame runs smoothly on into the first. Returns (F, J, 4)."""
-    if fade <= 0:
-        return keys
-    out = keys[:-fade].copy()
-    tail = keys[-fade:]
-    a = (np.arange(fade) / fade)[:, None, None]
-    head = out[:fade]
-    tail = np.where(np.sum(tail * head, axis=-1, keepdims=True) < 0, -tail, tail)
-    mix = (1 - a) * tail + a * head  # normalised lerp between matching hemispheres
-    out[:fade] = mix / np.linalg.norm(mix, axis=-1, keepdims=True)
-    return out
 
 
 # ---------------------------------------------------------------------------- mesh
@@ -227,14 +237,27 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     ----------
     tree : Tree
     keys : (F, J, 4) float
-        Local joint rotations per frame (from :func:`local_rotations`).
+        Local joint rotations per frame (from :func:`local_rotations`) of the joints of
+        :func:`skeleton` ``(tree, present)``; key k plays at k / ``fps``, so the clip lasts
+        (F − 1) / ``fps``.
     fps : float
         Frames per second of ``keys``.
     season : float
-        Leaf colour; leaves not ``present`` are left out of the mesh.
+        Leaf colour.
+    mesh : TreeMesh, optional
+        The tree's mesh (:func:`~treeanim.render.mesh.build_mesh`), built if not given.
+    present : (M,) bool, optional
+        Objects on the tree: the others (fallen leaves) are left out of the mesh and the skin.
+
+    Raises
+    ------
+    ValueError
+        If ``keys`` are not for the skeleton's joints.
     """
     mesh = mesh if mesh is not None else build_mesh(tree)
-    skel = skeleton(tree)
+    skel = skeleton(tree, present)
+    if keys.shape[1] != skel.count:
+        raise ValueError(f"keys for {keys.shape[1]} joints, the skeleton has {skel.count}")
     doc = gl.GLTF2(asset=gl.Asset(version="2.0", generator="treeanim"))
     blob = _Blob(doc)
 
@@ -266,6 +289,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     joints[:, 1] = np.where(single, 0, j2)
     weights[:, 1] = np.where(single, 0, np.round(w2 * 255)).astype(np.uint8)
     weights[:, 0] = 255 - weights[:, 1]
+    joints[weights == 0] = 0  # a joint listed with no weight is noise to clients (and the validator)
     index = remap[mesh.indices[keep_tris]].astype(np.uint32)
 
     attrs = gl.Attributes(
