@@ -1,4 +1,5 @@
-"""A plain (non-editable) wheel install holds every subpackage and finds its presets and shaders."""
+"""A plain (non-editable) wheel install holds every subpackage and finds its presets, scenes and
+shaders."""
 
 import os
 import shutil
@@ -30,7 +31,9 @@ def test_installed_wheel_finds_assets(tmp_path):
         "import importlib.resources as r, json, treeanim as ta\n"
         "t = ta.load_preset('small_cherry')\n"
         "names = sorted(p.name for p in r.files('treeanim.shaders').iterdir() if p.name.split('.')[-1] in ('vert', 'frag', 'glsl'))\n"
-        "print(json.dumps({'file': ta.__file__, 'presets': ta.list_presets(), 'leaves': t.stats()['leaves'], 'shaders': names}))\n"
+        "plants = sorted(p.name for p in (r.files('treeanim.presets') / 'scenes' / 'plants').iterdir())\n"
+        "print(json.dumps({'file': ta.__file__, 'presets': ta.list_presets(), 'leaves': t.stats()['leaves'], 'shaders': names,\n"
+        "                  'scenes': ta.list_scenes(), 'plants': plants}))\n"
     )
     env = dict(os.environ, PYTHONPATH=str(site))
     res = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
@@ -41,6 +44,8 @@ def test_installed_wheel_finds_assets(tmp_path):
     assert out["file"].startswith(str(site)), "the installed copy was imported, not the source tree"
     assert set(out["presets"]) == {"beam", "small_cherry", "large_cherry", "tulip_poplar", "grassland"}
     assert out["leaves"] == 816
+    assert out["scenes"] == ["orchard", "woodland"]
+    assert out["plants"] == ["meadow.toml", "sapling.toml", "shrub.toml"]
     assert out["shaders"] == shaders
     source = ROOT / "src" / "treeanim"
     packages = sorted(str(p.parent.relative_to(source)) for p in source.rglob("__init__.py"))

@@ -236,21 +236,18 @@ def cmd_view(args) -> int:
 
 
 def load_any(name_or_path: str, args=None):
-    """A preset by name, a preset TOML file or a TreeQSM model (.txt, .csv, .mat) by path, with
-    ``args``' --leaves (QSM only), --modes and --physics."""
+    """A preset or a scene by name, a preset or scene TOML file or a TreeQSM model (.txt, .csv,
+    .mat) by path, with ``args``' --leaves (QSM only), --modes and --physics."""
     import dataclasses
 
-    import treeanim as ta
     from treeanim.model.qsm import QSM_SUFFIXES
     from treeanim.model.qsm.leaves import LEAVES_FOR_QSM_ONLY
+    from treeanim.model.scene_file import load_named
 
     leaves, modes = getattr(args, "leaves", None), getattr(args, "modes", None)
-    if name_or_path.lower().endswith((*QSM_SUFFIXES, ".toml")):
-        tree = ta.load_tree(name_or_path, leaves=leaves)
-    elif leaves is not None:
+    if leaves is not None and not name_or_path.lower().endswith((*QSM_SUFFIXES, ".toml")):
         raise UsageError(LEAVES_FOR_QSM_ONLY)
-    else:
-        tree = ta.load_preset(name_or_path)
+    tree = load_named(name_or_path, leaves=leaves)
     if modes is not None:
         tree.modes = modes
     settings = dict(getattr(args, "physics", None) or ())
@@ -260,10 +257,10 @@ def load_any(name_or_path: str, args=None):
 
 
 def cmd_list(args) -> int:
-    """The shipped presets, a line each: name, size and description."""
-    from treeanim.describe import preset_lines
+    """The shipped presets and scenes, a line each: name, size and description."""
+    from treeanim.describe import preset_lines, scene_list_lines
 
-    print("\n".join(preset_lines()))
+    print("\n".join(preset_lines() + scene_list_lines()))
     return 0
 
 
@@ -271,6 +268,7 @@ def cmd_info(args) -> int:
     """Print a preset's statistics beside the paper's Table 1 row (or, --objects, its objects)."""
     import treeanim as ta
     from treeanim.model.params import ModeRange
+    from treeanim.model.scene import Scene
     from treeanim.model.tree import PLURAL
 
     tree = load_any(args.preset, args)
@@ -278,6 +276,11 @@ def cmd_info(args) -> int:
         from treeanim.describe import object_lines
 
         print("\n".join(object_lines(tree)))
+        return 0
+    if isinstance(tree, Scene):
+        from treeanim.describe import scene_lines
+
+        print("\n".join(scene_lines(tree, args.season)))
         return 0
     stats = tree.stats(args.season)
     key = tree.name + ("@winter" if args.season >= 1.0 and tree.name == "large_cherry" else "")
@@ -436,9 +439,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_view)
     _help_ends_with(p, lambda: __import__("treeanim.describe").describe.viewer_controls())
 
-    p = sub.add_parser("list", help="list the shipped presets: size and description",
+    p = sub.add_parser("list", help="list the shipped presets and scenes: size and description",
                        description="List the shipped presets, a line each: name, height, objects and triangles "
-                       "(in summer) and what it is.")
+                       "(in summer) and what it is; then the shipped scenes: their trees and what they are.")
     p.set_defaults(func=cmd_list)
     for p in (parser, *sub.choices.values()):
         _one_line_errors(p)

@@ -8,7 +8,7 @@ what to install or use instead. This module imports nothing, so every layer may 
 
 from __future__ import annotations
 
-__all__ = ["InputError", "UsageError", "PresetError", "QSMError", "GLUnavailable", "ViewerUnavailable"]
+__all__ = ["InputError", "UsageError", "PresetError", "QSMError", "SceneError", "GLUnavailable", "ViewerUnavailable"]
 
 
 class InputError(ValueError):
@@ -28,6 +28,11 @@ class PresetError(InputError):
 class QSMError(PresetError):
     """A TreeQSM cylinder model that cannot be used: one line naming the file, the row (the
     cylinder's number, 1-based as TreeQSM counts) and what was wrong."""
+
+
+class SceneError(PresetError):
+    """A scene file that cannot be used: one line naming the file, the key (``trees[3].scale``,
+    ``scatter[0].count``) and what was expected."""
 
 
 class GLUnavailable(RuntimeError):

@@ -16,8 +16,8 @@ MAX_FRAMES = 1_000_000
 #: Most simulation steps one command may take (hours of work at a few ms a step).
 MAX_STEPS = 2_000_000
 #: The help of every command's tree argument.
-PRESET_HELP = ("a preset's name (see 'treeanim list'), a preset .toml file, or a TreeQSM cylinder model: "
-               "a .txt or .csv table or a .mat file (see --leaves)")
+PRESET_HELP = ("a preset's or a scene's name (see 'treeanim list'), a preset or scene .toml file, or a TreeQSM "
+               "cylinder model: a .txt or .csv table or a .mat file (see --leaves)")
 #: How ``--pull``, ``--drag`` and ``trace --object`` name an object, for their help.
 OBJECT_HELP = ("OBJECT is an object's number, root first and level by level (0 is the trunk, or a meadow's "
                "first blade); 'treeanim info PRESET --objects' lists them with their kind, length and tip")

@@ -24,6 +24,7 @@ from ..errors import PresetError
 from ..files import atomic_path
 from ..model.declare import default_of
 from ..model.params import PARAMS, PhysicsParams
+from ..model.scene import Scene
 from ..model.tree import KINDS, Tree
 
 __all__ = ["physics_toml", "preset_text", "save_preset", "original_preset_text"]
@@ -78,6 +79,9 @@ def original_preset_text(tree: Tree) -> str:
     ValueError
         The tree has no readable source file (e.g. it was built in code).
     """
+    if isinstance(tree, Scene):
+        raise ValueError(f"{tree.name!r} is a scene of {tree.n_trees} trees; its physics are its trees' presets' "
+                         "(open one of them to save its physics)")
     if tree.source and not tree.source.endswith(".toml"):
         raise ValueError(f"tree {tree.name!r} was loaded from {tree.source}, not a preset file; there is no "
                          "preset shape to save its physics with")

@@ -112,16 +112,26 @@ def load_preset(name: str) -> Tree:
         return read_tree(path)
 
 
-def read_tree(path: str | Path) -> Tree:
+def read_tree(path: str | Path, data: dict | None = None) -> Tree:
     """Read a preset TOML file and generate its tree (``treeanim.load_tree`` reads any tree
-    file: :func:`treeanim.model.qsm.load_tree`).
+    file, scenes too: :func:`treeanim.model.scene_file.load_tree`).
+
+    Parameters
+    ----------
+    path : str or Path
+    data : dict, optional
+        The file's TOML already read (:func:`read_toml`), to read it once.
 
     Raises
     ------
     PresetError
         One line naming the file, the key and what was expected.
     """
-    spec = read_spec(path)
+    return tree_of(read_spec(path, data), path)
+
+
+def tree_of(spec: TreeSpec, path) -> Tree:
+    """Generate a checked spec's tree; a problem is one PresetError line naming ``path``."""
     try:
         tree = generate(spec)
     except ValueError as e:  # the generator names the key it could not use
@@ -160,17 +170,26 @@ def _read_text(path: Path) -> str:
         raise PresetError(f"{path}: not a UTF-8 text file") from None
 
 
-def read_spec(path: str | Path) -> TreeSpec:
-    """Parse and check a preset file into a :class:`TreeSpec` (no generation)."""
+def read_toml(path: str | Path) -> dict:
+    """A preset or scene file's TOML: a regular UTF-8 file of at most :data:`MAX_PRESET_BYTES`
+    that parses (PresetError otherwise, one line naming the file)."""
     path = Path(path)
     text = _read_text(path)
     try:
-        data = tomllib.loads(text)
+        return tomllib.loads(text)
     except ValueError as e:  # TOMLDecodeError, or an integer of thousands of digits
         why = " ".join(str(e).split())
         raise PresetError(f"{path}: not valid TOML ({why if len(why) <= 120 else why[:117] + '...'})") from None
     except RecursionError:  # tomllib parses nested arrays and tables recursively
         raise PresetError(f"{path}: arrays or tables nested too deeply to be a preset") from None
+
+
+def read_spec(path: str | Path, data: dict | None = None) -> TreeSpec:
+    """Parse and check a preset file into a :class:`TreeSpec` (no generation); ``data``, the
+    file's TOML if already read."""
+    path = Path(path)
+    if data is None:
+        data = read_toml(path)
     try:
         spec = _tree_spec(data, str(path))
         _check_leaves(spec)
@@ -269,6 +288,9 @@ def _physics(data) -> PhysicsParams:
 def _tree_spec(data: dict, source: str) -> TreeSpec:
     top = ("name", "description", "type", "seed", "trunk", "levels", "crown", "leaves", "lamina", "bark", "grass",
            "beam", "physics")
+    if data.get("type") == "scene":
+        raise _KeyProblem("type", "expected 'tree', 'grass' or 'beam', got 'scene' (a scene file: treeanim.load_scene "
+                                  "reads it)")
     for k in data:
         if k not in top:
             raise _KeyProblem(k, f"unknown key; expected one of {', '.join(top)}")

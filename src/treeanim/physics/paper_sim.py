@@ -8,6 +8,7 @@ import numbers
 import numpy as np
 
 from ..model.params import MODE_PARAMS, PhysicsParams, check_physics
+from ..model.scene import Scene
 from ..model.tree import KINDS, Tree
 from ..validate import finite_float, finite_vector3, float_within, object_index
 from .derived import Derived
@@ -121,6 +122,9 @@ class PaperSim(Derived, Stages, Pose, Snapshot):
                  integrator: str = "exact", coupling: bool = True, modes: str | None = None):
         if not isinstance(tree, Tree):
             raise ValueError(f"tree must be a treeanim Tree, got {type(tree).__name__}")
+        if isinstance(tree, Scene) and tree.n_trees > 1:
+            raise ValueError(f"the paper's model takes one tree (its modal ranges span the tree); the scene "
+                             f"{tree.name!r} has {tree.n_trees}: use the tree model")
         if isinstance(seed, bool) or not isinstance(seed, numbers.Integral) or seed < 0:
             raise ValueError(f"seed must be a non-negative integer, got {seed!r}")
         self._tree = tree

@@ -32,9 +32,10 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from ..model.geometry import lamina_frames, polygon_centroid, unit
+from ..model.scene import Scene
 from .compiled import njit
 
-__all__ = ["Structure", "foliage_clusters", "POISSON", "PETIOLE_BEND_TWIST", "PLATE_NORMAL_DRAG"]
+__all__ = ["Structure", "foliage_clusters", "leaf_clusters", "POISSON", "PETIOLE_BEND_TWIST", "PLATE_NORMAL_DRAG"]
 
 #: Poisson's ratio of wood along the grain (G = E / 2(1 + ν)).
 POISSON = 0.3
@@ -155,6 +156,22 @@ def foliage_clusters(X: np.ndarray, leaf_area: np.ndarray, lai: float) -> float:
     except (QhullError, ValueError):
         return 1.0  # a crown with no extent across (all nodes on a line)
     return max(1.0, lai * crown / total)
+
+
+def leaf_clusters(tree, X: np.ndarray, leaves: np.ndarray, leaf_area: np.ndarray, lai: float) -> np.ndarray:
+    """(L,) :func:`foliage_clusters` per leaf: of its own tree's crown in a scene (each placed
+    tree's nodes and leaves), of the whole tree otherwise."""
+    if not isinstance(tree, Scene) or tree.n_trees <= 1:
+        return np.full(len(leaves), foliage_clusters(X, leaf_area, lai))
+    node_tree = tree.node_tree
+    by_tree = np.argsort(node_tree, kind="stable")
+    node_edges = np.searchsorted(node_tree[by_tree], np.arange(tree.n_trees + 1))
+    owner = tree.object_tree[leaves]
+    out = np.ones(len(leaves))
+    for k in np.unique(owner):
+        mine = owner == k
+        out[mine] = foliage_clusters(X[by_tree[node_edges[k]:node_edges[k + 1]]], leaf_area[mine], lai)
+    return out
 
 
 def _point_moments(mass: np.ndarray, r: np.ndarray):
@@ -332,10 +349,11 @@ class Structure:
         Ja = lam_mass * width**2 / 12.0 + 1e-12
         # each leaf stands for a cluster of n real ones (physics.leaf_area_index): n times the
         # mass, drag, stiffness and inertia, so it turns as one leaf does and loads its twig as n
-        n = foliage_clusters(X, area, p.leaf_area_index)
+        # (of each placed tree's own crown in a scene)
+        n = leaf_clusters(tree, X, leaves, area, p.leaf_area_index)
         leaf_mass = leaf_mass * n
-        leaf_k = n * np.stack([ktl, kbl, kbl], axis=1)
-        leaf_J = n * np.stack([Ja, Jb, Jb], axis=1)
+        leaf_k = n[:, None] * np.stack([ktl, kbl, kbl], axis=1)
+        leaf_J = n[:, None] * np.stack([Ja, Jb, Jb], axis=1)
         leaf_d = 2.0 * p.wood_damping * np.sqrt(leaf_k * leaf_J)
         cna = 0.5 * p.air_density * p.drag_leaf * area * n
         cswing = 0.5 * p.air_density * PLATE_NORMAL_DRAG * area * n

@@ -23,6 +23,7 @@ import weakref
 import moderngl
 import numpy as np
 
+from ..model.scene import Scene as TreeScene
 from ..model.tree import Tree
 from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
@@ -152,8 +153,10 @@ class GroundPass:
         spread = np.percentile(np.linalg.norm(pts[:, [0, 2]] - crown[[0, 2]], axis=1), 85)
         self.occlusion_radius = float(max(1.1 * spread, 0.1 * float(np.max(hi - lo))))
         self.trunk_radius = float(0.5 * tree.node_diameter[trunks].max()) if len(trunks) else 0.0
-        self.block.set(ground_centre=(trunk_foot[0], 0.0, trunk_foot[2]),
-                       earth_radius=5.0 * tree.node_diameter[trunks].max() if len(trunks) else 0.0,
+        earth = 5.0 * tree.node_diameter[trunks].max() if len(trunks) else 0.0
+        if isinstance(tree, TreeScene) and tree.n_trees > 1:  # one tree's earth, shade and foot: not a scene's
+            self.occlusion_radius = self.trunk_radius = earth = 0.0
+        self.block.set(ground_centre=(trunk_foot[0], 0.0, trunk_foot[2]), earth_radius=earth,
                        occlusion_centre=(crown[0], 0.0, crown[2]))
 
     def apply(self, scene: Scene) -> None:
