@@ -97,7 +97,7 @@ def test_the_viewer_and_the_offline_frames_take_the_same_steps():
     tree = ta.load_preset("beam")
     a, b = ta.Simulation(tree), ta.Simulation(tree)
     pull = [Pull(0, (10.0, 0.0, 5.0), 0.0, 1.0)]
-    moved = max(np.abs(a.positions - tree.rest_positions).max() for _ in frames(a, 2.0, 30, pull))
+    moved = max(np.abs(a.positions - tree.rest_positions).max() for _ in frames(a, 60, 30, pull))
     driver, hand = FrameDriver(), Schedule(pull)
     for k in range(60):
         driver.advance(b, 1 / 30 if k else 0.0, hand)
@@ -105,3 +105,23 @@ def test_the_viewer_and_the_offline_frames_take_the_same_steps():
     assert a.time == pytest.approx(b.time)
     np.testing.assert_allclose(a.positions, b.positions, atol=1e-12)
     assert moved > 1e-2, "the pull moved the beam"
+
+
+@pytest.mark.parametrize("scale", [0.0, -1.0, float("nan"), float("inf")])
+def test_a_time_scale_that_is_not_finite_and_positive_is_refused_and_the_old_one_kept(scale):
+    driver = FrameDriver()
+    driver.time_scale = 0.5
+    with pytest.raises(ValueError, match="time scale"):
+        driver.time_scale = scale
+    assert driver.time_scale == 0.5
+
+
+@pytest.mark.parametrize("rate", [0.0, -30.0, float("nan"), float("inf")])
+def test_frames_at_a_rate_that_is_not_finite_and_positive_are_refused(rate):
+    with pytest.raises(ValueError, match="rate"):
+        FrameDriver.at_rate(rate)
+
+
+def test_frames_need_a_rate():
+    with pytest.raises(ValueError, match="at_rate"):
+        next(FrameDriver().frames(Counter(), 3))

@@ -39,7 +39,7 @@ def simulate(preset, seconds, fps, wind, pulls=(), season=0.0):
     0, 1/fps, ..., ``seconds`` (both ends included)."""
     tree = ta.load_preset(preset)
     sim = ta.Simulation(tree, wind=ta.WindField(speed=wind) if wind else None, season=season)
-    frames = scripted.frames(sim, seconds + 1 / fps, fps, [scripted.parse_pull(p) for p in pulls])
+    frames = scripted.frames(sim, int(round(seconds * fps)) + 1, fps, [scripted.parse_pull(p) for p in pulls])
     return tree, [sim.positions.copy() for _ in frames]
 
 
@@ -173,7 +173,7 @@ def test_loop_closes_at_exactly_the_asked_length_without_a_seam(tmp_path):
     # is at most what either motion steps, plus less than the joint's median step.
     tree = ta.load_preset("small_cherry")
     sim = ta.Simulation(tree, wind=ta.WindField(speed=12.0))
-    raw = np.array([local_rotations(skel, sim.rotations)[1:] for _ in scripted.frames(sim, seconds + (fade + 1) / fps, fps)])
+    raw = np.array([local_rotations(skel, sim.rotations)[1:] for _ in scripted.frames(sim, int(round(seconds * fps)) + fade + 1, fps)])
     own = np.maximum(_angles(raw[:fade], raw[1:fade + 1]), _angles(raw[n:n + fade], raw[n + 1:n + fade + 1]))
     added = np.max(steps[:fade] - own, axis=0)
     median = np.median(steps, axis=0)
@@ -243,3 +243,20 @@ def test_exported_bark_takes_the_species_colour():
         ratio = bark / expected
         assert np.all(ratio > 0.91) and np.all(ratio < 1.09)
         assert np.allclose(ratio[:, 0], ratio[:, 2])  # the species' hue, only brighter or darker
+
+
+def test_more_joints_than_a_skin_indexes_are_refused_in_one_line():
+    """glTF's JOINTS_0 holds 16-bit joint indices: a skeleton of more than 65,536 joints (five
+    grasslands, 75,001; the orchard's 121,009) was written with the indices wrapped, skinning
+    vertices to other trees' joints. Now it is refused."""
+    from treeanim import export as ex
+
+    grass = ta.load_preset("grassland")
+    scene = ta.make_scene([grass] * 5, positions=[(12.0 * k, 0.0, 0.0) for k in range(5)])
+    skel = skeleton(scene)
+    assert skel.count > ex.MAX_JOINTS
+    with pytest.raises(ValueError, match="at most 65,536") as e:
+        ex.bake(ta.Simulation(scene), skel, 2, 10.0)
+    assert "\n" not in str(e.value)
+    small = skeleton(grass)
+    ex.check_joints(small)  # one grassland's 15,001 joints are fine

@@ -50,7 +50,7 @@ def dragged_at(log, t):
 def test_overlapping_and_back_to_back_pulls():
     pulls = [parse_pull("0:1,0,0@0-2"), parse_pull("1:0,0,2@1-3"), parse_pull("0:0,-5,0@2-2.5")]
     rec = Recorder()
-    list(frames(rec, 4.0, 10, pulls, step=0.05))
+    list(frames(rec, 40, 10, pulls, step=0.05))
     assert held_at(rec.log, 0.5) == {0: (1.0, 0.0, 0.0)}
     assert held_at(rec.log, 1.5) == {0: (1.0, 0.0, 0.0), 1: (0.0, 0.0, 2.0)}
     assert held_at(rec.log, 2.2) == {0: (0.0, -5.0, 0.0), 1: (0.0, 0.0, 2.0)}
@@ -64,7 +64,7 @@ def test_frames_land_on_their_times_in_equal_steps(fps, per_frame):
     """The frame driver's offline policy (treeanim.driver.step_for): equal steps of at most
     1/60 s, a whole number of them a frame, so every frame lands on its time."""
     rec = Recorder()
-    times = [rec.time for _ in frames(rec, 2.0, fps, [])]
+    times = [rec.time for _ in frames(rec, 2 * fps, fps, [])]
     assert len(times) == 2 * fps
     np.testing.assert_allclose(times, np.arange(2 * fps) / fps, atol=1e-9)
     steps = np.diff([t for t, _, _ in rec.log])
@@ -77,7 +77,7 @@ def test_scripted_pull_matches_hand_stepping():
     tree = ta.load_preset("beam")
     a, b = ta.Simulation(tree), ta.Simulation(tree)
     moved = 0.0
-    for k in frames(a, 2.0, 20, [Pull(0, (10.0, 0.0, 5.0), 0.25, 1.0)], step=0.05):
+    for k in frames(a, 40, 20, [Pull(0, (10.0, 0.0, 5.0), 0.25, 1.0)], step=0.05):
         moved = max(moved, np.abs(a.positions - tree.rest_positions).max())
     t = 0.0
     while t < 1.95 - 1e-9:
@@ -103,7 +103,7 @@ def test_drags_hold_one_at_a_time_beside_pulls_on_the_same_object():
     items = [parse_drag("0:1,2,3@0-2"), parse_pull("0:5,0,0@1-1.5"), parse_drag("1@0.5:0,1,0@2-3"),
              parse_pull("1:0,0,1@2.5-3.5")]
     rec = Recorder()
-    list(frames(rec, 4.0, 10, items, step=0.05))
+    list(frames(rec, 40, 10, items, step=0.05))
     assert dragged_at(rec.log, 0.5) == (0, (1.0, 2.0, 3.0), 1.0) and held_at(rec.log, 0.5) == {}
     assert dragged_at(rec.log, 1.2) == (0, (1.0, 2.0, 3.0), 1.0) and held_at(rec.log, 1.2) == {0: (5.0, 0.0, 0.0)}
     assert dragged_at(rec.log, 1.7) == (0, (1.0, 2.0, 3.0), 1.0) and held_at(rec.log, 1.7) == {}
@@ -118,7 +118,7 @@ def test_a_scripted_drag_moves_the_beams_tip_toward_the_target():
     sim = ta.Simulation(ta.load_preset("beam"))
     tip = sim.tip_position(0)
     target = tip + [0.1, 0.0, 0.0]
-    for _ in frames(sim, 2.0, 10, [Drag(0, tuple(target), 0.0, 2.5)]):
+    for _ in frames(sim, 20, 10, [Drag(0, tuple(target), 0.0, 2.5)]):
         pass
     assert np.linalg.norm(sim.tip_position(0) - target) < 0.3 * 0.1
     assert sim.dragging is None, "let go at the end"

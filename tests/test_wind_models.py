@@ -192,6 +192,10 @@ def test_the_command_line_offers_a_registered_model(registry):
     args = parser.parse_args(["render", "beam", "--wind-model", "shear", "--turbulence", "0.2", "--out", "x.png"])
     with pytest.raises(UsageError, match="^turbulence: a setting of the"):
         cli.make_simulation(args)
+    # a named wind is the physical model's: asked of another it is refused, not swapped for it
+    args = parser.parse_args(["render", "beam", "--wind-model", "shear", "--wind-preset", "gale", "--out", "x.png"])
+    with pytest.raises(UsageError, match="^--wind-preset: the named winds are for the physical wind model, not the shear"):
+        cli.make_simulation(args)
 
 
 def test_registering_checks_the_class(registry):

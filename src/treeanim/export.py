@@ -122,6 +122,15 @@ def local_rotations(skel: Skeleton, rotations: np.ndarray) -> np.ndarray:
 # ---------------------------------------------------------------------------- mesh
 #: The most bytes of animation keys :func:`bake` allocates (float32 quaternions).
 MAX_KEY_BYTES = 8e9
+#: The most joints one skin holds: glTF's JOINTS_0 indexes them with 16 bits.
+MAX_JOINTS = 65536
+
+
+def check_joints(skel: "Skeleton") -> None:
+    """ValueError (one line) for a skeleton of more than :data:`MAX_JOINTS` joints."""
+    if skel.count > MAX_JOINTS:
+        raise ValueError(f"{skel.count:,} joints: a glTF skin holds at most {MAX_JOINTS:,} (16-bit joint indices); "
+                         "export fewer trees (a scene's trees in smaller scenes) or a winter clip")
 
 
 def bake(sim, skel: Skeleton, frames: int, fps: float, pulls=(), quiet: bool = True) -> np.ndarray:
@@ -136,19 +145,20 @@ def bake(sim, skel: Skeleton, frames: int, fps: float, pulls=(), quiet: bool = T
     Raises
     ------
     ValueError
-        More than :data:`MAX_KEY_BYTES` of keys.
+        More than :data:`MAX_KEY_BYTES` of keys, or more than :data:`MAX_JOINTS` joints.
     """
     from tqdm import tqdm
 
     from . import scripted
 
+    check_joints(skel)
     size = frames * skel.count * 16
     if size > MAX_KEY_BYTES:
         raise ValueError(f"{frames:,} frames of {skel.count:,} joints would need {size / 1e9:.0f} GB of keys; "
                          "export fewer seconds or frames per second")
     keys = np.empty((frames, skel.count, 4), np.float32)
     with tqdm(total=frames, desc=f"baking {sim.tree.name}", unit="frame", disable=quiet, leave=False) as bar:
-        for k in scripted.frames(sim, frames / fps, fps, pulls):
+        for k in scripted.frames(sim, frames, fps, pulls):
             keys[k] = local_rotations(skel, sim.rotations)
             bar.update()
     return keys
@@ -258,6 +268,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     skel = skeleton(tree, present)
     if keys.shape[1] != skel.count:
         raise ValueError(f"keys for {keys.shape[1]} joints, the skeleton has {skel.count}")
+    check_joints(skel)
     doc = gl.GLTF2(asset=gl.Asset(version="2.0", generator="treeanim"))
     blob = _Blob(doc)
 

@@ -181,9 +181,10 @@ def wind_settings(args) -> dict:
     model = getattr(args, "wind_model", None)
     kw = dict(model=model or ("paper" if getattr(args, "paper", False) else "physical"))
     if getattr(args, "wind_preset", None):
-        if kw["model"] == "paper":
-            raise UsageError("--wind-preset: the named winds are for --wind-model physical")
-        kw.update(wind_preset(args.wind_preset))
+        try:
+            kw.update(wind_preset(args.wind_preset, kw["model"]))
+        except ValueError as e:
+            raise UsageError(f"--wind-preset: {e}") from None
     kw.setdefault("speed", args.wind_default)
     if args.wind is not None:
         kw["speed"] = args.wind

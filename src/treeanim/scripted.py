@@ -181,14 +181,13 @@ class Schedule:
         self.held, self.dragged = {}, None
 
 
-def frames(sim, seconds: float, fps: float, pulls: list = (), step: float = STEP) -> Iterator[int]:
-    """Advance ``sim`` to each frame time k / fps for k = 0 .. round(seconds * fps) - 1 with
-    the scheduled ``pulls`` (:class:`Schedule`), yielding k there; everything is let go at the
-    end.
+def frames(sim, count: int, fps: float, pulls: list = (), step: float = STEP) -> Iterator[int]:
+    """Advance ``sim`` to each frame time k / fps for k = 0 … ``count`` − 1 with the scheduled
+    ``pulls`` (:class:`Schedule`), yielding k there; everything is let go at the end.
 
     The steps are the frame driver's for frames at ``fps``, of at most ``step`` seconds
     (:meth:`FrameDriver.at_rate <treeanim.driver.FrameDriver.at_rate>`).
     """
     schedule = Schedule(pulls)
-    yield from FrameDriver.at_rate(fps, step).frames(sim, int(round(seconds * fps)), fps, schedule)
+    yield from FrameDriver.at_rate(fps, step).frames(sim, count, schedule)
     schedule.release(sim)

@@ -157,9 +157,8 @@ class ViewerActions:
         :data:`treeanim.physics.wind.WIND_PRESETS`: its speed, turbulence and gusts)."""
         w = self.sim.wind
         if "preset" in changes:
-            changes = {**wind_preset_kwargs(changes.pop("preset")), **changes}
-            if w.model != changes.pop("model"):
-                raise ValueError("preset: the named winds are for the physical wind model")
+            changes = {**wind_preset_kwargs(changes.pop("preset"), w.model), **changes}
+            del changes["model"]
         for k, v in changes.items():
             if k == "angle":
                 w.direction = wind_direction(v)

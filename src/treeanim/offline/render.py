@@ -161,7 +161,7 @@ def run_render(job: RenderJob, tree, sim, log=print) -> RenderResult:
 
         if target.kind == "still":
             T = job.start + job.seconds
-            for _ in scripted.frames(sim, 2 * T, 1 / max(T, 1e-9), job.pulls):  # frames at 0 and T (T > 0)
+            for _ in scripted.frames(sim, 2, 1 / max(T, 1e-9), job.pulls):  # frames at 0 and T (T > 0)
                 pass
             write_png(target.path, shoot())
             return RenderResult(1, 1, True, False, target.path, (job.width, job.height), target.path.stat().st_size)
@@ -173,7 +173,7 @@ def run_render(job: RenderJob, tree, sim, log=print) -> RenderResult:
         kept = False
         with StopRequest() as stop:
             try:
-                for k in scripted.frames(sim, (first + n) / job.fps, job.fps, job.pulls):
+                for k in scripted.frames(sim, first + n, job.fps, job.pulls):
                     if stop.requested:
                         break
                     if k < first:

@@ -60,12 +60,12 @@ def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float, dr
     hand = Schedule([Drag(obj, tuple(drag), 0.0, np.inf) if drag is not None
                      else Pull(obj, tuple(force), 0.0, np.inf)])
     driver = FrameDriver.at_rate(rate)  # the offline commands' frames, sampled at the rate
-    for _ in driver.frames(sim, max(1, int(round(hold * rate))) + 1, rate, hand):
+    for _ in driver.frames(sim, max(1, int(round(hold * rate))) + 1, hand):
         pass
     held = sim.tip_position(obj)
     hand.release(sim)
     times, tips = np.empty(samples), np.empty((samples, 3))
-    for k in driver.frames(sim, samples, rate):
+    for k in driver.frames(sim, samples):
         times[k], tips[k] = sim.time, sim.tip_position(obj)
     f = zeta = None
     if sim.model == "paper":

@@ -52,7 +52,7 @@ WIND_PRESETS: dict[str, dict] = {
 }
 
 
-def wind_preset(name: str) -> dict:
+def wind_preset(name: str, model: str | None = None) -> dict:
     """WindField keyword arguments for a named wind (physical model).
 
     Parameters
@@ -61,6 +61,9 @@ def wind_preset(name: str) -> dict:
         ``calm`` (Beaufort 1, light air, 1 m/s), ``breeze`` (3, gentle breeze, 4.5 m/s),
         ``windy`` (5, fresh breeze, 9.5 m/s), ``gale`` (8, 19 m/s) or ``storm`` (10,
         26.5 m/s).
+    model : str or None
+        The wind model it is for, if one is chosen: the named winds are the physical model's
+        (any other is refused).
 
     Returns
     -------
@@ -70,10 +73,12 @@ def wind_preset(name: str) -> dict:
     Raises
     ------
     ValueError
-        If the name is not one of :data:`WIND_PRESETS`.
+        If the name is not one of :data:`WIND_PRESETS`, or ``model`` is another model.
     """
     if name not in WIND_PRESETS:
         raise ValueError(f"wind preset must be one of {', '.join(WIND_PRESETS)}, got {name!r}")
+    if model not in (None, "physical"):
+        raise ValueError(f"the named winds are for the physical wind model, not the {model} one")
     kw = {k: v for k, v in WIND_PRESETS[name].items() if k != "beaufort"}
     return dict(kw, model="physical")
 
