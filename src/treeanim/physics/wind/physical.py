@@ -139,7 +139,7 @@ def _gust_lattice(lo: float, hi: float, lanes: tuple, budget: int, gusts: tuple,
     n_lanes = lanes[1] - lanes[0] + 1
     first = np.int64(math.floor(lo))
     n = np.int64(math.floor(hi)) - first + 2
-    if n * n_lanes > budget:
+    if float(n) * float(n_lanes) > budget:  # (in float: no int64 overflow for lanes far apart)
         return 0, empty
     _, g, per_m, sr, sd, step = gusts
     ys = np.empty((n_lanes, n))
