@@ -11,33 +11,42 @@ shows how to add one.
 ``WindField(model="physical")`` (docs/design.md §12, issue 11) is weather-like wind:
 
 * **Turbulence in metres.** Three independent Gaussian fields (along-wind u, vertical v,
-  lateral w) on one periodic tile of 128 × 48 × 96 cells covering 8 L × 3 L × 6 L (along,
+  lateral w) on one periodic tile of 256 × 48 × 64 cells covering 16 L × 3 L × 4 L (along,
   up, across the wind), L the along-wind integral length scale (``length_scale``, by
-  default the canopy height). The tile is independent of any tree's box, so several trees
-  share one field. The 3-D spectrum is (k² + k0²)^−(β+2)/2 with k0 = 1/(1.339 L_c), so the
-  spectrum along any line is the von Kármán form (k1² + k0²)^−β/2: f^−β in the inertial
-  range, flat below the energy-containing eddies (L_u = L, L_v = L_w = L/3, as in canopy
-  flows). Its Fourier amplitudes are pre-compensated for trilinear interpolation (exactly
-  along the wind, on average across it), so the spectrum at a fixed point keeps its slope
-  up to about half the grid's Nyquist frequency U·12/(2L).
-* **Taylor's frozen turbulence.** The tile is carried downwind at the mean speed at the
-  canopy top, so a gust reaches a point d metres downwind d/U seconds later and gusts come
-  faster in stronger wind.
-* **Evolution, no loop.** Two layers of the tile, weighted sin(πs) and |cos(πs)| (their
-  squares sum to one, so the variance is steady), evolve with the travelled distance:
-  s grows by one every 4 L of travel, and each layer jumps to a new random place in the
-  tile (a hash of the seed and the cycle) when its weight is zero. Eddies so live for
-  about 4 L / U seconds and nothing repeats: the point's autocorrelation is ~0 beyond a few
-  L / U.
+  default the canopy height). The tile is independent of any tree's box, so every tree of a
+  scene stands in one field. The 3-D spectrum is (k² + k0²)^−(β+2)/2 with k0 = 1/(1.339 L),
+  so the spectrum along any line is the von Kármán form (k1² + k0²)^−β/2: f^−β in the
+  inertial range, flat below the energy-containing eddies (L_u = L, L_v = L_w = L/3, as in
+  canopy flows). Its Fourier amplitudes are
+  pre-compensated for trilinear interpolation (exactly along the wind, on average across
+  it), so the spectrum at a fixed point keeps its slope up to about half the grid's Nyquist
+  frequency U·12/(2L).
+* **A landscape without a period** (``turbulence.py``). The tile is read through blocks:
+  7 L long along the wind and, within each, L wide across it, each pair of blocks at its own
+  hashed whole-cell offset into the tile. Neighbouring blocks share a ramp L wide where their
+  weights w₀, w₁ (w₀² + w₁² = 1) hand over smoothly, so the variance stays exact and the
+  field continuous. A block with its ramps spans half the tile's period, and points farther
+  apart than a block never share an offset: no two places of the ground see the same wind
+  (the tile still repeats every 3 L up). The coherence of points across the wind falls with
+  distance much as Davenport's exp(−a·f·Δ/U) does, a ≈ 5–8 (measured; REALISM.md: 7–10).
+* **Taylor's frozen turbulence.** The blocks and the tile are carried downwind at the mean
+  speed at the canopy top, so a gust reaches a point d metres downwind d/U seconds later and
+  gusts come faster in stronger wind.
+* **Evolution, no loop.** The across-wind blocks slide across the wind, one block for every
+  4 L the air travels (one way in even along-wind blocks, the other way in odd ones), so
+  each eddy fades out and another fades in over about 4 L / U seconds and nothing repeats:
+  a point's autocorrelation is ~0 beyond a few L / U.
 * **Canopy profile.** Mean speed ``speed``·ln((y − d)/z0)/ln((h − d)/z0) above the canopy
   height h (d = 0.7 h, z0 = 0.1 h) and ``speed``·exp(a(y/h − 1)) inside it (a ≈ 3.03, so
   the two meet smoothly). Standard deviations σ_u : σ_w(lateral) : σ_v(vertical) =
   1 : 0.75 : 0.5 with σ_u = ``turbulence``·``speed`` at and above h, decaying as
   exp(y/h − 1) inside the canopy (the intensity rises towards the ground).
-* **Gusts.** ``gust_rate`` gusts a minute, each a plane front across the wind with a sharp
-  rise (0.5 L) and a slower decay (1.5 L) of peak ``gust_strength``·U·A (A uniform in
+* **Gusts.** ``gust_rate`` gusts a minute, each a front across the wind with a sharp rise
+  (0.5 L) and a slower decay (1.5 L) of peak ``gust_strength``·U·A (A uniform in
   [0.5, 1.5]), carried at the wind speed; their mean is subtracted, so they are gusts and
-  lulls about the set mean.
+  lulls about the set mean. They come in lanes 3 L wide across the wind, each lane its own
+  gusts, blended with the next lane's over a ramp L wide (as the turbulence's blocks are):
+  a gust reaches about 4 L across, as far as it is long.
 * **Mean direction.** Every fluctuation across the wind has zero mean by construction
   (symmetric Gaussian noise, no rescaling), so the long-run mean wind points along
   ``direction``.
