@@ -16,8 +16,8 @@ shows how to add one.
   default the canopy height). The tile is independent of any tree's box, so every tree of a
   scene stands in one field. The 3-D spectrum is (k² + k0²)^−(β+2)/2 with k0 = 1/(1.339 L),
   so the spectrum along any line is the von Kármán form (k1² + k0²)^−β/2: f^−β in the
-  inertial range, flat below the energy-containing eddies (L_u = L, L_v = L_w = L/3, as in
-  canopy flows). Its Fourier amplitudes are
+  inertial range, flat below the energy-containing eddies (one integral scale L for all
+  three components; canopy flows' shorter cross-wind scales, about L/3, are not modelled). Its Fourier amplitudes are
   pre-compensated for trilinear interpolation (exactly along the wind, on average across
   it), so the spectrum at a fixed point keeps its slope up to about half the grid's Nyquist
   frequency U·12/(2L).

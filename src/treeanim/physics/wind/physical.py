@@ -289,7 +289,7 @@ class PhysicalParams(WindParams):
     turbulence: Annotated[float, Param(0.0, 1.0, help="Along-wind turbulence intensity σ_u/U at the canopy "
                                        "top.")] = 0.3
     length_scale: Annotated[float, _length("Along-wind integral length scale L of the "
-                                           "turbulence (L/3 vertically and laterally); None: the canopy "
+                                           "turbulence (of all three components); None: the canopy "
                                            "height, at least 1 m.")] | None = None
     canopy_height: Annotated[float, _length("Canopy height h: the height of speed and of "
                                             "the canopy profile; None: the top of the bounds.")] | None = None

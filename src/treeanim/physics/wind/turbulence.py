@@ -37,7 +37,8 @@ _TILE = (256, 48, 64)
 _CELLS_PER_L = 16.0
 #: von Kármán: k0 = 1 / (1.339 L) puts the integral scale of (k² + k0²)^−5/6 at L.
 _VON_KARMAN = 1.339
-#: Integral scales of the vertical and lateral components, in L (canopy flows: L_w ≈ h/3).
+#: Integral scales of the vertical and lateral components, in L: the same as the along-wind
+#: component's (canopy flows have L_w ≈ h/3; not modelled).
 _CROSS_SCALE = 1.0
 #: Block lengths along and across the wind and the ramp two neighbours share (cells; the
 #: ramp is L): a block with its ramps reaches half the tile's period on its axis, 8 L along
