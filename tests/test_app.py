@@ -965,3 +965,10 @@ def test_run_loop_stops_on_close(viewer):
     assert run(v, max_frames=2) == 2 and v.window.swaps == 2
     v.on_key(glfw.KEY_Q, 0, glfw.PRESS, 0)  # Q: the loop ends after this frame
     assert v.window.should_close and run(v) == 0
+
+
+def test_the_loop_ends_on_a_minimised_headless_window(viewer):
+    """Nothing can restore a minimised headless window: the loop ends (it spun forever)."""
+    v = viewer
+    v.window.resize(0, 0)
+    assert run(v, max_frames=5) == 0 and v.window.should_close

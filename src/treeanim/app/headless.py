@@ -194,7 +194,11 @@ class HeadlessWindow:
                 getattr(self._viewer, name)(*args)
 
     def wait(self, timeout: float) -> None:
-        """As :meth:`poll`: nothing else can happen to a headless window, so it never waits."""
+        """As :meth:`poll`: nothing else can happen to a headless window, so it never waits. A
+        minimised one with nothing queued can never come back (only code resizes it): waiting
+        on it asks to close, so the main loop ends instead of spinning."""
+        if not self._events and 0 in self.framebuffer_size:
+            self.request_close()
         self.poll()
 
     def swap(self) -> None:
