@@ -34,7 +34,7 @@ WINDOW_MODULES = {"test_app_window", "test_render_window"}
 DURATIONS = Path(__file__).with_name("durations.json")
 #: A test measured at this many CPU seconds or more is marked ``slow``: ``-m "not slow"`` is the
 #: quick loop (0.4 s keeps it under 30 s of CPU; at 1 s it took a minute).
-SLOW_SECONDS = 0.4
+SLOW_SECONDS = 0.25
 
 
 def pytest_addoption(parser):
