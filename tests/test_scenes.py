@@ -280,6 +280,19 @@ BAD = [
      'position = [9.0, 0.0, 0.0]\n', "trees[1].tree", "a scene's leaves share one outline"),
     ('[[trees]]\ntree = "other.toml"\nposition = [0.0, 0.0, 0.0]\n', "trees[0].tree", "is a scene; a scene places"),
     ('[[trees]]\ntree = "missing.toml"\nposition = [0.0, 0.0, 0.0]\n', "trees[0].tree", "cannot read preset file"),
+    # an integer of hundreds of digits is no float (isfinite raised OverflowError)
+    ('seed = ' + "9" * 400 + '\n[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\n', "seed",
+     "expected an integer in [0, "),
+    ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nscale = ' + "1" * 400 + '\n', "trees[0].scale",
+     "got 1111"),
+    # a subnormal spacing made infinitely many grid or hash cells (OverflowError)
+    ('[[scatter]]\ntree = "beam"\ncount = 2\narea = [1.0, 1.0]\npattern = "grid"\nspacing = 1e-310\n',
+     "scatter[0].spacing", "in [0.05, 1000]"),
+    ('[[scatter]]\ntree = "beam"\ncount = 2\narea = [1.0, 1.0]\nspacing = 1e-310\n', "scatter[0].spacing",
+     "in [0.05, 1000]"),
+    # a grid's jitter past 10 km (place_tree's ValueError was a traceback)
+    ('[[scatter]]\ntree = "beam"\ncount = 3\narea = [10.0, 10.0]\ncentre = [9995.0, 0.0]\npattern = "grid"\n'
+     'spacing = 5.0\njitter = 100.0\n', "scatter[0].area", "with its jitter of 100 m"),
 ]
 
 
@@ -305,3 +318,18 @@ def test_not_a_scene_is_one_line_too(tmp_path):
         ta.load_scene("forest")
     with pytest.raises(ta.PresetError, match=r"got 'scene' \(a scene file: treeanim.load_scene reads it\)"):
         read_spec(write(tmp_path, '[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\n'))
+
+
+def test_what_placing_refuses_is_one_line_naming_the_table(tmp_path, monkeypatch):
+    """A guard: the checks leave place_tree nothing to refuse, but should it refuse, the scene's
+    reader says so in one line with the tree's table."""
+    from treeanim.model import scene_file
+
+    def refuse(tree, position, heading, scale):
+        raise ValueError("position must lie within 10000 m of the origin")
+
+    monkeypatch.setattr(scene_file, "place_tree", refuse)
+    path = write(tmp_path, '[[scatter]]\ntree = "beam"\ncount = 2\narea = [4.0, 4.0]\n')
+    with pytest.raises(SceneError) as e:
+        ta.load_scene(path)
+    assert str(e.value) == f"{path}: key 'scatter[0]': scatter[0] tree 0: position must lie within 10000 m of the origin"

@@ -42,6 +42,10 @@ SCENE_BUDGET = {"objects": 500_000, "nodes": 2_000_000, "triangles": 15_000_000}
 MAX_AREA = 2 * MAX_COORDINATE
 #: Candidate positions tried per tree before a random scatter gives up.
 TRIES_PER_TREE = 60
+#: The least spacing a scatter may ask for (m; 0, the default, is none for a random scatter):
+#: closer than the thinnest shipped trunk's width. With it a grid over the widest area has at
+#: most :data:`MAX_AREA` / MIN_SPACING + 1 = 400,001 columns and rows.
+MIN_SPACING = 0.05
 _TOP = ("name", "description", "type", "seed", "trees", "scatter")
 _TREE_KEYS = ("tree", "position", "heading", "scale", "seed", "leaves")
 _SCATTER_KEYS = ("tree", "count", "area", "centre", "spacing", "pattern", "jitter", "heading", "scale", "seed",
@@ -129,7 +133,9 @@ class _Bad(Exception):
 def _num(value, key: str, lo: float, hi: float, integer: bool = False) -> float:
     kind = "an integer" if integer else "a number"
     ok = isinstance(value, int) if integer else isinstance(value, (int, float))
-    if isinstance(value, bool) or not ok or not math.isfinite(value) or not lo <= value <= hi:
+    # (an int is compared exactly, never made a float first: 10**400 is no float at all)
+    if isinstance(value, bool) or not ok or not (isinstance(value, int) or math.isfinite(value)) \
+            or not lo <= value <= hi:
         raise _Bad(key, f"expected {kind} in [{lo:g}, {hi:g}], got {describe(value)}")
     return int(value) if integer else float(value) + 0.0
 
@@ -269,17 +275,21 @@ def _scatter(t: dict, key: str, count: int, rng: np.random.Generator, placed) ->
     area = _nums(t["area"], f"{key}.area", 2, 1e-3, MAX_AREA, "an area [width, depth] in metres")
     centre = _nums(t.get("centre", [0.0, 0.0]), f"{key}.centre", 2, -MAX_COORDINATE, MAX_COORDINATE,
                    "a centre [x, z] in metres")
-    if max(abs(c) + 0.5 * a for c, a in zip(centre, area)) > MAX_COORDINATE:
-        raise _Bad(f"{key}.area", f"reaches more than {MAX_COORDINATE:g} m from the origin")
     spacing = _num(t.get("spacing", 0.0), f"{key}.spacing", 0.0, 1000.0)
+    if 0.0 < spacing < MIN_SPACING:
+        raise _Bad(f"{key}.spacing", f"expected 0 (none) or a number in [{MIN_SPACING:g}, 1000] (m), got "
+                                     f"{describe(spacing)}")
     pattern = _string(t.get("pattern", "random"), f"{key}.pattern")
     jitter = _num(t.get("jitter", 0.0), f"{key}.jitter", 0.0, 100.0)
+    if max(abs(c) + 0.5 * a for c, a in zip(centre, area)) + (jitter if pattern == "grid" else 0.0) > MAX_COORDINATE:
+        raise _Bad(f"{key}.area", f"reaches more than {MAX_COORDINATE:g} m from the origin"
+                                  + (f" with its jitter of {jitter:g} m" if jitter and pattern == "grid" else ""))
     heading = _pair(t.get("heading", [0.0, 360.0]), f"{key}.heading", -3600.0, 3600.0, " in degrees")
     scale = _pair(t.get("scale", 1.0), f"{key}.scale", MIN_SCALE, MAX_SCALE, "")
     lo, size = np.array(centre) - 0.5 * np.array(area), np.array(area)
     if pattern == "grid":
         if spacing <= 0:
-            raise _Bad(f"{key}.spacing", "expected the grid's spacing, a number > 0 (m)")
+            raise _Bad(f"{key}.spacing", f"expected the grid's spacing, a number in [{MIN_SPACING:g}, 1000] (m)")
         cols, rows = (int(a // spacing) + 1 for a in area)
         if count > cols * rows:
             raise _Bad(f"{key}.count", f"{count:,} trees do not fit a grid of {cols} × {rows} at spacing "
@@ -387,6 +397,11 @@ def _check_leaves(trees: list[Tree], labels: list[str]) -> None:
                        "outline (the renderer draws one leaf shape)")
 
 
+def _table(label: str) -> str:
+    """The table a tree's label names ('scatter[2] tree 17' -> 'scatter[2]')."""
+    return label.split(" ")[0]
+
+
 def _check_trunks(scene: Scene, labels: list[str]) -> None:
     """No two trunks stand inside each other (their bases closer than the sum of their radii)."""
     from scipy.spatial import cKDTree
@@ -435,7 +450,10 @@ def read_scene(path: str | Path, data: dict | None = None) -> Scene:
                 tree = _grow(kind, bases[k], own)
             except PresetError as e:
                 raise _Bad(label.split(" ")[0] + ".tree", str(e)) from None
-            trees.append(place_tree(tree, pos, heading, scale))
+            try:  # (the checks above leave it nothing to refuse: a guard, in one line)
+                trees.append(place_tree(tree, pos, heading, scale))
+            except ValueError as e:
+                raise _Bad(_table(label), f"{label}: {e}") from None
             placements.append(Placement(kind.tree, pos, heading, scale, int(tree.seed)))
         _check_leaves(trees, plan.labels)
         try:
