@@ -250,6 +250,9 @@ BAD = [
     ('[[trees]]\ntree = "oak"\nposition = [0.0, 0.0, 0.0]\n', "trees[0].tree", "unknown preset 'oak'"),
     ('[[trees]]\ntree = "beam"\nposition = [nan, 0.0, 0.0]\n', "trees[0].position", "got [nan, 0.0, 0.0]"),
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0]\n', "trees[0].position", "a position [x, y, z]"),
+    # the ground is flat at y = 0 (and the contact floor absolute): a tree stands on it
+    ('[[trees]]\ntree = "beam"\nposition = [0.0, 2.5, 0.0]\n', "trees[0].position", "expected y = 0"),
+    ('[[trees]]\ntree = "beam"\nposition = [0.0, -0.1, 0.0]\n', "trees[0].position", "got [0.0, -0.1, 0.0]"),
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nscale = -1.0\n', "trees[0].scale", "got -1.0"),
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nheading = inf\n', "trees[0].heading", "got inf"),
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nsize = 2\n', "trees[0].size", "unknown key"),

@@ -153,7 +153,9 @@ def place_tree(tree: Tree, position=(0.0, 0.0, 0.0), heading: float = 0.0, scale
     ----------
     tree : Tree
     position : (3,) float
-        World metres, each within :data:`MAX_COORDINATE`.
+        World metres, each within :data:`MAX_COORDINATE`. The ground stays at y = 0 (the drawn
+        ground and the branches' contact floor, ``physics.structure``, are absolute): a y other
+        than 0 lifts the tree off it or sinks it in (scene files refuse one).
     heading : float
         Degrees about +y.
     scale : float

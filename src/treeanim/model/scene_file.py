@@ -248,6 +248,9 @@ def _plan(data: dict, path: Path) -> _Plan:
         k = kind_index(_kind(t, key, folder), key)
         pos = _nums(t["position"], f"{key}.position", 3, -MAX_COORDINATE, MAX_COORDINATE,
                     "a position [x, y, z] in metres")
+        if pos[1] != 0.0:  # the drawn ground and the branches' contact floor are flat at y = 0
+            raise _Bad(f"{key}.position", f"expected y = 0 (trees stand on the ground, which is flat at y = 0), "
+                                          f"got {describe(t['position'])}")
         heading = _num(t.get("heading", 0.0), f"{key}.heading", -3600.0, 3600.0)
         scale = _num(t.get("scale", 1.0), f"{key}.scale", MIN_SCALE, MAX_SCALE)
         own = _num(t["seed"], f"{key}.seed", 0, 2**63 - 1, integer=True) if "seed" in t else None
