@@ -14,9 +14,11 @@ import treeanim as ta
 from conftest import Uniform, grass_patch, small_tree
 from treeanim import cli
 from treeanim.errors import SceneError
+from treeanim.model.load import load_named
 from treeanim.model.presets import read_spec
+from treeanim.model.qsm.leaves import LEAVES_FOR_QSM_ONLY
 from treeanim.model.scene import heading_matrix, make_scene, merge_trees, place_tree
-from treeanim.model.scene_file import MAX_TREES, load_named, scene_summary
+from treeanim.model.scene_file import MAX_TREES, scene_summary
 
 ROOT = Path(__file__).resolve().parents[1]
 QSM = ROOT / "assets" / "qsm" / "synthetic_broadleaf.txt"
@@ -245,6 +247,42 @@ def test_info_prints_a_scenes_trees(tmp_path, capsys):
     assert "scene of 48 trees (48 small_cherry)" in lines[-2] and "1,000 trees" in lines[-1]
 
 
+def test_one_loader_reads_every_tree_file_and_refuses_leaves_in_one_message(tmp_path, capsys):
+    """ta.load_tree, the command line and the viewer's Open read through one function, which
+    refuses leaves for a preset or a scene in the words a scene file's ``leaves`` key is
+    refused in (they were four messages in four places)."""
+    from treeanim.app.actions import ViewerActions
+    from treeanim.model import load, qsm
+
+    assert ta.load_tree is load.load_tree and not hasattr(qsm, "load_tree")
+    beam = ROOT / "assets" / "presets" / "beam.toml"
+    scene = write(tmp_path, '[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\n')
+    said = []
+    for call in (lambda: ta.load_tree(beam, leaves="cherry"), lambda: ta.load_tree(scene, leaves="cherry"),
+                 lambda: load_named("beam", leaves="cherry"), lambda: load_named("orchard", leaves="cherry")):
+        with pytest.raises(ta.PresetError) as e:
+            call()
+        said.append(str(e.value))
+    bad = write(tmp_path, '[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nleaves = "cherry"\n', "bad.toml")
+    with pytest.raises(SceneError) as e:
+        ta.load_scene(bad)
+    said.append(str(e.value))
+    assert cli.main(["info", "beam", "--leaves", "cherry"]) == 2
+    said.append(capsys.readouterr().err.strip())
+    assert all(m.endswith(LEAVES_FOR_QSM_ONLY) and "\n" not in m for m in said), said
+    assert said[0].startswith(f"{beam}: ") and said[2] == f"beam: {LEAVES_FOR_QSM_ONLY}"
+    assert load_named("beam", leaves="none").n_objects == 1  # 'none' is no leaves: nothing to refuse
+
+    class Panel:  # the viewer's Open, without a window: what it loads and says
+        preset_path, messages, loaded = None, [], []
+        say, load_tree = messages.append, loaded.append
+
+    panel = Panel()
+    assert ViewerActions.open_file(panel, scene) and isinstance(panel.loaded[-1], ta.Scene)
+    assert ViewerActions.open_file(panel, str(QSM)) and panel.loaded[-1].name == "synthetic_broadleaf"
+    assert not ViewerActions.open_file(panel, bad) and LEAVES_FOR_QSM_ONLY in panel.messages[-1]
+
+
 # ---------------------------------------------------------------------------- bad scene files
 BAD = [
     ('[[trees]]\ntree = "oak"\nposition = [0.0, 0.0, 0.0]\n', "trees[0].tree", "unknown preset 'oak'"),
@@ -258,7 +296,7 @@ BAD = [
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nsize = 2\n', "trees[0].size", "unknown key"),
     ('[[trees]]\ntree = "beam"\n', "trees[0].position", "missing"),
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nleaves = "cherry"\n', "trees[0].leaves",
-     "only for a TreeQSM model"),
+     LEAVES_FOR_QSM_ONLY),
     ('', "trees", "at least one tree"),
     ('trees = 3\n', "trees", "array of tables"),
     ('colour = 1\n', "colour", "unknown key"),

@@ -24,14 +24,14 @@ import numpy as np
 
 from ..errors import PresetError, SceneError
 from .declare import describe
-from .presets import estimate_size, list_presets, load_preset, read_spec, read_toml, read_tree, tree_of
+from .presets import estimate_size, list_presets, read_spec, read_toml, tree_of
 from .qsm.convert import load_qsm
+from .qsm.leaves import LEAVES_FOR_QSM_ONLY
 from .qsm.read import QSM_SUFFIXES
 from .scene import MAX_COORDINATE, MAX_SCALE, MIN_SCALE, Placement, Scene, merge_trees, place_tree, same_lamina
 from .tree import Tree
 
-__all__ = ["list_scenes", "load_scene", "read_scene", "load_tree", "load_named", "scene_summary", "MAX_TREES",
-           "SCENE_BUDGET"]
+__all__ = ["list_scenes", "load_scene", "read_scene", "scene_summary", "MAX_TREES", "SCENE_BUDGET", "MIN_SPACING"]
 
 #: Most trees one scene may place.
 MAX_TREES = 5000
@@ -78,49 +78,6 @@ def load_scene(name_or_path: str | Path) -> Scene:
     if not text.lower().endswith(".toml"):
         raise SceneError(f"unknown scene {text!r}; known scenes: {', '.join(list_scenes())} (or a scene .toml file)")
     return read_scene(text)
-
-
-def load_tree(path: str | Path, leaves: str | None = None) -> Tree:
-    """Read any tree file: a scene or a preset ``.toml`` (by its ``type``), or a TreeQSM model
-    (:func:`treeanim.model.qsm.load_tree`). ``treeanim.load_tree``, the command line and the
-    viewer's Open read files through this one function.
-
-    Raises
-    ------
-    PresetError
-        One line naming the file, the key or row and what was expected.
-    """
-    if not str(path).lower().endswith(".toml"):
-        from .qsm.convert import load_tree as load_qsm_or_preset
-
-        return load_qsm_or_preset(path, leaves=leaves)
-    from .qsm.leaves import LEAVES_FOR_QSM_ONLY
-
-    if leaves not in (None, "none"):
-        raise PresetError(f"{path}: {LEAVES_FOR_QSM_ONLY}")
-    data = read_toml(path)
-    if data.get("type") == "scene":
-        return read_scene(path, data)
-    return read_tree(path, data)
-
-
-def load_named(name_or_path: str, leaves: str | None = None) -> Tree:
-    """A preset or a scene by name, or any tree file by path (:func:`load_tree`).
-
-    Raises
-    ------
-    PresetError
-        An unknown name (listing the presets and scenes) or an unusable file.
-    """
-    text = str(name_or_path)
-    if text.lower().endswith(_FILE_SUFFIXES):
-        return load_tree(text, leaves=leaves)
-    if text in list_scenes() and text not in list_presets():
-        return load_scene(text)
-    if text not in list_presets():
-        raise PresetError(f"unknown preset or scene {text!r}; presets: {', '.join(list_presets())}; scenes: "
-                          f"{', '.join(list_scenes())}")
-    return load_preset(text)
 
 
 # ---------------------------------------------------------------------------- checking
@@ -200,13 +157,13 @@ def _kind(table: dict, key: str, folder: Path) -> _Kind:
     if name.lower().endswith(_FILE_SUFFIXES):
         path = Path(name) if Path(name).is_absolute() else folder / name
         if leaves is not None and not name.lower().endswith(QSM_SUFFIXES):
-            raise _Bad(f"{key}.leaves", "only for a TreeQSM model (.txt, .csv, .mat); a preset has its own leaves")
+            raise _Bad(f"{key}.leaves", LEAVES_FOR_QSM_ONLY)
         return _Kind(name, path, leaves)
     if name not in list_presets():
         raise _Bad(f"{key}.tree", f"unknown preset {name!r}; expected one of {', '.join(list_presets())} or a "
                                   f"file ({', '.join(_FILE_SUFFIXES)})")
     if leaves is not None:
-        raise _Bad(f"{key}.leaves", "only for a TreeQSM model (.txt, .csv, .mat); a preset has its own leaves")
+        raise _Bad(f"{key}.leaves", LEAVES_FOR_QSM_ONLY)
     return _Kind(name, None, None)
 
 
