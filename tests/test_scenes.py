@@ -17,7 +17,7 @@ from treeanim.errors import SceneError
 from treeanim.model.load import load_named
 from treeanim.model.presets import read_spec
 from treeanim.model.qsm.leaves import LEAVES_FOR_QSM_ONLY
-from treeanim.model.scene import heading_matrix, make_scene, merge_trees, place_tree
+from treeanim.model.scene import MergeError, heading_matrix, make_scene, merge_trees, place_tree
 from treeanim.model.scene_file import MAX_TREES, scene_summary
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -161,6 +161,23 @@ def test_merging_refuses_what_it_cannot_hold(cherry):
             place_tree(cherry, **kw)
     with pytest.raises(ValueError, match="positions, headings and scales"):
         make_scene([cherry, cherry], [(0, 0, 0)])
+
+
+def test_leaves_of_another_outline_are_refused_once_naming_the_trees_table(tmp_path, cherry):
+    """merge_trees alone checks the shared leaf outline; it says which tree, and a scene file's
+    reader names that tree's table."""
+    sapling = ROOT / "assets" / "presets" / "scenes" / "plants" / "sapling.toml"
+    light = ta.load_tree(sapling)
+    with pytest.raises(MergeError) as e:
+        merge_trees([grass_patch(), cherry, light])
+    assert e.value.index == 2 and str(e.value).startswith("tree 2 (") and "another shape" in str(e.value)
+    assert "than tree 1 (small_cherry: " in str(e.value)
+    path = write(tmp_path, f'[[trees]]\ntree = "small_cherry"\nposition = [0.0, 0.0, 0.0]\n[[scatter]]\n'
+                           f'tree = "{sapling}"\ncount = 2\narea = [10.0, 10.0]\ncentre = [0.0, 20.0]\n')
+    with pytest.raises(SceneError) as e:
+        ta.load_scene(path)
+    assert str(e.value).startswith(f"{path}: key 'scatter[0].tree': scatter[0] tree 0 ({sapling}) has leaves of "
+                                   f"another shape ('{light.lamina.shape}') than trees[0] (small_cherry: ")
 
 
 # ---------------------------------------------------------------------------- scene files

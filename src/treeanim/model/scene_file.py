@@ -28,7 +28,7 @@ from .presets import estimate_size, list_presets, read_spec, read_toml, tree_of
 from .qsm.convert import load_qsm
 from .qsm.leaves import LEAVES_FOR_QSM_ONLY
 from .qsm.read import QSM_SUFFIXES
-from .scene import MAX_COORDINATE, MAX_SCALE, MIN_SCALE, Placement, Scene, merge_trees, place_tree, same_lamina
+from .scene import MAX_COORDINATE, MAX_SCALE, MIN_SCALE, MergeError, Placement, Scene, merge_trees, place_tree
 from .tree import Tree
 
 __all__ = ["list_scenes", "load_scene", "read_scene", "scene_summary", "MAX_TREES", "SCENE_BUDGET", "MIN_SPACING"]
@@ -343,20 +343,6 @@ def _grow(kind: _Kind, base, seed: int | None) -> Tree:
     return tree_of(base if seed is None else dataclasses.replace(base, seed=seed), kind.path or kind.tree)
 
 
-def _check_leaves(trees: list[Tree], labels: list[str]) -> None:
-    """Every leafy tree has the first leafy tree's lamina (the renderer draws one leaf shape)."""
-    first = None
-    for k, t in enumerate(trees):
-        if t.lamina is None or not np.any(t.kind == "leaf"):
-            continue
-        if first is None:
-            first = k
-        elif t.lamina is not trees[first].lamina and not same_lamina(t.lamina, trees[first].lamina):
-            raise _Bad(f"{labels[k].split(' ')[0]}.tree", f"its leaves ({t.lamina.shape!r}) are not those of "
-                       f"{labels[first].split(' ')[0]} ({trees[first].lamina.shape!r}); a scene's leaves share one "
-                       "outline (the renderer draws one leaf shape)")
-
-
 def _table(label: str) -> str:
     """The table a tree's label names ('scatter[2] tree 17' -> 'scatter[2]')."""
     return label.split(" ")[0]
@@ -409,17 +395,19 @@ def read_scene(path: str | Path, data: dict | None = None) -> Scene:
             try:
                 tree = _grow(kind, bases[k], own)
             except PresetError as e:
-                raise _Bad(label.split(" ")[0] + ".tree", str(e)) from None
+                raise _Bad(_table(label) + ".tree", str(e)) from None
             try:  # (the checks above leave it nothing to refuse: a guard, in one line)
                 trees.append(place_tree(tree, pos, heading, scale))
             except ValueError as e:
                 raise _Bad(_table(label), f"{label}: {e}") from None
             placements.append(Placement(kind.tree, pos, heading, scale, int(tree.seed)))
-        _check_leaves(trees, plan.labels)
-        try:
+        try:  # (it refuses leaves of another outline than the first leafy tree's)
             scene = merge_trees(trees, placements, name=data["name"], seed=int(data.get("seed", 0)),
-                                source=str(path), description=" ".join(str(data.get("description", "")).split()))
-        except ValueError as e:
+                                source=str(path), description=" ".join(str(data.get("description", "")).split()),
+                                labels=plan.labels)
+        except MergeError as e:
+            raise _Bad(f"{_table(plan.labels[e.index])}.tree", str(e)) from None
+        except ValueError as e:  # (a guard: nothing else in it is left to refuse a checked plan)
             raise _Bad("trees", str(e)) from None
         _check_trunks(scene, plan.labels)
     except _Bad as e:
