@@ -80,6 +80,22 @@ def test_tree_nodes_and_objects_are_each_trees_own(cherry):
             scene.tree_nodes(bad)
 
 
+def test_tree_nodes_are_the_nodes_of_the_trees_objects_and_one_kind_order_sorts_both(cherry):
+    """tree_nodes (which leaf_clusters uses for each tree's crown) from the tree's objects is the
+    node_tree definition; a scene sorts kinds by the order assemble sorts one tree by."""
+    from treeanim.model import build
+    from treeanim.model import scene as scene_module
+
+    trees = [cherry, grass_patch(), small_tree(leaves_per_twig=0), cherry]
+    scene = make_scene(trees, [(0, 0, 0), (6, 0, 0), (-5, 0, 4), (0, 0, 9)], [0, 45, 200, 10])
+    for k in range(scene.n_trees):
+        nodes = scene.tree_nodes(k)
+        assert nodes.dtype == np.int64 and np.array_equal(nodes, np.flatnonzero(scene.node_tree == k))
+    assert scene_module.KIND_ORDER is build.KIND_ORDER
+    key = scene.level * 3 + np.array([build.KIND_ORDER[kind] for kind in scene.kind])
+    assert np.all(np.diff(key) >= 0)
+
+
 def test_trees_of_their_own_seeds_differ_and_of_one_seed_are_alike():
     spec = read_spec(ROOT / "assets" / "presets" / "small_cherry.toml")
     from treeanim.model.generate import generate

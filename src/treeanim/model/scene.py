@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..validate import finite_float, finite_vector3
+from .build import KIND_ORDER
 from .params import PhysicsParams, SeasonModes
 from .tree import KINDS, Tree
 
@@ -31,8 +32,6 @@ __all__ = ["Placement", "Scene", "MergeError", "place_tree", "merge_trees", "mak
 MIN_SCALE, MAX_SCALE = 0.05, 20.0
 #: How far from the origin a tree may stand (m): a landscape of 20 km.
 MAX_COORDINATE = 10_000.0
-#: Objects sort by level, then kind (as :func:`treeanim.model.build.assemble` sorts them).
-_KIND_ORDER = {"branch": 0, "blade": 1, "leaf": 2}
 
 
 class MergeError(ValueError):
@@ -130,7 +129,10 @@ class Scene(Tree):
         ValueError
             If ``k`` is not an integer in ``range(n_trees)``.
         """
-        return np.flatnonzero(self.node_tree == self._tree_index(k))
+        objs = self.tree_objects(k)  # each object's nodes are contiguous, in object order
+        count = np.asarray(self.object_count)[objs]
+        first = np.asarray(self.object_start)[objs] - (np.cumsum(count) - count)
+        return (np.repeat(first, count) + np.arange(int(count.sum()))).astype(np.int64)
 
     def validate(self) -> None:
         """:meth:`Tree.validate`, and every object in a tree whose parent is in the same tree."""
@@ -297,7 +299,7 @@ def merge_trees(trees: list[Tree], placements=None, name: str = "scene", seed: i
     global_rank[np.flatnonzero(leaf)[np.lexsort((owner[leaf], share))]] = np.arange(int(leaf.sum()))
 
     # sort objects by (level, kind) over the scene, stably (tree order within a key)
-    key = level * 3 + np.vectorize(_KIND_ORDER.get, otypes=[np.int64])(kind) if len(kind) else level
+    key = level * 3 + np.vectorize(KIND_ORDER.get, otypes=[np.int64])(kind) if len(kind) else level
     order = np.argsort(key, kind="stable")
     M, N = len(order), int(node_off[-1])
     inv = np.empty(M, np.int64)
