@@ -250,6 +250,7 @@ spacing = 5.0
     assert isinstance(scene, ta.Scene) and scene.n_trees == 3 + 30 + 6 and scene.name == "test"
     cherry = ta.load_preset("small_cherry")
     assert scene.placements[0].seed == cherry.seed and scene.placements[1].seed == 12
+    assert len({p.seed for p in scene.placements[3:]}) == 36  # a scatter's trees: each its own seed
     assert np.allclose(scene.rest_positions[scene.tree_nodes(0)], place_tree(cherry, (1, 0, 2), 90, 0.5).rest_positions)
     qsm = ta.load_qsm(QSM, leaves="cherry", seed=3)
     assert np.allclose(scene.rest_positions[scene.tree_nodes(2)], qsm.rest_positions + (20, 0, 0))
@@ -388,6 +389,8 @@ def test_not_a_scene_is_one_line_too(tmp_path):
     path.write_text('name = "x"\ntype = "scene"\n[[trees]\n')
     with pytest.raises(SceneError, match=r"not valid TOML"):
         ta.load_scene(path)
+    with pytest.raises(SceneError, match=r"not valid TOML"):  # as its docstring says (it was a PresetError)
+        scene_summary(path)
     with pytest.raises(SceneError, match="unknown scene 'forest'; known scenes: orchard, woodland"):
         ta.load_scene("forest")
     with pytest.raises(ta.PresetError, match=r"got 'scene' \(a scene file: treeanim.load_scene reads it\)"):

@@ -4,10 +4,12 @@ A scene file has ``type = "scene"``, a ``name``, an optional ``description`` and
 any number of ``[[trees]]`` (one tree each, at a position) and ``[[scatter]]`` tables (``count``
 trees of one kind over a rectangle, at random with a least spacing or on a grid). A tree is a
 preset's name or a file: a preset ``.toml`` or a TreeQSM model (``.txt``, ``.csv``, ``.mat``),
-relative to the scene file. Each tree is generated with its own seed: a placed tree with its
-preset's unless it gives one, a scattered tree with one drawn from the scene's seed, so no two
-are alike (a TreeQSM model's seed grows its leaves; its wood is the scan's). Every problem is
-one :class:`~treeanim.errors.SceneError` line naming the file, the key and what was expected.
+relative to the scene file. A placed tree is its preset's own tree (the preset's seed) unless
+it gives a ``seed``, so two ``[[trees]]`` of one preset without seeds are alike; a scattered
+tree is grown with a seed drawn, without repeats, from the scene's and the scatter's seeds, so
+no two of a scatter are alike (a TreeQSM model's seed grows its leaves; its wood is the
+scan's). Every problem is one :class:`~treeanim.errors.SceneError` line naming the file, the
+key and what was expected.
 
 Shipped scenes live in ``assets/presets/scenes/`` (package data ``treeanim.presets``).
 """
@@ -423,14 +425,17 @@ def scene_summary(path: str | Path) -> tuple[int, dict[str, int], str]:
     Raises
     ------
     SceneError
-        As :func:`read_scene` for what the file says (its trees are not read).
+        As :func:`read_scene`: a file that cannot be read or is not TOML, or what the file
+        says (its trees are not read).
     """
     path = Path(path)
-    data = read_toml(path)
     try:
+        data = read_toml(path)
         plan = _plan(data, path)
     except _Bad as e:
         raise SceneError(f"{path}: key '{e.key}': {e.expected}") from None
+    except PresetError as e:  # read_toml's, which names the file
+        raise SceneError(str(e)) from None
     per: dict[str, int] = {}
     for k, *_ in plan.where:
         per[plan.kinds[k].tree] = per.get(plan.kinds[k].tree, 0) + 1
