@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +18,7 @@ from treeanim.model.build import ObjectSpec, assemble
 from treeanim.model.geometry import arc_length, object_lengths
 from treeanim.model.params import WOOD_TYPES, PhysicsParams
 from treeanim.model.qsm import LEAF_SPACING, SPECIES, build_tree, load_qsm, synthetic_table, write_table
+from treeanim.model.qsm.leaves import LEAVES_FOR_QSM_ONLY
 from treeanim.physics.trace import trace_tips
 
 ASSET = Path(__file__).resolve().parents[1] / "assets" / "qsm" / "synthetic_broadleaf.txt"
@@ -212,7 +214,7 @@ def test_the_command_line_reads_a_qsm_and_reports_a_bad_one_in_one_line(tmp_path
     err = capsys.readouterr().err.strip()
     assert err.count("\n") == 0 and "row 3" in err and "radius is -1;" in err
     assert main(["info", "small_cherry", "--leaves", "cherry"]) == 2  # a preset has its own leaves
-    assert "--leaves is for TreeQSM models" in capsys.readouterr().err
+    assert LEAVES_FOR_QSM_ONLY in capsys.readouterr().err
     assert main(["info", str(ASSET), "--leaves", "cherry:many"]) == 2
     assert "expected leaves per metre of twig in (0, 1000]" in capsys.readouterr().err
     assert main(["info", "large_cherry", "--modes", "physical"]) == 0
@@ -444,7 +446,7 @@ def test_load_tree_reads_a_treeqsm_model_by_its_suffix_as_the_command_line_does(
     """Issue 31: ta.load_tree("scan.txt") said "not valid TOML" where the CLI read a TreeQSM model."""
     assert ta.load_tree(ASSET).n_objects == load_qsm(ASSET).n_objects
     assert ta.load_tree(ASSET, leaves="cherry").n_objects == load_qsm(ASSET, leaves="cherry").n_objects
-    with pytest.raises(PresetError, match="--leaves is for TreeQSM models"):
+    with pytest.raises(PresetError, match=re.escape(LEAVES_FOR_QSM_ONLY)):
         ta.load_tree(ASSET.parents[1] / "presets" / "beam.toml", leaves="cherry")
 
 

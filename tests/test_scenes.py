@@ -14,9 +14,11 @@ import treeanim as ta
 from conftest import Uniform, grass_patch, small_tree
 from treeanim import cli
 from treeanim.errors import SceneError
+from treeanim.model.load import load_named
 from treeanim.model.presets import read_spec
-from treeanim.model.scene import heading_matrix, make_scene, merge_trees, place_tree
-from treeanim.model.scene_file import MAX_TREES, load_named, scene_summary
+from treeanim.model.qsm.leaves import LEAVES_FOR_QSM_ONLY
+from treeanim.model.scene import MergeError, heading_matrix, make_scene, merge_trees, place_tree
+from treeanim.model.scene_file import MAX_TREES, scene_summary
 
 ROOT = Path(__file__).resolve().parents[1]
 QSM = ROOT / "assets" / "qsm" / "synthetic_broadleaf.txt"
@@ -76,6 +78,22 @@ def test_tree_nodes_and_objects_are_each_trees_own(cherry):
     for bad in (3, -1, 1.0, True):
         with pytest.raises(ValueError, match="tree index"):
             scene.tree_nodes(bad)
+
+
+def test_tree_nodes_are_the_nodes_of_the_trees_objects_and_one_kind_order_sorts_both(cherry):
+    """tree_nodes (which leaf_clusters uses for each tree's crown) from the tree's objects is the
+    node_tree definition; a scene sorts kinds by the order assemble sorts one tree by."""
+    from treeanim.model import build
+    from treeanim.model import scene as scene_module
+
+    trees = [cherry, grass_patch(), small_tree(leaves_per_twig=0), cherry]
+    scene = make_scene(trees, [(0, 0, 0), (6, 0, 0), (-5, 0, 4), (0, 0, 9)], [0, 45, 200, 10])
+    for k in range(scene.n_trees):
+        nodes = scene.tree_nodes(k)
+        assert nodes.dtype == np.int64 and np.array_equal(nodes, np.flatnonzero(scene.node_tree == k))
+    assert scene_module.KIND_ORDER is build.KIND_ORDER
+    key = scene.level * 3 + np.array([build.KIND_ORDER[kind] for kind in scene.kind])
+    assert np.all(np.diff(key) >= 0)
 
 
 def test_trees_of_their_own_seeds_differ_and_of_one_seed_are_alike():
@@ -161,6 +179,23 @@ def test_merging_refuses_what_it_cannot_hold(cherry):
         make_scene([cherry, cherry], [(0, 0, 0)])
 
 
+def test_leaves_of_another_outline_are_refused_once_naming_the_trees_table(tmp_path, cherry):
+    """merge_trees alone checks the shared leaf outline; it says which tree, and a scene file's
+    reader names that tree's table."""
+    sapling = ROOT / "assets" / "presets" / "scenes" / "plants" / "sapling.toml"
+    light = ta.load_tree(sapling)
+    with pytest.raises(MergeError) as e:
+        merge_trees([grass_patch(), cherry, light])
+    assert e.value.index == 2 and str(e.value).startswith("tree 2 (") and "another shape" in str(e.value)
+    assert "than tree 1 (small_cherry: " in str(e.value)
+    path = write(tmp_path, f'[[trees]]\ntree = "small_cherry"\nposition = [0.0, 0.0, 0.0]\n[[scatter]]\n'
+                           f'tree = "{sapling}"\ncount = 2\narea = [10.0, 10.0]\ncentre = [0.0, 20.0]\n')
+    with pytest.raises(SceneError) as e:
+        ta.load_scene(path)
+    assert str(e.value).startswith(f"{path}: key 'scatter[0].tree': scatter[0] tree 0 ({sapling}) has leaves of "
+                                   f"another shape ('{light.lamina.shape}') than trees[0] (small_cherry: ")
+
+
 # ---------------------------------------------------------------------------- scene files
 @pytest.mark.parametrize("name", ["orchard", "woodland"])
 def test_each_shipped_scene_loads_and_steps_finitely_in_a_gale(name):
@@ -215,6 +250,7 @@ spacing = 5.0
     assert isinstance(scene, ta.Scene) and scene.n_trees == 3 + 30 + 6 and scene.name == "test"
     cherry = ta.load_preset("small_cherry")
     assert scene.placements[0].seed == cherry.seed and scene.placements[1].seed == 12
+    assert len({p.seed for p in scene.placements[3:]}) == 36  # a scatter's trees: each its own seed
     assert np.allclose(scene.rest_positions[scene.tree_nodes(0)], place_tree(cherry, (1, 0, 2), 90, 0.5).rest_positions)
     qsm = ta.load_qsm(QSM, leaves="cherry", seed=3)
     assert np.allclose(scene.rest_positions[scene.tree_nodes(2)], qsm.rest_positions + (20, 0, 0))
@@ -245,17 +281,56 @@ def test_info_prints_a_scenes_trees(tmp_path, capsys):
     assert "scene of 48 trees (48 small_cherry)" in lines[-2] and "1,000 trees" in lines[-1]
 
 
+def test_one_loader_reads_every_tree_file_and_refuses_leaves_in_one_message(tmp_path, capsys):
+    """ta.load_tree, the command line and the viewer's Open read through one function, which
+    refuses leaves for a preset or a scene in the words a scene file's ``leaves`` key is
+    refused in (they were four messages in four places)."""
+    from treeanim.app.actions import ViewerActions
+    from treeanim.model import load, qsm
+
+    assert ta.load_tree is load.load_tree and not hasattr(qsm, "load_tree")
+    beam = ROOT / "assets" / "presets" / "beam.toml"
+    scene = write(tmp_path, '[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\n')
+    said = []
+    for call in (lambda: ta.load_tree(beam, leaves="cherry"), lambda: ta.load_tree(scene, leaves="cherry"),
+                 lambda: load_named("beam", leaves="cherry"), lambda: load_named("orchard", leaves="cherry")):
+        with pytest.raises(ta.PresetError) as e:
+            call()
+        said.append(str(e.value))
+    bad = write(tmp_path, '[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nleaves = "cherry"\n', "bad.toml")
+    with pytest.raises(SceneError) as e:
+        ta.load_scene(bad)
+    said.append(str(e.value))
+    assert cli.main(["info", "beam", "--leaves", "cherry"]) == 2
+    said.append(capsys.readouterr().err.strip())
+    assert all(m.endswith(LEAVES_FOR_QSM_ONLY) and "\n" not in m for m in said), said
+    assert said[0].startswith(f"{beam}: ") and said[2] == f"beam: {LEAVES_FOR_QSM_ONLY}"
+    assert load_named("beam", leaves="none").n_objects == 1  # 'none' is no leaves: nothing to refuse
+
+    class Panel:  # the viewer's Open, without a window: what it loads and says
+        preset_path, messages, loaded = None, [], []
+        say, load_tree = messages.append, loaded.append
+
+    panel = Panel()
+    assert ViewerActions.open_file(panel, scene) and isinstance(panel.loaded[-1], ta.Scene)
+    assert ViewerActions.open_file(panel, str(QSM)) and panel.loaded[-1].name == "synthetic_broadleaf"
+    assert not ViewerActions.open_file(panel, bad) and LEAVES_FOR_QSM_ONLY in panel.messages[-1]
+
+
 # ---------------------------------------------------------------------------- bad scene files
 BAD = [
     ('[[trees]]\ntree = "oak"\nposition = [0.0, 0.0, 0.0]\n', "trees[0].tree", "unknown preset 'oak'"),
     ('[[trees]]\ntree = "beam"\nposition = [nan, 0.0, 0.0]\n', "trees[0].position", "got [nan, 0.0, 0.0]"),
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0]\n', "trees[0].position", "a position [x, y, z]"),
+    # the ground is flat at y = 0 (and the contact floor absolute): a tree stands on it
+    ('[[trees]]\ntree = "beam"\nposition = [0.0, 2.5, 0.0]\n', "trees[0].position", "expected y = 0"),
+    ('[[trees]]\ntree = "beam"\nposition = [0.0, -0.1, 0.0]\n', "trees[0].position", "got [0.0, -0.1, 0.0]"),
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nscale = -1.0\n', "trees[0].scale", "got -1.0"),
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nheading = inf\n', "trees[0].heading", "got inf"),
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nsize = 2\n', "trees[0].size", "unknown key"),
     ('[[trees]]\ntree = "beam"\n', "trees[0].position", "missing"),
     ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nleaves = "cherry"\n', "trees[0].leaves",
-     "only for a TreeQSM model"),
+     LEAVES_FOR_QSM_ONLY),
     ('', "trees", "at least one tree"),
     ('trees = 3\n', "trees", "array of tables"),
     ('colour = 1\n', "colour", "unknown key"),
@@ -280,6 +355,19 @@ BAD = [
      'position = [9.0, 0.0, 0.0]\n', "trees[1].tree", "a scene's leaves share one outline"),
     ('[[trees]]\ntree = "other.toml"\nposition = [0.0, 0.0, 0.0]\n', "trees[0].tree", "is a scene; a scene places"),
     ('[[trees]]\ntree = "missing.toml"\nposition = [0.0, 0.0, 0.0]\n', "trees[0].tree", "cannot read preset file"),
+    # an integer of hundreds of digits is no float (isfinite raised OverflowError)
+    ('seed = ' + "9" * 400 + '\n[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\n', "seed",
+     "expected an integer in [0, "),
+    ('[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\nscale = ' + "1" * 400 + '\n', "trees[0].scale",
+     "got 1111"),
+    # a subnormal spacing made infinitely many grid or hash cells (OverflowError)
+    ('[[scatter]]\ntree = "beam"\ncount = 2\narea = [1.0, 1.0]\npattern = "grid"\nspacing = 1e-310\n',
+     "scatter[0].spacing", "in [0.05, 1000]"),
+    ('[[scatter]]\ntree = "beam"\ncount = 2\narea = [1.0, 1.0]\nspacing = 1e-310\n', "scatter[0].spacing",
+     "in [0.05, 1000]"),
+    # a grid's jitter past 10 km (place_tree's ValueError was a traceback)
+    ('[[scatter]]\ntree = "beam"\ncount = 3\narea = [10.0, 10.0]\ncentre = [9995.0, 0.0]\npattern = "grid"\n'
+     'spacing = 5.0\njitter = 100.0\n', "scatter[0].area", "with its jitter of 100 m"),
 ]
 
 
@@ -301,7 +389,24 @@ def test_not_a_scene_is_one_line_too(tmp_path):
     path.write_text('name = "x"\ntype = "scene"\n[[trees]\n')
     with pytest.raises(SceneError, match=r"not valid TOML"):
         ta.load_scene(path)
+    with pytest.raises(SceneError, match=r"not valid TOML"):  # as its docstring says (it was a PresetError)
+        scene_summary(path)
     with pytest.raises(SceneError, match="unknown scene 'forest'; known scenes: orchard, woodland"):
         ta.load_scene("forest")
     with pytest.raises(ta.PresetError, match=r"got 'scene' \(a scene file: treeanim.load_scene reads it\)"):
         read_spec(write(tmp_path, '[[trees]]\ntree = "beam"\nposition = [0.0, 0.0, 0.0]\n'))
+
+
+def test_what_placing_refuses_is_one_line_naming_the_table(tmp_path, monkeypatch):
+    """A guard: the checks leave place_tree nothing to refuse, but should it refuse, the scene's
+    reader says so in one line with the tree's table."""
+    from treeanim.model import scene_file
+
+    def refuse(tree, position, heading, scale):
+        raise ValueError("position must lie within 10000 m of the origin")
+
+    monkeypatch.setattr(scene_file, "place_tree", refuse)
+    path = write(tmp_path, '[[scatter]]\ntree = "beam"\ncount = 2\narea = [4.0, 4.0]\n')
+    with pytest.raises(SceneError) as e:
+        ta.load_scene(path)
+    assert str(e.value) == f"{path}: key 'scatter[0]': scatter[0] tree 0: position must lie within 10000 m of the origin"

@@ -21,7 +21,7 @@ _EXPORTS = {
     "InputError": "errors",
     "list_presets": "model.presets",
     "load_preset": "model.presets",
-    "load_tree": "model.scene_file",
+    "load_tree": "model.load",
     "load_scene": "model.scene_file",
     "list_scenes": "model.scene_file",
     "Scene": "model.scene",

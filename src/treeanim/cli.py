@@ -240,13 +240,9 @@ def load_any(name_or_path: str, args=None):
     .mat) by path, with ``args``' --leaves (QSM only), --modes and --physics."""
     import dataclasses
 
-    from treeanim.model.qsm import QSM_SUFFIXES
-    from treeanim.model.qsm.leaves import LEAVES_FOR_QSM_ONLY
-    from treeanim.model.scene_file import load_named
+    from treeanim.model.load import load_named
 
     leaves, modes = getattr(args, "leaves", None), getattr(args, "modes", None)
-    if leaves is not None and not name_or_path.lower().endswith((*QSM_SUFFIXES, ".toml")):
-        raise UsageError(LEAVES_FOR_QSM_ONLY)
     tree = load_named(name_or_path, leaves=leaves)
     if modes is not None:
         tree.modes = modes

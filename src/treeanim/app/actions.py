@@ -65,8 +65,8 @@ class ViewerActions:
         self._default_path = default
 
     def open_file(self, path=None) -> bool:
-        """Open a preset or TreeQSM model file (default :attr:`preset_path`; .toml, .txt, .csv
-        or .mat) and show its tree.
+        """Open a tree file (default :attr:`preset_path`): a preset or scene .toml, or a TreeQSM
+        model (.txt, .csv or .mat), read by ``treeanim.load_tree``, and show its tree or scene.
 
         Returns
         -------
@@ -77,11 +77,9 @@ class ViewerActions:
         """
         import treeanim as ta
 
-        from ..model.qsm import QSM_SUFFIXES
-
         target = path or self.preset_path
         try:
-            self.load_tree(ta.load_qsm(target) if str(target).lower().endswith(QSM_SUFFIXES) else ta.load_tree(target))
+            self.load_tree(ta.load_tree(target))
         except (ValueError, OSError) as e:  # PresetError is a ValueError
             self.say(f"error: {_one_line(e)}")
             return False

@@ -9,7 +9,11 @@ import numpy as np
 from .geometry import perpendicular, unit
 from .tree import Tree
 
-__all__ = ["ObjectSpec", "assemble", "eq1_w", "perpendicular"]
+__all__ = ["ObjectSpec", "assemble", "eq1_w", "perpendicular", "KIND_ORDER"]
+
+#: Within a level objects sort by kind in this order (:func:`assemble`, and
+#: :func:`treeanim.model.scene.merge_trees` over a whole scene).
+KIND_ORDER = {"branch": 0, "blade": 1, "leaf": 2}
 
 
 @dataclass
@@ -91,8 +95,7 @@ def assemble(specs: list[ObjectSpec], **tree_kw) -> Tree:
     ValueError
         If the assembled tree breaks a structural invariant (:meth:`Tree.validate`).
     """
-    kind_order = {"branch": 0, "blade": 1, "leaf": 2}
-    order = sorted(range(len(specs)), key=lambda i: (specs[i].level, kind_order[specs[i].kind]))
+    order = sorted(range(len(specs)), key=lambda i: (specs[i].level, KIND_ORDER[specs[i].kind]))
     new_index = np.empty(len(specs), dtype=np.int64)
     new_index[order] = np.arange(len(specs))
     sorted_specs = [specs[i] for i in order]

@@ -114,7 +114,7 @@ def load_preset(name: str) -> Tree:
 
 def read_tree(path: str | Path, data: dict | None = None) -> Tree:
     """Read a preset TOML file and generate its tree (``treeanim.load_tree`` reads any tree
-    file, scenes too: :func:`treeanim.model.scene_file.load_tree`).
+    file, scenes too: :func:`treeanim.model.load.load_tree`).
 
     Parameters
     ----------

@@ -21,18 +21,26 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..validate import finite_float, finite_vector3
+from .build import KIND_ORDER
 from .params import PhysicsParams, SeasonModes
 from .tree import KINDS, Tree
 
-__all__ = ["Placement", "Scene", "place_tree", "merge_trees", "make_scene", "heading_matrix", "same_lamina", "MAX_SCALE",
-           "MIN_SCALE", "MAX_COORDINATE"]
+__all__ = ["Placement", "Scene", "MergeError", "place_tree", "merge_trees", "make_scene", "heading_matrix",
+           "same_lamina", "MAX_SCALE", "MIN_SCALE", "MAX_COORDINATE"]
 
 #: The least and largest scale a tree may be placed at (a seedling of a preset to a giant).
 MIN_SCALE, MAX_SCALE = 0.05, 20.0
 #: How far from the origin a tree may stand (m): a landscape of 20 km.
 MAX_COORDINATE = 10_000.0
-#: Objects sort by level, then kind (as :func:`treeanim.model.build.assemble` sorts them).
-_KIND_ORDER = {"branch": 0, "blade": 1, "leaf": 2}
+
+
+class MergeError(ValueError):
+    """:func:`merge_trees`' refusal of one of its trees; ``index`` is that tree's place in the
+    list (a scene file's reader names its table with it)."""
+
+    def __init__(self, message: str, index: int):
+        super().__init__(message)
+        self.index = index
 
 
 @dataclass(frozen=True)
@@ -121,7 +129,10 @@ class Scene(Tree):
         ValueError
             If ``k`` is not an integer in ``range(n_trees)``.
         """
-        return np.flatnonzero(self.node_tree == self._tree_index(k))
+        objs = self.tree_objects(k)  # each object's nodes are contiguous, in object order
+        count = np.asarray(self.object_count)[objs]
+        first = np.asarray(self.object_start)[objs] - (np.cumsum(count) - count)
+        return (np.repeat(first, count) + np.arange(int(count.sum()))).astype(np.int64)
 
     def validate(self) -> None:
         """:meth:`Tree.validate`, and every object in a tree whose parent is in the same tree."""
@@ -153,7 +164,9 @@ def place_tree(tree: Tree, position=(0.0, 0.0, 0.0), heading: float = 0.0, scale
     ----------
     tree : Tree
     position : (3,) float
-        World metres, each within :data:`MAX_COORDINATE`.
+        World metres, each within :data:`MAX_COORDINATE`. The ground stays at y = 0 (the drawn
+        ground and the branches' contact floor, ``physics.structure``, are absolute): a y other
+        than 0 lifts the tree off it or sinks it in (scene files refuse one).
     heading : float
         Degrees about +y.
     scale : float
@@ -209,7 +222,7 @@ def _scene_physics(trees: list[Tree]) -> PhysicsParams:
 
 
 def merge_trees(trees: list[Tree], placements=None, name: str = "scene", seed: int = 0, source: str = "",
-                description: str = "") -> Scene:
+                description: str = "", labels=None) -> Scene:
     """Join placed trees into one :class:`Scene`.
 
     Objects are concatenated (parents and attach nodes offset) and stably sorted by level and
@@ -228,6 +241,9 @@ def merge_trees(trees: list[Tree], placements=None, name: str = "scene", seed: i
         One per tree (default: each at the origin, its own seed).
     name, seed, source, description :
         The scene's.
+    labels : list of str, optional
+        What to call each tree in a message (default ``'tree k'``; a scene file's reader
+        passes each tree's table, ``'scatter[0] tree 17'``).
 
     Returns
     -------
@@ -235,28 +251,33 @@ def merge_trees(trees: list[Tree], placements=None, name: str = "scene", seed: i
 
     Raises
     ------
+    MergeError
+        A scene among the trees, or a leafy tree whose lamina is not the first leafy tree's;
+        its ``index`` is that tree's.
     ValueError
-        No trees, a scene among them, placements that do not match, or leafy trees with
-        different laminas.
+        No trees, or placements or labels that do not match the trees.
     """
     trees = list(trees)
     if not trees:
         raise ValueError("a scene needs at least one tree")
     for k, t in enumerate(trees):
         if not isinstance(t, Tree) or isinstance(t, Scene):
-            raise ValueError(f"trees[{k}] must be a treeanim Tree (not a scene), got {type(t).__name__}")
+            raise MergeError(f"trees[{k}] must be a treeanim Tree (not a scene), got {type(t).__name__}", k)
     if placements is None:
         placements = [Placement(t.name, seed=int(t.seed)) for t in trees]
     placements = tuple(placements)
-    if len(placements) != len(trees):
-        raise ValueError(f"{len(placements)} placements for {len(trees)} trees")
+    labels = [f"tree {k}" for k in range(len(trees))] if labels is None else list(labels)
+    if not len(placements) == len(labels) == len(trees):
+        raise ValueError(f"{len(placements)} placements and {len(labels)} labels for {len(trees)} trees")
     leafy = [k for k, t in enumerate(trees) if t.lamina is not None and np.any(t.kind == "leaf")]
     lamina = trees[leafy[0]].lamina if leafy else next((t.lamina for t in trees if t.lamina is not None), None)
     for k in leafy[1:]:
-        if not same_lamina(trees[k].lamina, lamina):
-            raise ValueError(f"tree {k} ({placements[k].tree}) has leaves of another shape "
-                             f"({trees[k].lamina.shape!r}) than tree {leafy[0]} ({placements[leafy[0]].tree}: "
-                             f"{lamina.shape!r}); a scene's leaves share one lamina")
+        if trees[k].lamina is not lamina and not same_lamina(trees[k].lamina, lamina):
+            first = leafy[0]
+            raise MergeError(f"{labels[k]} ({placements[k].tree}) has leaves of another shape "
+                             f"({trees[k].lamina.shape!r}) than {labels[first]} ({placements[first].tree}: "
+                             f"{lamina.shape!r}); a scene's leaves share one outline (the renderer draws one "
+                             "leaf shape)", k)
 
     counts = [t.n_objects for t in trees]
     node_off = np.cumsum([0] + [t.n_nodes for t in trees])
@@ -278,7 +299,7 @@ def merge_trees(trees: list[Tree], placements=None, name: str = "scene", seed: i
     global_rank[np.flatnonzero(leaf)[np.lexsort((owner[leaf], share))]] = np.arange(int(leaf.sum()))
 
     # sort objects by (level, kind) over the scene, stably (tree order within a key)
-    key = level * 3 + np.vectorize(_KIND_ORDER.get, otypes=[np.int64])(kind) if len(kind) else level
+    key = level * 3 + np.vectorize(KIND_ORDER.get, otypes=[np.int64])(kind) if len(kind) else level
     order = np.argsort(key, kind="stable")
     M, N = len(order), int(node_off[-1])
     inv = np.empty(M, np.int64)

@@ -4,10 +4,12 @@ A scene file has ``type = "scene"``, a ``name``, an optional ``description`` and
 any number of ``[[trees]]`` (one tree each, at a position) and ``[[scatter]]`` tables (``count``
 trees of one kind over a rectangle, at random with a least spacing or on a grid). A tree is a
 preset's name or a file: a preset ``.toml`` or a TreeQSM model (``.txt``, ``.csv``, ``.mat``),
-relative to the scene file. Each tree is generated with its own seed: a placed tree with its
-preset's unless it gives one, a scattered tree with one drawn from the scene's seed, so no two
-are alike (a TreeQSM model's seed grows its leaves; its wood is the scan's). Every problem is
-one :class:`~treeanim.errors.SceneError` line naming the file, the key and what was expected.
+relative to the scene file. A placed tree is its preset's own tree (the preset's seed) unless
+it gives a ``seed``, so two ``[[trees]]`` of one preset without seeds are alike; a scattered
+tree is grown with a seed drawn, without repeats, from the scene's and the scatter's seeds, so
+no two of a scatter are alike (a TreeQSM model's seed grows its leaves; its wood is the
+scan's). Every problem is one :class:`~treeanim.errors.SceneError` line naming the file, the
+key and what was expected.
 
 Shipped scenes live in ``assets/presets/scenes/`` (package data ``treeanim.presets``).
 """
@@ -24,14 +26,14 @@ import numpy as np
 
 from ..errors import PresetError, SceneError
 from .declare import describe
-from .presets import estimate_size, list_presets, load_preset, read_spec, read_toml, read_tree, tree_of
+from .presets import estimate_size, list_presets, read_spec, read_toml, tree_of
 from .qsm.convert import load_qsm
+from .qsm.leaves import LEAVES_FOR_QSM_ONLY
 from .qsm.read import QSM_SUFFIXES
-from .scene import MAX_COORDINATE, MAX_SCALE, MIN_SCALE, Placement, Scene, merge_trees, place_tree, same_lamina
+from .scene import MAX_COORDINATE, MAX_SCALE, MIN_SCALE, MergeError, Placement, Scene, merge_trees, place_tree
 from .tree import Tree
 
-__all__ = ["list_scenes", "load_scene", "read_scene", "load_tree", "load_named", "scene_summary", "MAX_TREES",
-           "SCENE_BUDGET"]
+__all__ = ["list_scenes", "load_scene", "read_scene", "scene_summary", "MAX_TREES", "SCENE_BUDGET", "MIN_SPACING"]
 
 #: Most trees one scene may place.
 MAX_TREES = 5000
@@ -42,6 +44,10 @@ SCENE_BUDGET = {"objects": 500_000, "nodes": 2_000_000, "triangles": 15_000_000}
 MAX_AREA = 2 * MAX_COORDINATE
 #: Candidate positions tried per tree before a random scatter gives up.
 TRIES_PER_TREE = 60
+#: The least spacing a scatter may ask for (m; 0, the default, is none for a random scatter):
+#: closer than the thinnest shipped trunk's width. With it a grid over the widest area has at
+#: most :data:`MAX_AREA` / MIN_SPACING + 1 = 400,001 columns and rows.
+MIN_SPACING = 0.05
 _TOP = ("name", "description", "type", "seed", "trees", "scatter")
 _TREE_KEYS = ("tree", "position", "heading", "scale", "seed", "leaves")
 _SCATTER_KEYS = ("tree", "count", "area", "centre", "spacing", "pattern", "jitter", "heading", "scale", "seed",
@@ -76,49 +82,6 @@ def load_scene(name_or_path: str | Path) -> Scene:
     return read_scene(text)
 
 
-def load_tree(path: str | Path, leaves: str | None = None) -> Tree:
-    """Read any tree file: a scene or a preset ``.toml`` (by its ``type``), or a TreeQSM model
-    (:func:`treeanim.model.qsm.load_tree`). ``treeanim.load_tree``, the command line and the
-    viewer's Open read files through this one function.
-
-    Raises
-    ------
-    PresetError
-        One line naming the file, the key or row and what was expected.
-    """
-    if not str(path).lower().endswith(".toml"):
-        from .qsm.convert import load_tree as load_qsm_or_preset
-
-        return load_qsm_or_preset(path, leaves=leaves)
-    from .qsm.leaves import LEAVES_FOR_QSM_ONLY
-
-    if leaves not in (None, "none"):
-        raise PresetError(f"{path}: {LEAVES_FOR_QSM_ONLY}")
-    data = read_toml(path)
-    if data.get("type") == "scene":
-        return read_scene(path, data)
-    return read_tree(path, data)
-
-
-def load_named(name_or_path: str, leaves: str | None = None) -> Tree:
-    """A preset or a scene by name, or any tree file by path (:func:`load_tree`).
-
-    Raises
-    ------
-    PresetError
-        An unknown name (listing the presets and scenes) or an unusable file.
-    """
-    text = str(name_or_path)
-    if text.lower().endswith(_FILE_SUFFIXES):
-        return load_tree(text, leaves=leaves)
-    if text in list_scenes() and text not in list_presets():
-        return load_scene(text)
-    if text not in list_presets():
-        raise PresetError(f"unknown preset or scene {text!r}; presets: {', '.join(list_presets())}; scenes: "
-                          f"{', '.join(list_scenes())}")
-    return load_preset(text)
-
-
 # ---------------------------------------------------------------------------- checking
 class _Bad(Exception):
     def __init__(self, key: str, expected: str):
@@ -129,7 +92,9 @@ class _Bad(Exception):
 def _num(value, key: str, lo: float, hi: float, integer: bool = False) -> float:
     kind = "an integer" if integer else "a number"
     ok = isinstance(value, int) if integer else isinstance(value, (int, float))
-    if isinstance(value, bool) or not ok or not math.isfinite(value) or not lo <= value <= hi:
+    # (an int is compared exactly, never made a float first: 10**400 is no float at all)
+    if isinstance(value, bool) or not ok or not (isinstance(value, int) or math.isfinite(value)) \
+            or not lo <= value <= hi:
         raise _Bad(key, f"expected {kind} in [{lo:g}, {hi:g}], got {describe(value)}")
     return int(value) if integer else float(value) + 0.0
 
@@ -194,13 +159,13 @@ def _kind(table: dict, key: str, folder: Path) -> _Kind:
     if name.lower().endswith(_FILE_SUFFIXES):
         path = Path(name) if Path(name).is_absolute() else folder / name
         if leaves is not None and not name.lower().endswith(QSM_SUFFIXES):
-            raise _Bad(f"{key}.leaves", "only for a TreeQSM model (.txt, .csv, .mat); a preset has its own leaves")
+            raise _Bad(f"{key}.leaves", LEAVES_FOR_QSM_ONLY)
         return _Kind(name, path, leaves)
     if name not in list_presets():
         raise _Bad(f"{key}.tree", f"unknown preset {name!r}; expected one of {', '.join(list_presets())} or a "
                                   f"file ({', '.join(_FILE_SUFFIXES)})")
     if leaves is not None:
-        raise _Bad(f"{key}.leaves", "only for a TreeQSM model (.txt, .csv, .mat); a preset has its own leaves")
+        raise _Bad(f"{key}.leaves", LEAVES_FOR_QSM_ONLY)
     return _Kind(name, None, None)
 
 
@@ -242,6 +207,9 @@ def _plan(data: dict, path: Path) -> _Plan:
         k = kind_index(_kind(t, key, folder), key)
         pos = _nums(t["position"], f"{key}.position", 3, -MAX_COORDINATE, MAX_COORDINATE,
                     "a position [x, y, z] in metres")
+        if pos[1] != 0.0:  # the drawn ground and the branches' contact floor are flat at y = 0
+            raise _Bad(f"{key}.position", f"expected y = 0 (trees stand on the ground, which is flat at y = 0), "
+                                          f"got {describe(t['position'])}")
         heading = _num(t.get("heading", 0.0), f"{key}.heading", -3600.0, 3600.0)
         scale = _num(t.get("scale", 1.0), f"{key}.scale", MIN_SCALE, MAX_SCALE)
         own = _num(t["seed"], f"{key}.seed", 0, 2**63 - 1, integer=True) if "seed" in t else None
@@ -269,17 +237,21 @@ def _scatter(t: dict, key: str, count: int, rng: np.random.Generator, placed) ->
     area = _nums(t["area"], f"{key}.area", 2, 1e-3, MAX_AREA, "an area [width, depth] in metres")
     centre = _nums(t.get("centre", [0.0, 0.0]), f"{key}.centre", 2, -MAX_COORDINATE, MAX_COORDINATE,
                    "a centre [x, z] in metres")
-    if max(abs(c) + 0.5 * a for c, a in zip(centre, area)) > MAX_COORDINATE:
-        raise _Bad(f"{key}.area", f"reaches more than {MAX_COORDINATE:g} m from the origin")
     spacing = _num(t.get("spacing", 0.0), f"{key}.spacing", 0.0, 1000.0)
+    if 0.0 < spacing < MIN_SPACING:
+        raise _Bad(f"{key}.spacing", f"expected 0 (none) or a number in [{MIN_SPACING:g}, 1000] (m), got "
+                                     f"{describe(spacing)}")
     pattern = _string(t.get("pattern", "random"), f"{key}.pattern")
     jitter = _num(t.get("jitter", 0.0), f"{key}.jitter", 0.0, 100.0)
+    if max(abs(c) + 0.5 * a for c, a in zip(centre, area)) + (jitter if pattern == "grid" else 0.0) > MAX_COORDINATE:
+        raise _Bad(f"{key}.area", f"reaches more than {MAX_COORDINATE:g} m from the origin"
+                                  + (f" with its jitter of {jitter:g} m" if jitter and pattern == "grid" else ""))
     heading = _pair(t.get("heading", [0.0, 360.0]), f"{key}.heading", -3600.0, 3600.0, " in degrees")
     scale = _pair(t.get("scale", 1.0), f"{key}.scale", MIN_SCALE, MAX_SCALE, "")
     lo, size = np.array(centre) - 0.5 * np.array(area), np.array(area)
     if pattern == "grid":
         if spacing <= 0:
-            raise _Bad(f"{key}.spacing", "expected the grid's spacing, a number > 0 (m)")
+            raise _Bad(f"{key}.spacing", f"expected the grid's spacing, a number in [{MIN_SPACING:g}, 1000] (m)")
         cols, rows = (int(a // spacing) + 1 for a in area)
         if count > cols * rows:
             raise _Bad(f"{key}.count", f"{count:,} trees do not fit a grid of {cols} × {rows} at spacing "
@@ -373,18 +345,9 @@ def _grow(kind: _Kind, base, seed: int | None) -> Tree:
     return tree_of(base if seed is None else dataclasses.replace(base, seed=seed), kind.path or kind.tree)
 
 
-def _check_leaves(trees: list[Tree], labels: list[str]) -> None:
-    """Every leafy tree has the first leafy tree's lamina (the renderer draws one leaf shape)."""
-    first = None
-    for k, t in enumerate(trees):
-        if t.lamina is None or not np.any(t.kind == "leaf"):
-            continue
-        if first is None:
-            first = k
-        elif t.lamina is not trees[first].lamina and not same_lamina(t.lamina, trees[first].lamina):
-            raise _Bad(f"{labels[k].split(' ')[0]}.tree", f"its leaves ({t.lamina.shape!r}) are not those of "
-                       f"{labels[first].split(' ')[0]} ({trees[first].lamina.shape!r}); a scene's leaves share one "
-                       "outline (the renderer draws one leaf shape)")
+def _table(label: str) -> str:
+    """The table a tree's label names ('scatter[2] tree 17' -> 'scatter[2]')."""
+    return label.split(" ")[0]
 
 
 def _check_trunks(scene: Scene, labels: list[str]) -> None:
@@ -434,14 +397,19 @@ def read_scene(path: str | Path, data: dict | None = None) -> Scene:
             try:
                 tree = _grow(kind, bases[k], own)
             except PresetError as e:
-                raise _Bad(label.split(" ")[0] + ".tree", str(e)) from None
-            trees.append(place_tree(tree, pos, heading, scale))
+                raise _Bad(_table(label) + ".tree", str(e)) from None
+            try:  # (the checks above leave it nothing to refuse: a guard, in one line)
+                trees.append(place_tree(tree, pos, heading, scale))
+            except ValueError as e:
+                raise _Bad(_table(label), f"{label}: {e}") from None
             placements.append(Placement(kind.tree, pos, heading, scale, int(tree.seed)))
-        _check_leaves(trees, plan.labels)
-        try:
+        try:  # (it refuses leaves of another outline than the first leafy tree's)
             scene = merge_trees(trees, placements, name=data["name"], seed=int(data.get("seed", 0)),
-                                source=str(path), description=" ".join(str(data.get("description", "")).split()))
-        except ValueError as e:
+                                source=str(path), description=" ".join(str(data.get("description", "")).split()),
+                                labels=plan.labels)
+        except MergeError as e:
+            raise _Bad(f"{_table(plan.labels[e.index])}.tree", str(e)) from None
+        except ValueError as e:  # (a guard: nothing else in it is left to refuse a checked plan)
             raise _Bad("trees", str(e)) from None
         _check_trunks(scene, plan.labels)
     except _Bad as e:
@@ -457,14 +425,17 @@ def scene_summary(path: str | Path) -> tuple[int, dict[str, int], str]:
     Raises
     ------
     SceneError
-        As :func:`read_scene` for what the file says (its trees are not read).
+        As :func:`read_scene`: a file that cannot be read or is not TOML, or what the file
+        says (its trees are not read).
     """
     path = Path(path)
-    data = read_toml(path)
     try:
+        data = read_toml(path)
         plan = _plan(data, path)
     except _Bad as e:
         raise SceneError(f"{path}: key '{e.key}': {e.expected}") from None
+    except PresetError as e:  # read_toml's, which names the file
+        raise SceneError(str(e)) from None
     per: dict[str, int] = {}
     for k, *_ in plan.where:
         per[plan.kinds[k].tree] = per.get(plan.kinds[k].tree, 0) + 1

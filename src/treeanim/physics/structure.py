@@ -163,14 +163,11 @@ def leaf_clusters(tree, X: np.ndarray, leaves: np.ndarray, leaf_area: np.ndarray
     tree's nodes and leaves), of the whole tree otherwise."""
     if not isinstance(tree, Scene) or tree.n_trees <= 1:
         return np.full(len(leaves), foliage_clusters(X, leaf_area, lai))
-    node_tree = tree.node_tree
-    by_tree = np.argsort(node_tree, kind="stable")
-    node_edges = np.searchsorted(node_tree[by_tree], np.arange(tree.n_trees + 1))
     owner = tree.object_tree[leaves]
     out = np.ones(len(leaves))
     for k in np.unique(owner):
         mine = owner == k
-        out[mine] = foliage_clusters(X[by_tree[node_edges[k]:node_edges[k + 1]]], leaf_area[mine], lai)
+        out[mine] = foliage_clusters(X[tree.tree_nodes(int(k))], leaf_area[mine], lai)
     return out
 
 

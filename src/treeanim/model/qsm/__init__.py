@@ -20,10 +20,10 @@ Every problem is one :class:`~treeanim.errors.QSMError` line naming the file, th
 and what was wrong.
 """
 
-from .convert import build_tree, load_qsm, load_tree
+from .convert import build_tree, load_qsm
 from .leaves import LEAF_SPACING, SPECIES, Species, parse_leaves
 from .read import QSM_SUFFIXES, read_table, write_table
 from .synthetic import synthetic_table
 
-__all__ = ["SPECIES", "Species", "QSM_SUFFIXES", "read_table", "load_qsm", "load_tree", "build_tree", "parse_leaves",
+__all__ = ["SPECIES", "Species", "QSM_SUFFIXES", "read_table", "load_qsm", "build_tree", "parse_leaves",
            "synthetic_table", "write_table", "LEAF_SPACING"]

@@ -13,8 +13,8 @@ from ..generate import place_leaves
 from ..lamina import make_lamina
 from ..params import WOOD_TYPES
 from ..tree import Tree
-from .leaves import DEFAULT_PRESET, LEAVES_FOR_QSM_ONLY, _leaf_rule, _preset_spec, _scaled_ei_max, parse_leaves
-from .read import COLUMNS, MAX_CYLINDERS, QSM_SUFFIXES, WIDTHS, _problem, _read_text, _widths_text, read_table
+from .leaves import DEFAULT_PRESET, _leaf_rule, _preset_spec, _scaled_ei_max, parse_leaves
+from .read import COLUMNS, MAX_CYLINDERS, WIDTHS, _problem, _read_text, _widths_text, read_table
 
 # ---------------------------------------------------------------------------- checking
 #: A cylinder's radius and length (m): from a tenth of a millimetre (TreeQSM resolves a few
@@ -282,27 +282,3 @@ def load_qsm(path: str | Path, leaves: str | None = None, seed: int = 0) -> Tree
     except PresetError as e:  # pragma: no cover - a shipped preset that does not read
         raise QSMError(f"{path}: {e}") from None
 
-
-def load_tree(path: str | Path, leaves: str | None = None) -> Tree:
-    """Read a tree file: a TreeQSM model by its suffix (:data:`QSM_SUFFIXES`: :func:`load_qsm`),
-    else a preset TOML file (:func:`~treeanim.model.presets.read_tree`). The command line and
-    ``treeanim.load_tree`` read files through this one function.
-
-    Parameters
-    ----------
-    path : str or Path
-    leaves : str or None
-        A TreeQSM model's leaves (:func:`parse_leaves`); a preset has its own.
-
-    Raises
-    ------
-    PresetError
-        One line naming the file, the key or row and what was expected.
-    """
-    if str(path).lower().endswith(QSM_SUFFIXES):
-        return load_qsm(path, leaves=leaves)
-    if leaves not in (None, "none"):
-        raise PresetError(f"{path}: {LEAVES_FOR_QSM_ONLY}")
-    from ..presets import read_tree
-
-    return read_tree(path)

@@ -47,8 +47,9 @@ SPECIES = {
 DEFAULT_PRESET = "large_cherry"
 
 
-#: Why ``--leaves`` is refused for a preset.
-LEAVES_FOR_QSM_ONLY = "--leaves is for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves"
+#: Why leaves (``--leaves``, a scene table's ``leaves``, ``load_tree(leaves=...)``) are refused
+#: for a preset or a scene: the one message, wherever it is refused.
+LEAVES_FOR_QSM_ONLY = "leaves are only for TreeQSM models (.txt, .csv, .mat); a preset has its own leaves"
 
 #: Most leaves per metre of twig ``--leaves NAME:PER_METRE`` accepts.
 MAX_PER_METRE = 1000.0
