@@ -86,7 +86,9 @@ def test_the_blocks_hold_their_members_where_glsl_reads_them(offscreen):
     ctx = offscreen.ctx
     with ctx:
         # transform feedback draws too: a complete framebuffer must be bound (a fresh context's
-        # own is not; the test failed when it was the first to use the session's context)
+        # own is not; the test failed when it was the first to use the session's context). The
+        # one bound before is bound again after, for the tests that share the context.
+        previous = ctx.fbo
         target = ctx.simple_framebuffer((1, 1))
         target.use()
         for name, members in BLOCKS.items():
@@ -124,7 +126,9 @@ def test_the_blocks_hold_their_members_where_glsl_reads_them(offscreen):
                 for o in (vao, out, block, prog):
                     o.release()
         assert ctx.error == "GL_NO_ERROR"
-        target.release()
+        if previous is not None:
+            previous.use()
+            target.release()
 
 
 def test_every_sampler_has_its_own_unit():
