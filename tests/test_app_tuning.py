@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import treeanim as ta
-from app_helpers import DT, H, W, centre
+from app_helpers import DT, H, W, centre, click, reveal
 from treeanim.app.headless import HeadlessWindow
 from treeanim.app.viewer import Viewer
 
@@ -185,15 +185,10 @@ def test_the_panels_undo_button(viewer):
     v.show_panel = True
     v.panel.apply("wind_speed", 6.0)
     v.frame(DT)
-    v.frame(DT)
-    x, y = centre(v.panel.item_rects["undo"])
-    v.on_cursor_pos(x, y)
-    v.frame(DT)
-    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.PRESS, 0)
-    v.frame(DT)
-    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
-    v.frame(DT)
+    click(v, *reveal(v, "undo"))  # (at the panel's foot, by the status line)
     assert v.sim.wind.speed == 0.0 and v.history.can_redo
+    click(v, *reveal(v, "redo"))
+    assert v.sim.wind.speed == 6.0
 
 
 # ---------------------------------------------------------------------------- bookmarks

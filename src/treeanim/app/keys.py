@@ -73,6 +73,7 @@ MOUSE = (
     ("left-drag the sky", "orbit"),
     ("right/middle-drag", "pan"),
     ("wheel", "zoom"),
+    ("right-click a panel setting", "back to its default"),
 )
 
 

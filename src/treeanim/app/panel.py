@@ -278,7 +278,6 @@ class Panel:
         if changed and idx != current and idx < len(presets):
             self.apply("preset", presets[idx])
         self.widget("season")
-        self._tuning_row()
 
         # --- wind
         if self._header("Wind", open_=True):
@@ -325,7 +324,6 @@ class Panel:
             imgui.same_line()
             if imgui.button("Frame"):
                 v.frame_camera()
-            self.widget("draft")
 
         # --- overlays
         if self._header("Overlays", open_=True):
@@ -338,6 +336,7 @@ class Panel:
         if self._header("Light"):
             for name in LIGHT:
                 self.widget(name)
+            self.widget("draft")
 
         # --- preset file
         if self._header("Preset file"):
@@ -355,6 +354,7 @@ class Panel:
             imgui.same_line()
             imgui.text_disabled("Ctrl+S / Ctrl+O")
 
+        self._tuning_row()
         for line in v.messages[-2:]:
             if line.startswith("error"):
                 imgui.push_style_color(imgui.Col_.text, imgui.ImVec4(1.0, 0.45, 0.4, 1.0))
