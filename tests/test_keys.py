@@ -17,8 +17,9 @@ def test_every_binding_is_an_action_of_the_viewer_and_in_the_help():
     for b in BINDINGS:
         assert callable(getattr(Viewer, b.action, None)), b.action
         for key in b.keys:
-            assert (key, b.ctrl) not in seen, b
-            seen.add((key, b.ctrl))
+            for shift in ((False, True) if b.shift is None else (b.shift,)):
+                assert (key, b.ctrl, shift) not in seen, b
+                seen.add((key, b.ctrl, shift))
         assert f"{b.label} {b.does}" in text
     assert all(f"{what}: {does}" in text for what, does in MOUSE)
 
@@ -39,6 +40,20 @@ def test_ctrl_picks_its_own_bindings():
     assert binding_for(glfw.KEY_F, glfw.MOD_CONTROL) is None  # Ctrl with an unbound key does nothing
     assert binding_for(glfw.KEY_F12, glfw.MOD_SHIFT).action == "request_screenshot"
     assert binding_for(glfw.KEY_A, 0) is None
+
+
+def test_shift_tells_undo_from_redo_and_digits_carry_their_number():
+    ctrl, shift = glfw.MOD_CONTROL, glfw.MOD_SHIFT
+    assert binding_for(glfw.KEY_Z, ctrl).action == "undo"
+    assert binding_for(glfw.KEY_Z, ctrl | shift).action == "redo"
+    assert binding_for(glfw.KEY_Y, ctrl).action == "redo"
+    assert binding_for(glfw.KEY_Z, 0) is None
+    b = binding_for(glfw.KEY_3, ctrl)
+    assert (b.action, b.args(glfw.KEY_3)) == ("store_bookmark", (3,))
+    b = binding_for(glfw.KEY_1, 0)
+    assert (b.action, b.args(glfw.KEY_1)) == ("recall_bookmark", (1,))
+    assert binding_for(glfw.KEY_5, 0) is None
+    assert binding_for(glfw.KEY_D, 0).action == "toggle_draft"
 
 
 def test_the_readme_lists_every_shortcut():

@@ -117,6 +117,7 @@ class ViewerActions:
         self.trace.clear()
         self.traced = None
         self._uploaded = None
+        self.note_defaults()  # the paper model's settings, the first time it runs on this tree
 
     def set_paper_model(self, on: bool) -> None:
         """The paper's model (True) or the tree model (False): :meth:`set_model`."""

@@ -93,7 +93,7 @@ class ViewerInput:
             return
         binding = binding_for(key, mods)
         if binding is not None:
-            getattr(self, binding.action)()
+            getattr(self, binding.action)(*binding.args(key))
 
     def on_resize(self, width: int, height: int) -> None:
         """The framebuffer is now ``width`` × ``height`` pixels (0 × 0: minimised). Beyond the

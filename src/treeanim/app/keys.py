@@ -27,6 +27,10 @@ class Binding:
         What it does, for the help.
     ctrl : bool
         Only with Ctrl held (and never without it).
+    shift : bool or None
+        Only with Shift held (True), never with it (False), either way (None).
+    numbered : bool
+        The action takes the key's number: 1 for the first of :attr:`keys`, 2 for the next …
     """
 
     keys: tuple[int, ...]
@@ -34,6 +38,15 @@ class Binding:
     action: str
     does: str
     ctrl: bool = False
+    shift: bool | None = None
+    numbered: bool = False
+
+    def args(self, key: int) -> tuple:
+        """The arguments the action takes for a press of ``key``."""
+        return (self.keys.index(key) + 1,) if self.numbered else ()
+
+
+_DIGITS = (glfw.KEY_1, glfw.KEY_2, glfw.KEY_3, glfw.KEY_4)
 
 
 #: Every shortcut, in the order the help lists them.
@@ -46,6 +59,12 @@ BINDINGS = (
     Binding((glfw.KEY_F11,), "F11", "toggle_fullscreen", "full screen"),
     Binding((glfw.KEY_S,), "Ctrl+S", "save_preset", "save the preset", ctrl=True),
     Binding((glfw.KEY_O,), "Ctrl+O", "open_file", "load it", ctrl=True),
+    Binding((glfw.KEY_Z,), "Ctrl+Z", "undo", "undo a setting", ctrl=True, shift=False),
+    Binding((glfw.KEY_Y,), "Ctrl+Y", "redo", "redo", ctrl=True),
+    Binding((glfw.KEY_Z,), "Ctrl+Shift+Z", "redo", "redo", ctrl=True, shift=True),
+    Binding(_DIGITS, "Ctrl+1–4", "store_bookmark", "store the camera", ctrl=True, numbered=True),
+    Binding(_DIGITS, "1–4", "recall_bookmark", "recall it", numbered=True),
+    Binding((glfw.KEY_D,), "D", "toggle_draft", "draft mode (fast)"),
     Binding((glfw.KEY_ESCAPE, glfw.KEY_Q), "Esc/Q", "quit", "quit"),
 )
 #: The mouse: (what, does).
@@ -54,13 +73,14 @@ MOUSE = (
     ("left-drag the sky", "orbit"),
     ("right/middle-drag", "pan"),
     ("wheel", "zoom"),
+    ("right-click a panel setting", "back to its default"),
 )
 
 
 def binding_for(key: int, mods: int) -> Binding | None:
     """The binding a press of ``key`` with modifier bits ``mods`` triggers, or None."""
-    ctrl = bool(mods & glfw.MOD_CONTROL)
-    return next((b for b in BINDINGS if b.ctrl == ctrl and key in b.keys), None)
+    ctrl, shift = bool(mods & glfw.MOD_CONTROL), bool(mods & glfw.MOD_SHIFT)
+    return next((b for b in BINDINGS if b.ctrl == ctrl and key in b.keys and b.shift in (None, shift)), None)
 
 
 def help_lines() -> list[str]:

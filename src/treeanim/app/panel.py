@@ -67,6 +67,7 @@ class Panel:
         self._text: tuple[str, str] = ("", "")
         self._timing_at = -1.0
         self._timing = ""
+        self._holding: str | None = None  # the setting whose widget is held since it changed
 
     # ------------------------------------------------------------------ geometry
     @property
@@ -106,23 +107,45 @@ class Panel:
         self._pending.clear()
 
     # ------------------------------------------------------------------ changes
-    def apply(self, name: str, value) -> bool:
+    def apply(self, name: str, value, merge: bool = False) -> bool:
         """Apply setting ``name`` (a key of :data:`~treeanim.app.settings.SETTINGS`: ``preset``,
         ``season``, the wind's, ``ei_max``, ``f:KIND`` and ``zeta:KIND`` ((min, max) of the
         edited season's table), ``time_scale``, ``paper_model``, the paper model's
-        ``integrator``, ``coupling`` and ``physical_modes``, the switches, the light's) through
-        the viewer's method for it; returns whether it was accepted (a refusal is shown in the
-        panel)."""
-        v = self.viewer
-        try:
-            setting = SETTINGS.get(name)
-            if setting is None:
-                raise ValueError(f"unknown setting {name!r}")
-            setting.apply(v, value, **({"season": self.edit_season} if setting.seasonal else {}))
-        except (ValueError, OSError) as e:
-            v.say(f"error: {' '.join(str(e).split())}")
-            return False
-        return True
+        ``integrator``, ``coupling`` and ``physical_modes``, the switches, the light's, ``draft``)
+        through the viewer's method for it, recorded to undo
+        (:meth:`Viewer.change_setting <treeanim.app.tuning.ViewerTuning.change_setting>`;
+        ``merge``: part of the last step, a slider still held); returns whether it was accepted
+        (a refusal is shown in the panel)."""
+        return self.viewer.change_setting(name, value, season=self.edit_season, merge=merge)
+
+    def _held(self, name: str, changed: bool) -> bool:
+        """After a widget of setting ``name``: whether a change continues the step of the same
+        held widget (a drag is one step to undo); a right-click sets it back to its default."""
+        merge = self._holding == name
+        if imgui.is_item_active():
+            if changed:
+                self._holding = name
+        elif self._holding == name:
+            self._holding = None
+        if imgui.is_item_clicked(imgui.MouseButton_.right):
+            self.viewer.reset_setting(name, self.edit_season)
+        elif imgui.is_item_hovered() and not self.viewer.is_default(name, self.edit_season):
+            imgui.set_tooltip("right-click: back to its default")
+        return merge
+
+    def state_line(self) -> str:
+        """The status line under the timings: time or paused, the GL renderer and its
+        multisampling (or draft mode), what is grabbed."""
+        v, sim = self.viewer, self.viewer.sim
+        gl = v.gl_renderer.split(" (")[0][:24]
+        msaa = f"MSAA {v.window.samples}×" if v.window.samples else "no MSAA"
+        if v.draft:
+            msaa = "DRAFT: ½ res, no MSAA, no shadows"
+        state = f"{'paused' if v.paused else f't = {sim.time:.1f} s'}   {gl}, {msaa}"
+        if v.grab is not None:
+            verb = "dragging" if sim.model == "tree" else "pulling"
+            state += f"  {verb} #{v.grab.object} ({sim.tree.kind[v.grab.object]})"
+        return state
 
     # ------------------------------------------------------------------ drawing
     def _rect(self, label: str, frame_only: bool = False) -> None:
@@ -163,9 +186,12 @@ class Panel:
                     self._pending[name] = new
                 if name in self._pending and not imgui.is_item_active():
                     self.apply(name, self._pending.pop(name))
+                if imgui.is_item_clicked(imgui.MouseButton_.right):
+                    self.viewer.reset_setting(name)
                 return
+        merge = self._held(name, changed)
         if changed:
-            self.apply(name, new)
+            self.apply(name, new, merge=merge)
 
     def _range_pair(self, name: str, speed: float) -> None:
         """Setting ``name``'s (min, max) pair as two linked drag fields (f or ζ of a kind), in its
@@ -179,8 +205,28 @@ class Panel:
         changed, lo, hi = imgui.drag_float_range2(st.label, r[0], r[1], speed, st.lo, st.hi, st.fmt, st.fmt,
                                                   imgui.SliderFlags_.always_clamp)
         self._rect(name.replace(":", " "))
+        merge = self._held(name, changed)
         if changed:
-            self.apply(name, (max(lo, st.lo), max(hi, st.lo)))
+            self.apply(name, (max(lo, st.lo), max(hi, st.lo)), merge=merge)
+
+    def _button(self, label: str, enabled: bool, rect: str) -> bool:
+        imgui.begin_disabled(not enabled)
+        pressed = imgui.button(label)
+        imgui.end_disabled()
+        self._rect(rect)
+        return pressed
+
+    def _tuning_row(self) -> None:
+        """Undo, Redo and Reset all (right-click a setting: that one back to its default)."""
+        v = self.viewer
+        if self._button("Undo", v.history.can_undo, "undo"):
+            v.undo()
+        imgui.same_line()
+        if self._button("Redo", v.history.can_redo, "redo"):
+            v.redo()
+        imgui.same_line()
+        if self._button("Reset all", True, "reset all"):
+            v.reset_all()
 
     def draw(self) -> None:
         """Build the panel for this frame (between ``imgui.new_frame`` and ``imgui.render``)."""
@@ -219,13 +265,7 @@ class Panel:
             self._timing = f"sim {v.sim_ms.value or 0:.1f} ms  render {v.render_ms.value or 0:.1f} ms  {fps:.0f} FPS{rt}"
             self._timing_at = now
         imgui.text(self._timing)
-        gl = v.gl_renderer.split(" (")[0][:24]
-        msaa = f"MSAA {v.window.samples}×" if v.window.samples else "no MSAA"
-        state = f"{'paused' if v.paused else f't = {sim.time:.1f} s'}   {gl}, {msaa}"
-        if v.grab is not None:
-            verb = "dragging" if sim.model == "tree" else "pulling"
-            state += f"  {verb} #{v.grab.object} ({sim.tree.kind[v.grab.object]})"
-        imgui.text_disabled(state)
+        imgui.text_disabled(self.state_line())
         imgui.separator()
 
         # --- tree
@@ -296,6 +336,7 @@ class Panel:
         if self._header("Light"):
             for name in LIGHT:
                 self.widget(name)
+            self.widget("draft")
 
         # --- preset file
         if self._header("Preset file"):
@@ -313,6 +354,7 @@ class Panel:
             imgui.same_line()
             imgui.text_disabled("Ctrl+S / Ctrl+O")
 
+        self._tuning_row()
         for line in v.messages[-2:]:
             if line.startswith("error"):
                 imgui.push_style_color(imgui.Col_.text, imgui.ImVec4(1.0, 0.45, 0.4, 1.0))

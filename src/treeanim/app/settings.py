@@ -205,6 +205,8 @@ SETTINGS: dict[str, Setting] = {
     "physical_modes": _check("physical modes (beam theory)", _physical_modes, "set_physical_modes",
                              shown=_paper_model, paper_only=True),
     "paused": _check("paused", "paused", "set_paused"),
+    # draft mode for slow renderers: half resolution, no MSAA, no shadows (not undone or reset)
+    "draft": _check("draft", "draft", "set_draft"),
     # overlays
     "show_trace": _check("grab trace", "show_trace", "set_overlay", args=("trace",)),
     "show_frames": _check("local frames", "show_frames", "set_overlay", args=("frames",)),

@@ -15,6 +15,7 @@ frame. :func:`run` is the main loop. The controls are the table in :mod:`treeani
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from pathlib import Path
 
@@ -36,6 +37,7 @@ from .actions import ViewerActions
 from .gui import Gui
 from .input import ViewerInput
 from .protocol import AppWindow
+from .tuning import DRAFT_SCALE, ViewerTuning
 from .winddir import wind_direction
 
 __all__ = ["Viewer", "run", "MAX_FRAME_DT"]
@@ -62,7 +64,7 @@ class _Ema:
         self.value = x if self.value is None else self.value + self.w * (x - self.value)
 
 
-class Viewer(ViewerInput, ViewerActions):
+class Viewer(ViewerInput, ViewerActions, ViewerTuning):
     """A tree in wind in a window: simulation, renderer, camera, mouse and keys, panel.
 
     Parameters
@@ -151,6 +153,8 @@ class Viewer(ViewerInput, ViewerActions):
         self.sim: Simulation | None = None
         self.renderer: Renderer | None = None
         self.scene = Scene()  # sun, shadows and leaves' translucency, kept across trees
+        self._init_tuning()  # undo history, defaults, camera bookmarks, draft mode (tuning.py)
+        self._draft_target = None
         named = wind_preset_kwargs(wind_preset) if wind_preset else {}
         if wind_speed is not None:
             named["speed"] = float(wind_speed)
@@ -207,6 +211,7 @@ class Viewer(ViewerInput, ViewerActions):
         self._wind_arrow_anchor = (0.5 * (lo + hi), 0.65 * size)
         self._follow_file_name()
         self.frame_camera()
+        self.note_defaults(fresh=True)
         self.panel.tree_changed()
 
     def _wind_at(self, points: np.ndarray) -> np.ndarray:
@@ -307,8 +312,17 @@ class Viewer(ViewerInput, ViewerActions):
         target = self.window.framebuffer
         if target is None:  # minimised since the viewer last heard of the size
             return
-        target.use()
-        r.draw(self.camera, fw, fh, season=sim.season, overlays=self.overlays())
+        if self.draft:  # no shadows, a smaller picture without MSAA, scaled up (tuning.py)
+            from .draft import DraftTarget
+
+            r.scene = dataclasses.replace(self.scene, shadow=False)
+            self._draft_target = self._draft_target or DraftTarget(self.ctx)
+            self._draft_target.draw(r, self.camera, fw, fh, DRAFT_SCALE, target, season=sim.season,
+                                    overlays=self.overlays())
+        else:
+            r.scene = self.scene
+            target.use()
+            r.draw(self.camera, fw, fh, season=sim.season, overlays=self.overlays())
         if self.show_panel:
             ww, wh = self._win
             self.gui.new_frame(ww, wh, fw, fh, dt if dt > 0 else 1 / 60)
@@ -415,6 +429,9 @@ class Viewer(ViewerInput, ViewerActions):
         if self.renderer is not None:
             self.renderer.release()
             self.renderer = None
+        if self._draft_target is not None:
+            self._draft_target.release()
+            self._draft_target = None
         self.gui.release()
 
 
