@@ -16,10 +16,10 @@ the squared displacement it adds over the clip is at most
 (q the joints' world quaternions: the scalar part of q_k⁻¹ q_j is their dot product). The
 cheapest merge is made first and the costs of the merged joint's children, which now hang
 from k, are measured again (a heap with lazy updates). This is greedy least squares: it
-minimises the RMS displacement added merge by merge. The order it finds is the one the
-structure suggests, measured rather than assumed: petiole segments (short reach, few
-vertices) ride their leaf's first joint, leaves their twig, then twigs' segments and short
-twigs their branch; trunk and main limbs, whose motion carries the whole crown, merge last.
+minimises the RMS displacement added merge by merge. It is measured rather than assumed from
+the structure (a rule such as "petioles first" guesses the motion): on a small cherry in wind
+8, a budget of 256 keeps about 200 leaf joints, the leaves that flutter most, and merges the
+branch segments that turn with their neighbours, while the quiet leaves ride their twigs.
 
 :func:`motion_error` measures the result against the full motion: every vertex of the mesh,
 skinned as the file skins it, at every frame, in metres.
