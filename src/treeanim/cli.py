@@ -56,7 +56,7 @@ def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
 def cmd_export(args) -> int:
     """Bake the simulated motion into a glTF 2.0 file: n frames at --fps make n + 1 keys, the
     last at exactly --seconds (a loop's repeats its first: :mod:`treeanim.loop`)."""
-    from treeanim import export, loop
+    from treeanim import export, joints, loop
 
     out = output_path(args.out, (".glb", ".gltf"))
     n = opt.check_frames(args.seconds, args.fps)
@@ -69,18 +69,22 @@ def cmd_export(args) -> int:
     fade = max(opt.check_frames(args.loop, args.fps), 1) if args.loop > 0 else 0
     if fade >= n:
         raise UsageError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
+    budget = args.joints if args.target is None else opt.JOINT_TARGETS[args.target]
     tree, sim = make_simulation(args)
     skel = export.skeleton(tree, sim.present)
     try:
         raw = export.bake(sim, skel, n + max(fade, 1), args.fps, opt.scheduled(args), quiet=args.quiet)
     except ValueError as e:
         raise UsageError(str(e)) from None
+    full = skel
+    skel, raw, mesh, error = joints.fit(tree, full, raw, n, budget, sim.present)
     keys = loop.close_loop(raw, n) if fade else raw
-    doc, data = export.build_gltf(tree, keys, args.fps, season=args.season, present=sim.present)
+    doc, data = export.build_gltf(tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel)
     files = export.write_gltf(out, doc, data)
     size = sum(f.stat().st_size for f in files)
     print(f"wrote {', '.join(map(str, files))}: {skel.count} joints, {n} frames at {args.fps:g} fps, "
           f"{n + 1} keys from 0 to {n / args.fps:.2f} s, {size / 1e6:.1f} MB")
+    print(joints.report(full, skel, budget, error))
     if fade:
         print(loop.seam(keys, raw).line())
     return 0
@@ -346,6 +350,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--loop", type=opt.non_negative, default=0.0, metavar="SECONDS",
                    help="make the clip loop: the simulation runs this many seconds past the end and cross-fades into the "
                    "clip's start; the last key repeats the first (default 0: no loop)")
+    budgets = p.add_mutually_exclusive_group()
+    budgets.add_argument("--joints", type=opt.checked(opt.joint_budget), default=None, metavar="N",
+                         help="merge the skeleton into at most N joints (a whole number >= 2, the root joint "
+                         "included) where it costs least motion: petioles ride their leaf, leaves their twig, short "
+                         "twigs their branch; reports the error against the full motion (default: all, one joint "
+                         "per segment)")
+    budgets.add_argument("--target", choices=sorted(opt.JOINT_TARGETS), default=None,
+                         help="the joint budget of an engine: " + ", ".join(
+                             f"{k} {v}" for k, v in sorted(opt.JOINT_TARGETS.items()))
+                         + " (Unreal's default of 256 bones per section; Unity and Godot stay responsive; "
+                         "three.js with its bone texture)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_export)
 

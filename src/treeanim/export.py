@@ -239,8 +239,52 @@ class _Blob:
         return b"".join(self.parts) + b"\0" * pad
 
 
+def skin(tree: Tree, mesh: TreeMesh, skel: Skeleton, present: np.ndarray | None = None):
+    """The skinned vertices of ``mesh`` on ``skel``: what :func:`build_gltf` writes.
+
+    Linear-blend skinning: a vertex at t along a branch's segment leans from its base frame
+    T₀ toward its segment's joint as a cantilever, by t(3 − t)/2 (the renderer's Hermite
+    curve, without the tip's overshoot, which blend weights cannot express).
+
+    Returns
+    -------
+    keep_tris : (T,) bool
+        Triangles of present objects.
+    used : (V,) bool
+        Vertices those triangles use.
+    pos : (U, 3) float32
+        Their rest positions.
+    joints : (U, 4) uint16
+        Their joints (a slot with no weight names joint 0).
+    weights : (U, 4) uint8
+        Their weights, summing to 255.
+    """
+    keep_tris = np.ones(len(mesh.indices), bool)
+    if present is not None:
+        tri_obj = np.repeat(np.arange(tree.n_objects), mesh.object_triangles)
+        keep_tris = present[tri_obj]
+    used = np.zeros(mesh.vertex_count, bool)
+    used[mesh.indices[keep_tris].ravel()] = True
+    v = mesh.vertices[used]
+    ids = v["ids"]
+    pos = (tree.rest_positions[ids[:, 0]] + v["offset"]).astype(np.float32)
+    t = v["curve"][:, 0].astype(np.float64)
+    w2 = v["extra"][:, 0].astype(np.float64) * (1.0 - 0.5 * t * (3.0 - t))
+    j1 = skel.node_joint[ids[:, 0]]
+    j2 = np.where(ids[:, 1] >= 0, skel.node_joint[np.maximum(ids[:, 1], 0)], 0)  # -1: the ground
+    single = (w2 <= 0) | (j1 == j2)
+    joints = np.zeros((len(v), 4), np.uint16)
+    weights = np.zeros((len(v), 4), np.uint8)  # normalised: each vertex's weights sum to 255
+    joints[:, 0] = j1
+    joints[:, 1] = np.where(single, 0, j2)
+    weights[:, 1] = np.where(single, 0, np.round(w2 * 255)).astype(np.uint8)
+    weights[:, 0] = 255 - weights[:, 1]
+    joints[weights == 0] = 0  # a joint listed with no weight is noise to clients (and the validator)
+    return keep_tris, used, pos, joints, weights
+
+
 def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, mesh: TreeMesh | None = None,
-               present: np.ndarray | None = None) -> tuple[gl.GLTF2, bytes]:
+               present: np.ndarray | None = None, skel: Skeleton | None = None) -> tuple[gl.GLTF2, bytes]:
     """The glTF document and its binary buffer.
 
     Parameters
@@ -258,6 +302,9 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
         The tree's mesh (:func:`~treeanim.render.mesh.build_mesh`), built if not given.
     present : (M,) bool, optional
         Objects on the tree: the others (fallen leaves) are left out of the mesh and the skin.
+    skel : Skeleton, optional
+        The joints ``keys`` are for: :func:`skeleton` ``(tree, present)`` by default, or one
+        reduced to a joint budget (:func:`treeanim.joints.reduce`).
 
     Raises
     ------
@@ -265,7 +312,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
         If ``keys`` are not for the skeleton's joints.
     """
     mesh = mesh if mesh is not None else build_mesh(tree)
-    skel = skeleton(tree, present)
+    skel = skel if skel is not None else skeleton(tree, present)
     if keys.shape[1] != skel.count:
         raise ValueError(f"keys for {keys.shape[1]} joints, the skeleton has {skel.count}")
     check_joints(skel)
@@ -273,34 +320,12 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     blob = _Blob(doc)
 
     # --- mesh: rest positions, normals, colours, joints and weights
-    keep_tris = np.ones(len(mesh.indices), bool)
-    if present is not None:
-        tri_obj = np.repeat(np.arange(tree.n_objects), mesh.object_triangles)
-        keep_tris = present[tri_obj]
-    used = np.zeros(mesh.vertex_count, bool)
-    used[mesh.indices[keep_tris].ravel()] = True
+    keep_tris, used, pos, joints, weights = skin(tree, mesh, skel, present)
     remap = np.cumsum(used) - 1
     v = mesh.vertices[used]
-    ids = v["ids"]
-    pos = (tree.rest_positions[ids[:, 0]] + v["offset"]).astype(np.float32)
     nrm = v["normal"].astype(np.float64)
     nrm = (nrm / np.linalg.norm(nrm, axis=1, keepdims=True)).astype(np.float32)
     col = np.round(vertex_colours(tree, mesh, season)[used] * 255).astype(np.uint8)
-    # Linear-blend skinning: a vertex at t along a branch's segment leans from its base frame
-    # T₀ toward its segment's joint as a cantilever, by t(3 − t)/2 (the renderer's Hermite
-    # curve, without the tip's overshoot, which blend weights cannot express).
-    t = v["curve"][:, 0].astype(np.float64)
-    w2 = v["extra"][:, 0].astype(np.float64) * (1.0 - 0.5 * t * (3.0 - t))
-    j1 = skel.node_joint[ids[:, 0]]
-    j2 = np.where(ids[:, 1] >= 0, skel.node_joint[np.maximum(ids[:, 1], 0)], 0)  # -1: the ground
-    single = (w2 <= 0) | (j1 == j2)
-    joints = np.zeros((len(v), 4), np.uint16)
-    weights = np.zeros((len(v), 4), np.uint8)  # normalised: each vertex's weights sum to 255
-    joints[:, 0] = j1
-    joints[:, 1] = np.where(single, 0, j2)
-    weights[:, 1] = np.where(single, 0, np.round(w2 * 255)).astype(np.uint8)
-    weights[:, 0] = 255 - weights[:, 1]
-    joints[weights == 0] = 0  # a joint listed with no weight is noise to clients (and the validator)
     index = remap[mesh.indices[keep_tris]].astype(np.uint32)
 
     attrs = gl.Attributes(

@@ -57,6 +57,32 @@ def positive(kind, hi: float = LIMIT):
 non_negative = number(float, 0, LIMIT, lo_open=False)
 
 
+#: Joint budgets of ``export --target``, the joints one skin holds for each engine: Unreal
+#: imports 256 bones per skeletal mesh section by default; Unity and Godot take more, but their
+#: editors slow down (Godot's has frozen on skeletons of 600–760 bones); three.js (``web``)
+#: keeps its bone matrices in a texture, and 1,024 keeps a large tree's animation CPU low.
+JOINT_TARGETS = {"unreal": 256, "unity": 256, "godot": 256, "web": 1024}
+
+
+def joint_budget(text: str) -> int | None:
+    """``export --joints``: a whole number >= 2 (the root joint and one more), or ``all`` (None).
+
+    Raises
+    ------
+    ValueError
+        One line, for anything else.
+    """
+    if str(text).strip().lower() == "all":
+        return None
+    try:
+        n = int(text)
+    except ValueError:
+        raise ValueError(f"{text!r}: expected a whole number of joints >= 2, or 'all'") from None
+    if n < 2:
+        raise ValueError(f"{n}: at least 2 joints (the root joint and one more), or 'all'")
+    return n
+
+
 def checked(parse):
     """An argparse type from a parser that raises ValueError with a clear message."""
 
