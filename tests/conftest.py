@@ -4,6 +4,7 @@ durations in tests/durations.json (``pytest --store-durations`` writes them)."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import resource
 import time
@@ -315,3 +316,50 @@ def offscreen():
     off = OffscreenRenderer(160, 120, samples=4)
     yield off
     off.release()
+
+
+# ---------------------------------------------------------------------------- the headless app
+@pytest.fixture(scope="module")
+def cherry():
+    """The small cherry, generated once for the module and read-only (its arrays cannot be
+    written): each app gets a Tree of its own over the same arrays."""
+    import treeanim as ta
+
+    tree = ta.load_preset("small_cherry")
+    for f in dataclasses.fields(tree):
+        value = getattr(tree, f.name)
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+    return tree
+
+
+@pytest.fixture
+def no_display(monkeypatch):
+    """No X or Wayland display for the app: whatever needed one would fail."""
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+
+
+@pytest.fixture()
+def viewer(cherry, no_display):
+    """An app of its own for each test: a headless window (no MSAA, as the viewer on a
+    software rasteriser) and a viewer of the small cherry at rest, calm, the tree model, panel
+    hidden, 480 × 360, framed, one frame drawn (with no display: see ``no_display``)."""
+    from app_helpers import DT, H, W
+    from treeanim.app.headless import HeadlessWindow
+    from treeanim.app.viewer import Viewer
+
+    win = HeadlessWindow(W, H)
+    try:
+        v = Viewer(win, dataclasses.replace(cherry), wind_speed=0.0, show_panel=False)
+    except BaseException:
+        win.close()
+        raise
+    try:
+        v.panel.record_rects = True  # where the widgets are, to click on them
+        win.connect(v)
+        v.frame(DT)
+        yield v
+    finally:
+        v.release()
+        win.close()

@@ -29,45 +29,7 @@ from treeanim.model.params import ModeRange
 from treeanim.physics.pull import SpringPull, TreeDrag
 from treeanim.render.scene import Scene, sun_angles
 
-
-@pytest.fixture(scope="module")
-def cherry():
-    """The small cherry, generated once for the module and read-only (its arrays cannot be
-    written): each app gets a Tree of its own over the same arrays."""
-    tree = ta.load_preset("small_cherry")
-    for f in dataclasses.fields(tree):
-        value = getattr(tree, f.name)
-        if isinstance(value, np.ndarray):
-            value.flags.writeable = False
-    return tree
-
-
-@pytest.fixture(autouse=True)
-def no_display(monkeypatch):
-    """No X or Wayland display for the app: whatever needed one would fail."""
-    monkeypatch.delenv("DISPLAY", raising=False)
-    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
-
-
-@pytest.fixture()
-def viewer(cherry):
-    """An app of its own for each test: a headless window (no MSAA, as the viewer on a
-    software rasteriser) and a viewer of the small cherry at rest, calm, the tree model, panel
-    hidden, 480 × 360, framed, one frame drawn."""
-    win = HeadlessWindow(W, H)
-    try:
-        v = Viewer(win, dataclasses.replace(cherry), wind_speed=0.0, show_panel=False)
-    except BaseException:
-        win.close()
-        raise
-    try:
-        v.panel.record_rects = True  # where the widgets are, to click on them
-        win.connect(v)
-        v.frame(DT)
-        yield v
-    finally:
-        v.release()
-        win.close()
+pytestmark = pytest.mark.usefixtures("no_display")  # the app fixtures: tests/conftest.py
 
 
 # ---------------------------------------------------------------------------- drawing

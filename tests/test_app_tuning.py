@@ -6,48 +6,16 @@ half resolution, no MSAA, no shadows, said in the status line)."""
 
 from __future__ import annotations
 
-import dataclasses
-
 import glfw
 import numpy as np
 import pytest
 
-import treeanim as ta
 from app_helpers import DT, H, W, centre, click, reveal
-from treeanim.app.headless import HeadlessWindow
-from treeanim.app.viewer import Viewer
 
 CTRL, SHIFT = glfw.MOD_CONTROL, glfw.MOD_SHIFT
 
 
-@pytest.fixture(scope="module")
-def cherry():
-    return ta.load_preset("small_cherry")
-
-
-@pytest.fixture(autouse=True)
-def no_display(monkeypatch):
-    monkeypatch.delenv("DISPLAY", raising=False)
-    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
-
-
-@pytest.fixture()
-def viewer(cherry):
-    """A viewer of its own: the small cherry, calm, the tree model, panel hidden, one frame."""
-    win = HeadlessWindow(W, H)
-    try:
-        v = Viewer(win, dataclasses.replace(cherry), wind_speed=0.0, show_panel=False)
-    except BaseException:
-        win.close()
-        raise
-    try:
-        v.panel.record_rects = True
-        win.connect(v)
-        v.frame(DT)
-        yield v
-    finally:
-        v.release()
-        win.close()
+pytestmark = pytest.mark.usefixtures("no_display")  # the app fixtures: tests/conftest.py
 
 
 def key(v, k, mods=0):
