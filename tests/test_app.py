@@ -934,3 +934,29 @@ def test_the_loop_ends_on_a_minimised_headless_window(viewer):
     v = viewer
     v.window.resize(0, 0)
     assert run(v, max_frames=5) == 0 and v.window.should_close
+
+
+def test_the_named_wind_box_shows_the_wind_it_is(viewer, monkeypatch):
+    """Issue 31: the box never showed the active named wind (chosen in it or by --wind-preset).
+    It shows the named wind whose settings the wind has, and none once one is changed."""
+    from imgui_bundle import imgui
+
+    v = viewer
+    v.show_panel = True
+    shown = {}
+    combo = imgui.combo
+
+    def spy(label, current, items, *args):
+        shown[label] = items[current] if current >= 0 else None
+        return combo(label, current, items, *args)
+
+    monkeypatch.setattr(imgui, "combo", spy)
+    assert v.panel.apply("wind_preset", "gale")
+    v.frame(DT)
+    assert shown["named wind"].startswith("gale")
+    assert v.panel.apply("wind_speed", 12.0)
+    v.frame(DT)
+    assert shown["named wind"] is None
+    assert v.panel.apply("wind_preset", "breeze")
+    v.frame(DT)
+    assert shown["named wind"].startswith("breeze")

@@ -18,7 +18,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from ..model.tree import KINDS, PLURAL
-from ..physics.wind import WIND_PRESETS
+from ..physics.wind import WIND_PRESETS, named_wind
 from .keys import help_lines
 from .settings import EI_SPAN, SETTINGS
 
@@ -283,9 +283,12 @@ class Panel:
         if self._header("Wind", open_=True):
             if SETTINGS["wind_preset"].shown(v):
                 names = list(WIND_PRESETS)
-                changed, idx = imgui.combo("named wind", -1, [f"{n} (Bf {WIND_PRESETS[n]['beaufort']})" for n in names])
+                now = named_wind(v.sim.wind)  # the one the wind is now (blank: a wind of its own)
+                current = names.index(now) if now is not None else -1
+                changed, idx = imgui.combo("named wind", current,
+                                           [f"{n} (Bf {WIND_PRESETS[n]['beaufort']})" for n in names])
                 self._rect("named wind", frame_only=True)
-                if changed and 0 <= idx < len(names):
+                if changed and idx != current and 0 <= idx < len(names):
                     self.apply("wind_preset", names[idx])
             for name in WIND_SLIDERS:
                 self.widget(name)

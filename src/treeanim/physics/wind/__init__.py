@@ -79,7 +79,7 @@ import numpy as np
 from .field import DEFAULT_MODEL, WIND_MODELS, WindField, WindParams, register_wind_model, wind_model
 from .paper import PaperParams, PaperWind, fbm_noise
 from .physical import SIGMA_RATIOS, PhysicalParams, PhysicalWind
-from .settings import DEFAULT_BOUNDS, MAX_SPEED, WIND_PRESETS, wind_preset
+from .settings import DEFAULT_BOUNDS, MAX_SPEED, WIND_PRESETS, named_wind, wind_preset
 
 #: The registry under its older name (the same dict).
 MODELS = WIND_MODELS
@@ -111,5 +111,5 @@ def fit_to_tree(wind, rest_positions) -> None:
         wind.bounds = box
 
 __all__ = ["fit_to_tree", "fbm_noise", "WindField", "WindParams", "WIND_MODELS", "DEFAULT_MODEL", "register_wind_model",
-           "wind_model", "PhysicalWind", "PhysicalParams", "PaperWind", "PaperParams", "WIND_PRESETS", "wind_preset",
+           "wind_model", "PhysicalWind", "PhysicalParams", "PaperWind", "PaperParams", "WIND_PRESETS", "wind_preset", "named_wind",
            "MODELS", "DEFAULT_BOUNDS", "MAX_SPEED", "SIGMA_RATIOS"]

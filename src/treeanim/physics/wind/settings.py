@@ -52,6 +52,17 @@ WIND_PRESETS: dict[str, dict] = {
 }
 
 
+def named_wind(wind) -> str | None:
+    """The named wind (:data:`WIND_PRESETS`) whose settings ``wind`` has now, or None: a
+    physical wind whose speed, turbulence and gusts are one's, to within rounding."""
+    if getattr(wind, "model", None) != "physical":
+        return None
+    for name, preset in WIND_PRESETS.items():
+        if all(abs(float(getattr(wind, k)) - v) <= 1e-9 * max(1.0, abs(v)) for k, v in preset.items() if k != "beaufort"):
+            return name
+    return None
+
+
 def wind_preset(name: str, model: str | None = None) -> dict:
     """WindField keyword arguments for a named wind (physical model).
 
