@@ -960,3 +960,22 @@ def test_the_named_wind_box_shows_the_wind_it_is(viewer, monkeypatch):
     assert v.panel.apply("wind_preset", "breeze")
     v.frame(DT)
     assert shown["named wind"].startswith("breeze")
+
+
+def test_the_trace_of_a_released_branch_shrinks_away_as_the_swing_dies(viewer):
+    """Issue 31: the last pull's trace stayed on screen until R. It keeps the swing's last
+    seconds: once the branch is still again it is a point."""
+    v = viewer
+    obj, x, y = branch_on_screen(v)
+    press(v, x, y)
+    v.on_cursor_pos(x + 40, y + 25)
+    for _ in range(60):
+        v.advance(DT)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    for _ in range(60):
+        v.advance(DT)
+    swing = np.ptp(v.trace.points, axis=0).max()
+    for _ in range(60 * 20):
+        v.advance(DT)
+    assert swing > 0.02, swing
+    assert np.ptp(v.trace.points, axis=0).max() < 0.05 * swing

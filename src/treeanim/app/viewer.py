@@ -131,7 +131,9 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning):
         self.show_wind = False
         self.grab: TreeDrag | SpringPull | None = None
         self.traced: tuple[int, float] | None = None  # (object, s) of the point the trace follows
-        self.trace = PullTrace(capacity=2400)
+        # the last 6 s of steps: after a release, the swing's last seconds, shrinking to a point
+        # as it dies away (with 40 s the last pull's path stayed on screen until R)
+        self.trace = PullTrace(capacity=360)
         self.camera = OrbitCamera(azimuth=20.0, elevation=TREE_ELEVATION)
         self.messages: list[str] = []  # lines for the panel's status line (newest last)
         self.preset_path = self._default_path = ""
