@@ -5,6 +5,7 @@
 // sun that reaches the point (sun_visibility); `highlight` 1 marks the grabbed object.
 
 #include "common.glsl"
+#include "constants.glsl"
 
 vec3 tree_light(vec3 albedo, vec3 n, vec3 V, float ao, float sun, bool foliage, float highlight) {
     float ndl = dot(n, u_sun_dir);
@@ -17,5 +18,5 @@ vec3 tree_light(vec3 albedo, vec3 n, vec3 V, float ao, float sun, bool foliage, 
         vec3 H = normalize(V + u_sun_dir);
         c += u_sun_color * 0.06 * pow(max(dot(n, H), 0.0), 40.0) * step(0.0, ndl) * sun;
     }
-    return mix(c, vec3(1.0, 0.45, 0.05) * 1.5, 0.55 * highlight);
+    return mix(c, C_HIGHLIGHT * 1.5, 0.55 * highlight);
 }

@@ -301,8 +301,28 @@ def test_highlight_tints_the_object(scene):
     diff = changed(lit, base)
     assert diff.sum() > 30
     px = lit[diff].astype(float)
-    assert np.mean(px[:, 0] - px[:, 2]) > 60  # orange
+    assert np.mean(px[:, 0] - px[:, 1]) > 60 and np.mean(px[:, 2] - px[:, 1]) > 60  # violet
     assert not changed(off.render(cam), base).any()
+
+
+def test_the_highlight_stands_apart_from_every_leaf_blade_and_bark_colour():
+    """Issue 31: the orange highlight vanished among autumn leaves. Its hue is now at least 60°
+    from every colour of the palette, summer's greens through autumn's reds, and from the
+    presets' bark."""
+    import colorsys
+
+    from treeanim.model.presets import list_presets, load_preset
+    from treeanim.render import palette
+
+    def hue(rgb):
+        return 360.0 * colorsys.rgb_to_hsv(*rgb)[0]
+
+    h = hue(palette.HIGHLIGHT)
+    others = [c for n, c in palette.COLOURS.items() if n != "HIGHLIGHT"]
+    others += [load_preset(p).bark.color for p in list_presets()]
+    for rgb in others:
+        d = abs(h - hue(rgb)) % 360.0
+        assert min(d, 360.0 - d) >= 60.0, (rgb, hue(rgb), h)
 
 
 # ------------------------------------------------------------------------------ overlays

@@ -14,6 +14,7 @@ BLADE_BASE = (0.10, 0.24, 0.05)
 BLADE_TIP = (0.42, 0.58, 0.16)
 BLADE_TIP_DRY = (0.55, 0.60, 0.22)
 BLADE_WINTER = (0.62, 0.55, 0.32)
+HIGHLIGHT = (0.85, 0.15, 1.0)  # the grabbed object's tint: a violet no leaf, blade or bark takes
 
 #: Every colour above, by name (the shader's constants).
 COLOURS = {name: value for name, value in globals().items() if name.isupper() and isinstance(value, tuple)}
