@@ -87,6 +87,11 @@ class Gui:
         style.item_spacing = imgui.ImVec2(6.0, 3.0)
         c = style.color_(imgui.Col_.window_bg)
         style.set_color_(imgui.Col_.window_bg, imgui.ImVec4(c.x, c.y, c.z, 0.86))
+        # a slider's knob narrow and see-through: its value, drawn over it, stays readable
+        style.grab_min_size = 5.0
+        for col, alpha in ((imgui.Col_.slider_grab, 0.45), (imgui.Col_.slider_grab_active, 0.7)):
+            c = style.color_(col)
+            style.set_color_(col, imgui.ImVec4(c.x, c.y, c.z, alpha))
         if scale != 1.0:
             style.scale_all_sizes(scale)
         path = _font_path()
