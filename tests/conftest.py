@@ -34,8 +34,8 @@ WINDOW_MODULES = {"test_app_window", "test_render_window"}
 #: Each test's measured CPU seconds (node id -> s), written by ``pytest --store-durations``.
 DURATIONS = Path(__file__).with_name("durations.json")
 #: A test measured at this many CPU seconds or more is marked ``slow``: ``-m "not slow"`` is the
-#: quick loop (0.25 s keeps it under 30 s of CPU; at 0.4 s it took 43 s, at 1 s a minute).
-SLOW_SECONDS = 0.25
+#: quick loop (0.2 s keeps it under 30 s of CPU; at 0.4 s it took 43 s, at 1 s a minute).
+SLOW_SECONDS = 0.2
 
 
 def pytest_addoption(parser):
