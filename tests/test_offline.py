@@ -275,6 +275,18 @@ def test_trace_with_fewer_than_two_samples_is_refused():
     assert len(tr.times) == 2 and np.all(np.isfinite(tr.tips))
 
 
+@pytest.mark.parametrize("hold,seconds,rate", [(0.5, 1e12, 1000.0), (1e12, 1.0, 1000.0)])
+def test_a_trace_too_long_to_keep_is_refused_before_it_starts(hold, seconds, rate):
+    """From Python (the command line's frame check aside) a trace of 10^15 samples tried to
+    allocate them; a hold of 10^15 steps would never end."""
+    from treeanim.physics.simulation import Simulation
+
+    sim = Simulation(ta.load_preset("beam"))
+    with pytest.raises(InputError, match="samples; at most"):
+        run_trace(sim, 0, (1.0, 0.0, 0.0), hold, seconds, rate)
+    assert sim.time == 0.0 and not sim.pulls
+
+
 # ------------------------------------------------------------------------------ bench
 def test_bench_wind_beyond_the_fields_limit_is_input_error(monkeypatch):
     from treeanim.physics.wind import MAX_SPEED

@@ -41,8 +41,10 @@ def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float, dr
     Raises
     ------
     InputError
-        ``seconds`` or ``rate`` not finite and positive, or so small that fewer than 2 samples
-        would follow the release (checked before anything is simulated).
+        ``seconds`` or ``rate`` not finite and positive, so small that fewer than 2 samples
+        would follow the release, or so large that the hold or the trace would take more than
+        a quarter of :data:`~treeanim.physics.trace.MAX_TRACE_VALUES` samples (checked before
+        anything is simulated or allocated).
     """
     from ..driver import FrameDriver
     from ..scripted import Drag, Pull, Schedule
@@ -51,7 +53,13 @@ def run_trace(sim, obj: int, force, hold: float, seconds: float, rate: float, dr
         positive_float("--seconds", seconds), positive_float("--rate", rate)
     except ValueError as e:
         raise InputError(str(e)) from None
-    samples = int(round(seconds * rate)) + 1  # the release and every sample after it
+    from ..physics.trace import MAX_TRACE_VALUES
+
+    samples = seconds * rate + 1  # the release and every sample after it
+    if not 4 * max(samples, hold * rate) <= MAX_TRACE_VALUES:  # a time and a point a sample
+        raise InputError(f"--seconds {seconds:g} and --hold {hold:g} at --rate {rate:g} Hz are {samples:.3g} samples; "
+                         f"at most {MAX_TRACE_VALUES // 4:,}")
+    samples = int(round(samples))
     if samples < 2:
         raise InputError(f"--seconds {seconds:g} at --rate {rate:g} Hz gives {samples} sample after release; "
                          f"a trace needs at least 2 samples")
