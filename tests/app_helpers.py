@@ -10,6 +10,7 @@ import glfw
 import numpy as np
 
 import treeanim as ta
+from treeanim.app.viewer import Viewer
 
 #: The apps' size in screen units, and a 60 Hz frame.
 W, H = 480, 360
@@ -117,3 +118,23 @@ def unsimulable(name="beam"):
     physics = dataclasses.replace(p, summer=dataclasses.replace(p.summer, branch=None),
                                   winter=dataclasses.replace(p.winter, branch=None))
     return dataclasses.replace(tree, physics=physics)
+
+
+def open_viewer(win, tree, ready=lambda v: None):
+    """A viewer of ``tree`` in ``win`` as the app tests use it (calm, the tree model, panel
+    hidden, its widgets' rects recorded), ``ready(v)`` then one frame drawn; yields it, and
+    releases it and closes the window after (the window too if the viewer fails to open)."""
+    try:
+        v = Viewer(win, tree, wind_speed=0.0, show_panel=False)
+    except BaseException:
+        win.close()
+        raise
+    try:
+        v.panel.record_rects = True  # where the widgets are, to click on them
+        win.connect(v)
+        ready(v)
+        v.frame(DT)
+        yield v
+    finally:
+        v.release()
+        win.close()

@@ -345,21 +345,7 @@ def viewer(cherry, no_display):
     """An app of its own for each test: a headless window (no MSAA, as the viewer on a
     software rasteriser) and a viewer of the small cherry at rest, calm, the tree model, panel
     hidden, 480 × 360, framed, one frame drawn (with no display: see ``no_display``)."""
-    from app_helpers import DT, H, W
+    from app_helpers import H, W, open_viewer
     from treeanim.app.headless import HeadlessWindow
-    from treeanim.app.viewer import Viewer
 
-    win = HeadlessWindow(W, H)
-    try:
-        v = Viewer(win, dataclasses.replace(cherry), wind_speed=0.0, show_panel=False)
-    except BaseException:
-        win.close()
-        raise
-    try:
-        v.panel.record_rects = True  # where the widgets are, to click on them
-        win.connect(v)
-        v.frame(DT)
-        yield v
-    finally:
-        v.release()
-        win.close()
+    yield from open_viewer(HeadlessWindow(W, H), dataclasses.replace(cherry))

@@ -18,7 +18,7 @@ import glfw
 import pytest
 
 import treeanim as ta
-from app_helpers import DT, H, W, check_tree_and_panel, unsimulable
+from app_helpers import DT, H, W, check_tree_and_panel, open_viewer, unsimulable
 from treeanim.app import window as window_module
 from treeanim.app.viewer import Viewer, run
 from treeanim.app.window import Window
@@ -30,20 +30,7 @@ def viewer():
     the small cherry at rest, calm, the tree model, panel hidden, 480 × 360, framed, one frame
     drawn."""
     win = Window.open(W, H, "treeanim test", samples=4)  # 4x MSAA: screenshots resolve it
-    try:
-        v = Viewer(win, ta.load_preset("small_cherry"), wind_speed=0.0, show_panel=False)
-    except BaseException:
-        win.close()
-        raise
-    try:
-        v.panel.record_rects = True  # where the widgets are, to click on them
-        win.connect(v)
-        _settle(v, (W, H))
-        v.frame(DT)
-        yield v
-    finally:
-        v.release()
-        win.close()
+    yield from open_viewer(win, ta.load_preset("small_cherry"), ready=lambda v: _settle(v, (W, H)))
 
 
 def _settle(v, size):
