@@ -48,6 +48,19 @@ def axis_spectrum(field: np.ndarray) -> np.ndarray:
     return np.mean(out, axis=0)
 
 
+def save_profile(plt, fig, bx, title: str, out: Path) -> Path:
+    """Label the profile's axes ``bx``, title it, and write ``fig`` as out/wind_slice.png."""
+    bx.set_xlabel("speed (m/s)")
+    bx.set_ylabel("height y (m)")
+    bx.set_title(title)
+    bx.legend(fontsize=7, loc="lower right")
+    fig.tight_layout()
+    path = out / "wind_slice.png"
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
 def physical_plots(args, plt) -> tuple[Path, Path]:
     """The default physical wind: spectra at fixed points over time, a slice and the profile."""
     from scipy.signal import welch
@@ -123,15 +136,7 @@ def physical_plots(args, plt) -> tuple[Path, Path]:
     bx.plot(U * wind.profile(heights), heights, "-", color="tab:red", label="U · canopy profile")
     bx.plot(along.std(axis=0), heights, "s", ms=3, color="tab:green", label="measured σ_u")
     bx.axhline(H, color="0.5", lw=0.8, ls=":")
-    bx.set_xlabel("speed (m/s)")
-    bx.set_ylabel("height y (m)")
-    bx.set_title("Mean profile")
-    bx.legend(fontsize=7, loc="lower right")
-    fig.tight_layout()
-    slice_png = args.out / "wind_slice.png"
-    fig.savefig(slice_png)
-    plt.close(fig)
-    return spectrum_png, slice_png
+    return spectrum_png, save_profile(plt, fig, bx, "Mean profile", args.out)
 
 
 def paper_plots(args, plt) -> tuple[Path, Path]:
@@ -209,16 +214,7 @@ def paper_plots(args, plt) -> tuple[Path, Path]:
             label=f"speed·c1·ln(c2·h), c1 = {wind.c1:.3f}, c2 = {wind.c2:g}/m")
     bx.plot(fit * law, heights, "-", color="tab:red",
             label=f"c1·ln(c2·h) × {fit:.2f} m/s (least squares)")
-    bx.set_xlabel("speed (m/s)")
-    bx.set_ylabel("height y (m)")
-    bx.set_title("Mean profile (Eq. 16)")
-    bx.legend(fontsize=7, loc="lower right")
-    fig.tight_layout()
-    slice_png = args.out / "wind_slice.png"
-    fig.savefig(slice_png)
-    plt.close(fig)
-
-    return spectrum_png, slice_png
+    return spectrum_png, save_profile(plt, fig, bx, "Mean profile (Eq. 16)", args.out)
 
 
 
