@@ -192,8 +192,3 @@ def format_row(r: dict) -> str:
     return (f"| {name} | {pair(r['objects'], r['paper_objects'])} | {pair(r['nodes'], r['paper_nodes'])} "
             f"| {pair(r['triangles'], r['paper_triangles'])} | {r['sim_ms']:.1f} | {r['render_ms']:.1f} "
             f"| {r['fps']:.1f} / {pf if pf is not None else '—'} |")
-
-
-def format_bench(result: dict) -> str:
-    """The benchmark as a Markdown table with its machine line."""
-    return "\n".join([format_head(result), *map(format_row, result["rows"])])
