@@ -56,9 +56,12 @@ def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
 def cmd_export(args) -> int:
     """Bake the simulated motion into a glTF 2.0 file: n frames at --fps make n + 1 keys, the
     last at exactly --seconds (a loop's repeats its first: :mod:`treeanim.loop`)."""
-    from treeanim import export, joints, loop
+    from treeanim import export, export_usd, joints, loop
 
-    out = output_path(args.out, (".glb", ".gltf"))
+    out = output_path(args.out, (".glb", ".gltf", *export_usd.USD_SUFFIXES))
+    usd = out.suffix.lower() in export_usd.USD_SUFFIXES
+    if usd:
+        export_usd.require_usd()
     n = opt.check_frames(args.seconds, args.fps)
     if abs(args.seconds * args.fps - n) > 1e-6 * max(n, 1):
         whole = sorted({max(int(args.seconds * args.fps), 1), int(args.seconds * args.fps) + 1})
@@ -79,8 +82,11 @@ def cmd_export(args) -> int:
     full = skel
     skel, raw, mesh, error = joints.fit(tree, full, raw, n, budget, sim.present)
     keys = loop.close_loop(raw, n) if fade else raw
-    doc, data = export.build_gltf(tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel)
-    files = export.write_gltf(out, doc, data)
+    if usd:
+        files = export_usd.write_usd(out, tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel)
+    else:
+        doc, data = export.build_gltf(tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel)
+        files = export.write_gltf(out, doc, data)
     size = sum(f.stat().st_size for f in files)
     print(f"wrote {', '.join(map(str, files))}: {skel.count} joints, {n} frames at {args.fps:g} fps, "
           f"{n + 1} keys from 0 to {n / args.fps:.2f} s, {size / 1e6:.1f} MB")
@@ -342,11 +348,13 @@ def build_parser() -> argparse.ArgumentParser:
                    "and tip")
     p.set_defaults(func=cmd_info)
 
-    p = sub.add_parser("export", help="bake the animation into a glTF 2.0 file (.glb or .gltf)",
-                       description="Simulate and bake the motion into a glTF 2.0 file: the mesh, a skin with one "
-                       "joint per segment and rotation keys at --fps. Opens in Blender, three.js and game engines.")
+    p = sub.add_parser("export", help="bake the animation into a glTF 2.0 (.glb, .gltf) or USD file",
+                       description="Simulate and bake the motion into a glTF 2.0 or a USD (UsdSkel) file: the mesh, a "
+                       "skin with one joint per segment and rotation keys at --fps. Opens in Blender, three.js, game "
+                       "engines and USD tools.")
     opt.add_scene_options(p)
-    p.add_argument("--out", required=True, help="output file: tree.glb, or tree.gltf (+ tree.bin)")
+    p.add_argument("--out", required=True, help="output file: tree.glb, tree.gltf (+ tree.bin), or tree.usda (text), tree.usdc or "
+                   "tree.usd (binary; needs usd-core)")
     p.add_argument("--loop", type=opt.non_negative, default=0.0, metavar="SECONDS",
                    help="make the clip loop: the simulation runs this many seconds past the end and cross-fades into the "
                    "clip's start; the last key repeats the first (default 0: no loop)")

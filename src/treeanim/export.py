@@ -119,6 +119,18 @@ def local_rotations(skel: Skeleton, rotations: np.ndarray) -> np.ndarray:
     return quaternions(local)
 
 
+def rest_joints(tree: Tree, skel: Skeleton) -> np.ndarray:
+    """(J, 3) each joint's world position at rest (the root joint at the origin)."""
+    return np.concatenate([np.zeros((1, 3)), tree.rest_positions[skel.joint_node[1:]]])
+
+
+def rest_translations(tree: Tree, skel: Skeleton) -> np.ndarray:
+    """(J, 3) each joint's translation from its parent joint at rest: its local translation,
+    as every joint's frame is axis-aligned at rest."""
+    rest = rest_joints(tree, skel)
+    return rest - np.where(skel.joint_parent[:, None] >= 0, rest[np.maximum(skel.joint_parent, 0)], 0.0)
+
+
 # ---------------------------------------------------------------------------- mesh
 #: The most bytes of animation keys :func:`bake` allocates (float32 quaternions).
 MAX_KEY_BYTES = 8e9
