@@ -13,87 +13,12 @@ import threading
 
 from . import options as opt
 from .errors import GLUnavailable, InputError, UsageError
+from .offline.export import cmd_export
+from .options import load_any, make_simulation, output_path
 from .table1 import ROWS, TABLE1, TABLE1_FPS
 
 #: What plain ``treeanim`` runs.
 DEFAULT_COMMAND = ["view"]
-
-
-def make_simulation(args):
-    """The tree and a Simulation set up from :func:`treeanim.options.add_scene_options`."""
-    import treeanim as ta
-    from treeanim.scripted import check_pulls
-
-    tree = load_any(args.preset, args)
-    try:
-        check_pulls(opt.scheduled(args), tree.n_objects, opt.model(args))
-        wind = None
-        kw = opt.wind_settings(args)
-        if kw["speed"] > 0:
-            wind = ta.WindField(**kw)
-        sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed, model=opt.model(args))
-    except ValueError as e:
-        raise UsageError(str(e)) from None
-    return tree, sim
-
-
-def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
-    """Check an output path: a known extension and a folder where files can really be created."""
-    from pathlib import Path
-
-    from treeanim.offline.target import check_file
-
-    path = Path(text)
-    if path.suffix.lower() not in suffixes:
-        raise UsageError(f"{option} {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
-    try:
-        check_file(path, text)
-    except InputError as e:
-        raise UsageError(str(e).replace("--out ", f"{option} ", 1)) from None
-    return path
-
-
-def cmd_export(args) -> int:
-    """Bake the simulated motion into a glTF 2.0 file: n frames at --fps make n + 1 keys, the
-    last at exactly --seconds (a loop's repeats its first: :mod:`treeanim.loop`)."""
-    from treeanim import export, export_usd, joints, loop
-
-    out = output_path(args.out, (".glb", ".gltf", *export_usd.USD_SUFFIXES))
-    usd = out.suffix.lower() in export_usd.USD_SUFFIXES
-    if usd:
-        export_usd.require_usd()
-    n = opt.check_frames(args.seconds, args.fps)
-    if abs(args.seconds * args.fps - n) > 1e-6 * max(n, 1):
-        whole = sorted({max(int(args.seconds * args.fps), 1), int(args.seconds * args.fps) + 1})
-        raise UsageError(f"--seconds {args.seconds:g} at --fps {args.fps:g} is {args.seconds * args.fps:.4g} frames; a clip "
-                         f"holds whole frames: try --seconds {' or '.join(f'{k / args.fps:.6g}' for k in whole)}")
-    if n < 2:
-        raise UsageError(f"--seconds {args.seconds:g} at --fps {args.fps:g} gives fewer than 2 frames")
-    fade = max(opt.check_frames(args.loop, args.fps), 1) if args.loop > 0 else 0
-    if fade >= n:
-        raise UsageError(f"--loop {args.loop:g}: the cross-fade must be shorter than --seconds")
-    budget = args.joints if args.target is None else opt.JOINT_TARGETS[args.target]
-    tree, sim = make_simulation(args)
-    skel = export.skeleton(tree, sim.present)
-    try:
-        raw = export.bake(sim, skel, n + max(fade, 1), args.fps, opt.scheduled(args), quiet=args.quiet)
-    except ValueError as e:
-        raise UsageError(str(e)) from None
-    full = skel
-    skel, raw, mesh, error = joints.fit(tree, full, raw, n, budget, sim.present)
-    keys = loop.close_loop(raw, n) if fade else raw
-    if usd:
-        files = export_usd.write_usd(out, tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel)
-    else:
-        doc, data = export.build_gltf(tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel)
-        files = export.write_gltf(out, doc, data)
-    size = sum(f.stat().st_size for f in files)
-    print(f"wrote {', '.join(map(str, files))}: {skel.count} joints, {n} frames at {args.fps:g} fps, "
-          f"{n + 1} keys from 0 to {n / args.fps:.2f} s, {size / 1e6:.1f} MB")
-    print(joints.report(full, skel, budget, error))
-    if fade:
-        print(loop.seam(keys, raw).line())
-    return 0
 
 
 # ---------------------------------------------------------------------------- render | trace | bench
@@ -245,23 +170,6 @@ def cmd_view(args) -> int:
     return 0
 
 
-def load_any(name_or_path: str, args=None):
-    """A preset or a scene by name, a preset or scene TOML file or a TreeQSM model (.txt, .csv,
-    .mat) by path, with ``args``' --leaves (QSM only), --modes and --physics."""
-    import dataclasses
-
-    from treeanim.model.load import load_named
-
-    leaves, modes = getattr(args, "leaves", None), getattr(args, "modes", None)
-    tree = load_named(name_or_path, leaves=leaves)
-    if modes is not None:
-        tree.modes = modes
-    settings = dict(getattr(args, "physics", None) or ())
-    if settings:
-        tree = dataclasses.replace(tree, physics=dataclasses.replace(tree.physics, **settings))
-    return tree
-
-
 def cmd_list(args) -> int:
     """The shipped presets and scenes, a line each: name, size and description."""
     from treeanim.describe import preset_lines, scene_list_lines
@@ -355,6 +263,10 @@ def build_parser() -> argparse.ArgumentParser:
     opt.add_scene_options(p)
     p.add_argument("--out", required=True, help="output file: tree.glb, tree.gltf (+ tree.bin), or tree.usda (text), tree.usdc or "
                    "tree.usd (binary; needs usd-core)")
+    p.add_argument("--motion", choices=("keys", "shader"), default="keys",
+                   help="keys (default): the simulated motion as rotation keys on a skeleton; shader: a static mesh "
+                   "whose vertices carry their branches' pivots, axes and measured frequency, damping and compliance, "
+                   "for the reference shader wind (shaders/engine_wind.glsl; .glb or .gltf)")
     p.add_argument("--loop", type=opt.non_negative, default=0.0, metavar="SECONDS",
                    help="make the clip loop: the simulation runs this many seconds past the end and cross-fades into the "
                    "clip's start; the last key repeats the first (default 0: no loop)")

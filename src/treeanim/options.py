@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 
 from .driver import step_for
-from .errors import UsageError
+from .errors import InputError, UsageError
 
 #: Upper bound of times, rates and counts on the command line: large enough for any real use,
 #: small enough that products of them stay finite and allocations sane.
@@ -295,3 +295,55 @@ def samples(text: str) -> int:
     if value not in SAMPLES:
         raise argparse.ArgumentTypeError(f"expected one of {', '.join(map(str, SAMPLES))}, got {shown(text)}")
     return value
+
+
+# ---------------------------------------------------------------------------- what commands build from their options
+def make_simulation(args):
+    """The tree and a Simulation set up from :func:`treeanim.options.add_scene_options`."""
+    import treeanim as ta
+    from treeanim.scripted import check_pulls
+
+    tree = load_any(args.preset, args)
+    try:
+        check_pulls(scheduled(args), tree.n_objects, model(args))
+        wind = None
+        kw = wind_settings(args)
+        if kw["speed"] > 0:
+            wind = ta.WindField(**kw)
+        sim = ta.Simulation(tree, wind=wind, season=args.season, seed=args.seed, model=model(args))
+    except ValueError as e:
+        raise UsageError(str(e)) from None
+    return tree, sim
+
+
+def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
+    """Check an output path: a known extension and a folder where files can really be created."""
+    from pathlib import Path
+
+    from treeanim.offline.target import check_file
+
+    path = Path(text)
+    if path.suffix.lower() not in suffixes:
+        raise UsageError(f"{option} {text}: unknown extension {path.suffix or '(none)'!r}; expected {', '.join(suffixes)}")
+    try:
+        check_file(path, text)
+    except InputError as e:
+        raise UsageError(str(e).replace("--out ", f"{option} ", 1)) from None
+    return path
+
+
+def load_any(name_or_path: str, args=None):
+    """A preset or a scene by name, a preset or scene TOML file or a TreeQSM model (.txt, .csv,
+    .mat) by path, with ``args``' --leaves (QSM only), --modes and --physics."""
+    import dataclasses
+
+    from treeanim.model.load import load_named
+
+    leaves, modes = getattr(args, "leaves", None), getattr(args, "modes", None)
+    tree = load_named(name_or_path, leaves=leaves)
+    if modes is not None:
+        tree.modes = modes
+    settings = dict(getattr(args, "physics", None) or ())
+    if settings:
+        tree = dataclasses.replace(tree, physics=dataclasses.replace(tree.physics, **settings))
+    return tree

@@ -1,0 +1,221 @@
+"""Shader wind for engines: a static mesh whose vertices carry their branch hierarchy and each
+branch's physical parameters, for a vertex shader to sway it (``shaders/engine_wind.glsl``, the
+reference; ``examples/shader_wind/index.html`` runs it in three.js).
+
+Each vertex carries up to :data:`LEVELS` levels of the branches it hangs from: the trunk and the
+three innermost (its own object, its parent, its grandparent; a leaf is its own level). Per
+level, attributes ``_PIVOT{l}`` (the branch's base at rest, xyz; its sway frequency in Hz, w;
+0 = no such level) and ``_AXIS{l}`` (the branch's rest direction, xyz; its compliance, w: the
+mean bend in rad is compliance·U^n in a wind of U m/s at the canopy top), and ``_DAMPING`` (the
+damping ratio of each level); the exponent n is the mesh's ``extras.treeanim_wind.exponent``.
+All come from the simulation of the tree (docs/design.md §16):
+
+- **compliance** and **exponent**: the mean bends of the branches against their parents in
+  steady winds of :data:`CALIBRATION_WINDS` m/s along x. Drag grows as U² on rigid wood and
+  slower where leaves reconfigure (Vogel's exponent), so the tree's bends grow as U^n, n fitted
+  to their sums at the two speeds; a branch's compliance is its bends' geometric mean over
+  U^n's;
+- **frequency** and **damping**: the wind then stops, and every branch swings back and rings
+  down: its frequency is the peak of its bend's spectrum, its damping ratio the decay of the
+  swing's RMS between the two halves of the record (ζ = ln(r)/(2πfΔt)).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import scripted
+from .export import skeleton, skin, vertex_colours
+from .model.tree import Tree
+from .physics.simulation import Simulation
+from .physics.wind.field import WindField
+from .render.mesh import TreeMesh, build_mesh
+
+__all__ = ["LEVELS", "CALIBRATION_WINDS", "BranchTable", "branch_table", "level_chains", "level_compliance",
+           "build_shader_gltf"]
+
+#: Levels of branches a vertex carries (Unreal's Pivot Painter and SpeedTree use 3–4).
+LEVELS = 4
+#: The steady winds (m/s at the canopy top) the branches' bends are measured in: a breeze and a gale.
+CALIBRATION_WINDS = (5.0, 15.0)
+#: Seconds each steady wind blows (the last half measured) and the ring-down after the last stops.
+SETTLE, RING = 5.0, 6.0
+#: The rate the calibration run is stepped and sampled at (frames per second): fine enough that the
+#: implicit step adds no damping of its own to a leaf's 10–15 Hz (at 1/60 s it doubles a beam's ζ).
+RATE = 240.0
+
+
+@dataclass(frozen=True)
+class BranchTable:
+    """Per object: its base, rest direction and sway parameters (see the module docstring)."""
+
+    pivot: np.ndarray       # (M, 3)
+    axis: np.ndarray        # (M, 3) unit
+    frequency: np.ndarray   # (M,) Hz
+    damping: np.ndarray     # (M,) ζ
+    compliance: np.ndarray  # (M,) rad per (m/s)^exponent
+    exponent: float         # the bends grow as U^exponent
+
+
+def _bend(tree: Tree, positions: np.ndarray, rotations: np.ndarray) -> np.ndarray:
+    """(M,) each object's bend: the turn of its chord (base to tip) from rest, in its parent's
+    frame at the attachment, about the z axis (across a wind along x; rad, signed). The whole
+    branch turning about its base is what the shader moves."""
+    first, last = tree.object_start, tree.object_start + tree.object_count - 1
+    att = tree.attach_node
+    P = np.where(att[:, None, None] >= 0, rotations[np.maximum(att, 0)], np.eye(3))
+    rest = tree.rest_positions[last] - tree.rest_positions[first]
+    now = np.einsum("mki,mk->mi", P, positions[last] - positions[first])  # Pᵀ·chord
+    rest /= np.maximum(np.linalg.norm(rest, axis=1, keepdims=True), 1e-300)
+    now /= np.maximum(np.linalg.norm(now, axis=1, keepdims=True), 1e-300)
+    return np.arcsin(np.clip(rest[:, 0] * now[:, 1] - rest[:, 1] * now[:, 0], -1.0, 1.0))
+
+
+def branch_table(tree: Tree, season: float = 0.0) -> BranchTable:
+    """Measure every object's sway parameters from the simulation of ``tree`` (module docstring).
+
+    Parameters
+    ----------
+    tree : Tree
+    season : float
+        Leaves present (0 = summer … 1 = winter).
+
+    Returns
+    -------
+    BranchTable
+    """
+    u1, u2 = CALIBRATION_WINDS
+    sim = Simulation(tree, season=season)
+    settle, ring = int(SETTLE * RATE), int(RING * RATE)
+    bends = []
+    for k in scripted.frames(sim, 2 * settle + ring, RATE, []):
+        if k in (0, settle):  # the gale, then the breeze (from the gale's lean, so less to settle)
+            sim.wind = WindField(speed=u2 if k == 0 else u1, turbulence=0.0, gust_strength=0.0)
+        elif k == 2 * settle:
+            sim.wind = None  # calm: every branch swings back and rings down
+        bends.append(_bend(tree, sim.positions, sim.rotations))
+    bends = np.array(bends)
+    b2 = np.abs(bends[settle // 2:settle].mean(axis=0))
+    b1 = np.abs(bends[settle + settle // 2:2 * settle].mean(axis=0))
+    exponent = float(np.log(b2.sum() / max(b1.sum(), 1e-300)) / np.log(u2 / u1))
+    compliance = np.sqrt(b1 * b2) / (u1 * u2) ** (0.5 * exponent)
+    settle *= 2
+    swing = bends[settle:] - bends[-ring // 4:].mean(axis=0)
+    pad = 8 * len(swing)  # zero-padded: the peak between the bins of a few seconds' record
+    spectrum = np.abs(np.fft.rfft(swing * np.hanning(len(swing))[:, None], n=pad, axis=0))
+    freqs = np.fft.rfftfreq(pad, 1.0 / RATE)
+    frequency = freqs[1:][np.argmax(spectrum[1:], axis=0)]
+    half = len(swing) // 2
+    r = np.sqrt(np.mean(swing[:half] ** 2, axis=0) / np.maximum(np.mean(swing[half:] ** 2, axis=0), 1e-300))
+    damping = np.log(np.maximum(r, 1.0)) / (2.0 * np.pi * np.maximum(frequency, 1e-6) * half / RATE)
+
+    X = tree.rest_positions
+    base = X[tree.object_start]
+    tip = X[tree.object_start + tree.object_count - 1]
+    axis = tip - base
+    axis /= np.maximum(np.linalg.norm(axis, axis=1, keepdims=True), 1e-12)
+    return BranchTable(pivot=base, axis=axis, frequency=frequency, damping=np.clip(damping, 0.01, 2.0),
+                       compliance=compliance, exponent=exponent)
+
+
+def level_chains(tree: Tree) -> tuple[np.ndarray, np.ndarray]:
+    """The branches each object's vertices sway with, trunk first.
+
+    Returns
+    -------
+    levels : (M, LEVELS) int
+        The objects whose frequency, damping and axis each level takes: the root and the three
+        innermost of the object's chain (−1 where the chain is shorter).
+    pivots : (M, LEVELS) int
+        The object whose base is each level's pivot: the level's own, except where the chain
+        skips branches between the root and level 1: that level then swings them and its
+        object as one piece about the first skipped branch's base.
+    """
+    levels = np.full((tree.n_objects, LEVELS), -1, np.int64)
+    pivots = levels.copy()
+    for o in range(tree.n_objects):
+        chain = [o]
+        while tree.parent[chain[-1]] >= 0:
+            chain.append(int(tree.parent[chain[-1]]))
+        chain.reverse()
+        kept = chain if len(chain) <= LEVELS else chain[:1] + chain[-(LEVELS - 1):]
+        levels[o, :len(kept)] = kept
+        pivots[o, :len(kept)] = kept
+        if len(chain) > LEVELS:
+            pivots[o, 1] = chain[1]
+    return levels, pivots
+
+
+def level_compliance(tree: Tree, table: BranchTable, levels: np.ndarray) -> np.ndarray:
+    """(M, LEVELS) each level's compliance: the bends of every branch from the level above it
+    (exclusive) to its own (inclusive) added up, so a level standing for skipped branches
+    bends as much as they do together (small bends about nearly parallel axes add)."""
+    cum = table.compliance.astype(float).copy()
+    for o in range(tree.n_objects):  # parents come first
+        if tree.parent[o] >= 0:
+            cum[o] += cum[tree.parent[o]]
+    on = levels >= 0
+    c = np.where(on, cum[np.maximum(levels, 0)], 0.0)
+    c[:, 1:] -= np.where(on[:, 1:], c[:, :-1], 0.0)
+    return c
+
+
+def build_shader_gltf(tree: Tree, table: BranchTable, season: float = 0.0, mesh: TreeMesh | None = None):
+    """The static glTF of ``tree`` with the shader-wind attributes (module docstring).
+
+    Returns
+    -------
+    (pygltflib.GLTF2, bytes)
+        The document and its buffer, for :func:`treeanim.export.write_gltf`.
+    """
+    import pygltflib as gl
+
+    from .export import _Blob
+
+    mesh = mesh if mesh is not None else build_mesh(tree)
+    present = tree.leaves_present(season)
+    keep_tris, used, pos, _, _ = skin(tree, mesh, skeleton(tree, present), present)
+    levels, pivots = level_chains(tree)
+    compliance = level_compliance(tree, table, levels)[mesh.object[used]]  # (U, LEVELS)
+    lv, pv = levels[mesh.object[used]], pivots[mesh.object[used]]
+    on = lv >= 0
+    o = np.maximum(lv, 0)
+    doc = gl.GLTF2(asset=gl.Asset(version="2.0", generator="treeanim (shader wind)"))
+    blob = _Blob(doc)
+    v = mesh.vertices[used]
+    nrm = v["normal"].astype(np.float64)
+    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    col = np.round(vertex_colours(tree, mesh, season)[used] * 255).astype(np.uint8)
+    attrs = {
+        "POSITION": blob.accessor(pos, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER, minmax=True),
+        "NORMAL": blob.accessor(nrm.astype(np.float32), gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
+        "COLOR_0": blob.accessor(col, gl.VEC4, gl.UNSIGNED_BYTE, gl.ARRAY_BUFFER, normalized=True),
+    }
+    for level in range(LEVELS):
+        f = np.where(on[:, level], table.frequency[o[:, level]], 0.0)
+        pivot = np.column_stack([table.pivot[np.maximum(pv[:, level], 0)], f])
+        axis = np.column_stack([table.axis[o[:, level]], compliance[:, level]])
+        for name, a in ((f"_PIVOT{level}", pivot), (f"_AXIS{level}", axis)):
+            attrs[name] = blob.accessor(a.astype(np.float32), gl.VEC4, gl.FLOAT, gl.ARRAY_BUFFER)
+    attrs["_DAMPING"] = blob.accessor(np.where(on, table.damping[o], 0.0).astype(np.float32), gl.VEC4, gl.FLOAT,
+                                      gl.ARRAY_BUFFER)
+    remap = np.cumsum(used) - 1
+    index = remap[mesh.indices[keep_tris]].astype(np.uint32).ravel()
+    indices = blob.accessor(index, gl.SCALAR, gl.UNSIGNED_INT, gl.ELEMENT_ARRAY_BUFFER, minmax=True)
+    doc.materials.append(gl.Material(
+        name="tree", doubleSided=True,
+        pbrMetallicRoughness=gl.PbrMetallicRoughness(baseColorFactor=[1, 1, 1, 1], metallicFactor=0.0, roughnessFactor=0.8),
+    ))
+    doc.meshes.append(gl.Mesh(name=tree.name, primitives=[gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices,
+                                                                         material=0)],
+                              extras={"treeanim_wind": {"levels": LEVELS, "exponent": round(table.exponent, 4),
+                                                        "calibration_winds": list(CALIBRATION_WINDS),
+                                                        "shader": "shaders/engine_wind.glsl"}}))
+    doc.nodes.append(gl.Node(name=tree.name, mesh=0))
+    doc.scenes.append(gl.Scene(name=tree.name, nodes=[0]))
+    doc.scene = 0
+    data = blob.bytes()
+    doc.buffers.append(gl.Buffer(byteLength=len(data)))
+    return doc, data
