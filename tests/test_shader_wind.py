@@ -1,20 +1,14 @@
 """Shader wind for engines: the branches' parameters are the simulation's, the static mesh passes
 the glTF validator, and the reference shader sways it in three.js in headless Chromium."""
 
-import base64
-import functools
-import http.server
-import re
 import shutil
-import subprocess
-import threading
 from pathlib import Path
 
 import numpy as np
 import pytest
-from PIL import Image
 
 import treeanim as ta
+from browser import changed, frames, serve
 from test_export import NODE_MODULES, export, validate
 from treeanim import scripted, shader_wind
 from treeanim.offline.trace import zero_crossing_frequency
@@ -95,29 +89,6 @@ def test_the_mean_lean_it_encodes_is_the_simulations_between_the_calibration_win
     assert np.mean(p[:, 0] - tree.rest_positions[tips, 0]) == pytest.approx(np.mean(shift), rel=0.2)
 
 
-def _serve(folder: Path):
-    handler = functools.partial(http.server.SimpleHTTPRequestHandler, directory=str(folder))
-    handler.log_message = lambda *a: None
-    server = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
-    threading.Thread(target=server.serve_forever, daemon=True).start()
-    return server
-
-
-def _frame(port: int, query: str, tmp_path: Path) -> np.ndarray:
-    """The example page's still frame at ``query``, rendered by headless Chromium (SwiftShader)."""
-    chromium = shutil.which("chromium") or shutil.which("chromium-browser")
-    assert chromium, "chromium is not installed: run scripts/test"
-    res = subprocess.run([chromium, "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
-                          "--enable-unsafe-swiftshader", f"--user-data-dir={tmp_path / 'profile'}",
-                          "--window-size=480,480", "--virtual-time-budget=60000", "--dump-dom",
-                          f"http://127.0.0.1:{port}/index.html?{query}"], capture_output=True, text=True, timeout=300)
-    m = re.search(r"data:image/png;base64,([A-Za-z0-9+/=]+)", res.stdout)
-    assert m, res.stderr[-2000:]
-    png = tmp_path / f"{query}.png"
-    png.write_bytes(base64.b64decode(m.group(1)))
-    return np.asarray(Image.open(png).convert("RGB"), float)
-
-
 def test_the_reference_shader_sways_the_mesh_in_three_js(tmp_path):
     web = tmp_path / "web"
     web.mkdir()
@@ -130,20 +101,14 @@ def test_the_reference_shader_sways_the_mesh_in_three_js(tmp_path):
     shutil.copy(ROOT / "shaders" / "engine_wind.glsl", web)
     assert (NODE_MODULES / "three").is_dir(), f"three is not installed in {NODE_MODULES}: run scripts/test"
     (web / "three").symlink_to(NODE_MODULES / "three")
-    server = _serve(web)
-    try:
-        port = server.server_address[1]
-        calm0, calm3 = _frame(port, "t=0&wind=0", tmp_path), _frame(port, "t=3&wind=0", tmp_path)
-        gale2, gale3 = _frame(port, "t=2&wind=20", tmp_path), _frame(port, "t=2.4&wind=20", tmp_path)
-    finally:
-        server.shutdown()
+    with serve(web) as port:
+        calm0, calm3, gale2, gale3 = (
+            frames(f"http://127.0.0.1:{port}/index.html?{q}", tmp_path / f"profile{i}")[0]
+            for i, q in enumerate(["t=0&wind=0", "t=3&wind=0", "t=2&wind=20", "t=2.4&wind=20"]))
     sky = calm0[0, 0]
     tree = np.abs(calm0 - sky).sum(axis=2) > 30
     assert tree.mean() > 0.03, "the tree is drawn"
     assert np.array_equal(calm0, calm3), "no wind, no motion"
-
-    def changed(a, b):
-        return np.mean(np.abs(a - b).sum(axis=2) > 30)
 
     assert changed(calm0, gale2) > 0.01, "the gale bends the tree"
     assert changed(gale2, gale3) > 0.005, "and it sways"
