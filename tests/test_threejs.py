@@ -24,7 +24,7 @@ for (const at of [1000, 2500]) setTimeout(() => {
 def readme_threejs() -> str:
     """The README's three.js code block."""
     text = (ROOT / "README.md").read_text(encoding="utf-8")
-    return re.search(r"\*\*three\.js\*\*:\s*```js\n(.*?)```", text, re.S).group(1)
+    return re.search(r"\*\*three\.js\*\*[^`]*```js\n(.*?)```", text, re.S).group(1)
 
 
 def test_the_readme_threejs_recipe_plays_the_clip(tmp_path):
