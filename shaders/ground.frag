@@ -23,7 +23,7 @@ vec3 ground_albedo(vec2 xz, float px) {
                      smoothstep(0.3, 0.7, broad));
     vec3 dry = srgb_to_linear(vec3(0.58, 0.54, 0.32));
     grass = mix(grass, dry, 0.75 * smoothstep(0.45, 0.7, 0.5 * clump + 0.5 * broad + 0.2 * (tuft - 0.5)));
-    grass *= 0.75 + 0.5 * tuft;
+    grass *= (0.75 + 0.5 * tuft) * (0.8 + 0.4 * clump);
     vec3 soil = srgb_to_linear(vec3(0.34, 0.28, 0.21)) * (0.8 + 0.4 * tuft);
     return mix(grass, soil, 0.85 * smoothstep(0.71, 0.8, clump + 0.3 * (tuft - 0.5)));
 }

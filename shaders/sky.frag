@@ -15,8 +15,8 @@ out vec4 f_color;
 const float CLOUD_SCALE = 2.0;
 
 // How much cloud covers the sky towards `dir` (0 .. 1), and how lit it is there (0 its shaded
-// underside .. 1 its sunlit side): the cloud is thinner towards the sun where the density falls
-// that way.
+// underside .. 1 its sunlit side): lit where the density falls towards the sun, greyer where
+// the cloud is thick.
 vec2 clouds(vec3 dir) {
     float h = max(dir.y, 0.0);
     vec2 p = CLOUD_SCALE * dir.xz / (h + 0.1);
@@ -25,7 +25,7 @@ vec2 clouds(vec3 dir) {
     float edge = mix(0.75, 0.3, u_clouds);
     float cover = smoothstep(edge, edge + 0.25, d) * smoothstep(0.0, 0.12, h) * step(1e-3, u_clouds);
     float towards_sun = fbm(p + 0.35 * normalize(u_sun_dir.xz + 1e-6), px, 3);
-    float lit = clamp(0.65 + 3.0 * (d - towards_sun), 0.0, 1.0);
+    float lit = clamp(0.6 + 4.0 * (d - towards_sun), 0.0, 1.0) * (1.0 - 0.5 * smoothstep(edge + 0.1, edge + 0.45, d));
     return vec2(cover, lit);
 }
 
@@ -33,13 +33,13 @@ vec3 sky_color(vec3 dir) {
     if (u_show_sky == 0) return u_sky_horizon;
     float h = dir.y;
     vec3 air = air_color(dir);
-    vec3 c = mix(air, u_sky_zenith, pow(clamp(h, 0.0, 1.0), 0.5));
+    vec3 c = mix(air, u_sky_zenith, pow(clamp(h, 0.0, 1.0), 0.6));
     c = mix(c, air * 0.92, smoothstep(0.0, -0.2, h));   // below the horizon: haze
     float s = max(dot(dir, u_sun_dir), 0.0);
     vec2 cl = clouds(dir);
-    vec3 shade = 0.55 * u_sky_horizon + 0.25 * u_sky_zenith;
-    vec3 sunlit = 0.55 * u_sun_color + 0.35 * u_sky_horizon;
-    vec3 cloud = mix(shade, sunlit, cl.y) + u_sun_color * 0.5 * pow(s, 12.0);   // bright towards the sun
+    vec3 shade = 0.45 * u_sky_horizon + 0.2 * u_sky_zenith;
+    vec3 sunlit = 0.4 * u_sun_color + 0.3 * u_sky_horizon;
+    vec3 cloud = mix(shade, sunlit, cl.y) + u_sun_color * 0.25 * pow(s, 24.0);   // bright round the sun
     cloud = mix(cloud, air, 1.0 - smoothstep(0.0, 0.35, h));                      // far clouds: into the haze
     c = mix(c, cloud, cl.x);
     float disc = smoothstep(0.99985, 0.99993, s);            // about 1.4 degrees across
