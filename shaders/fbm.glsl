@@ -8,7 +8,7 @@ float fbm(vec2 p, float px, int octaves) {
     const mat2 TURN = mat2(1.6, 1.2, -1.2, 1.6);   // x2 and turned by 37 degrees
     float sum = 0.0, weight = 0.5, total = 0.0;
     for (int k = 0; k < octaves; ++k) {
-        float keep = 1.0 - smoothstep(0.2, 0.6, px);
+        float keep = 1.0 - smoothstep(0.15, 0.45, px);
         sum += weight * mix(0.5, vnoise(p), keep);
         total += weight;
         p = TURN * p + vec2(17.3, -9.1);

@@ -83,14 +83,14 @@ def redness(rgb):
 def test_no_disc_of_soil_round_the_trunk_yet_the_ground_varies(offscreen, tree):
     """The ground at the trunk's foot is the grass 3 m away (the brown disc under every tree is
     gone), while grass and soil vary across it."""
-    cam = OrbitCamera(target=(0.0, 0.0, 0.0), distance=9.0, azimuth=20.0, elevation=80.0)
+    cam = OrbitCamera(target=(0.0, 0.0, 0.0), distance=14.0, azimuth=20.0, elevation=80.0)
     img = render(offscreen, tree, cam, shadow=False)
     near = sample(img, cam, rings(cam, np.linspace(0.25, 0.6, 5)))
     far = sample(img, cam, rings(cam, np.linspace(2.7, 3.3, 5)))
     assert len(near) > 500 and len(far) > 500
     assert abs(redness(near).mean() - redness(far).mean()) < 0.03, (redness(near).mean(), redness(far).mean())
-    wide = sample(img, cam, rings(cam, np.linspace(1.0, 4.0, 16)))   # grass and soil vary across it
-    assert np.std(luminance(wide)) > 2.5 and np.std(redness(wide)) > 0.01, (np.std(luminance(wide)), np.std(redness(wide)))
+    # Grass and soil vary across it (the picture: 13 × 9 m).
+    assert np.std(luminance(img)) > 2.5 and np.std(redness(img)) > 0.01, (np.std(luminance(img)), np.std(redness(img)))
 
 
 def horizon_column(off, tree, towards_sun):
