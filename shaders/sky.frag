@@ -11,7 +11,7 @@
 out vec4 f_color;
 
 // A cloud layer seen as a dome: p on it for a ray rising by h, so clouds shrink and crowd towards
-// the horizon. CLOUD_SCALE sets their size: about 20 degrees across overhead.
+// the horizon. CLOUD_SCALE sets their size: a noise cell is about 30 degrees across overhead.
 const float CLOUD_SCALE = 2.0;
 
 // How much cloud covers the sky towards `dir` (0 .. 1), and how lit it is there (0 its shaded
