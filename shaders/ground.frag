@@ -16,16 +16,16 @@ out vec4 f_color;
 // centimetres; dry grass and small patches of soil where the clumps' noise runs high. Detail
 // finer than a pixel fades to its mean (fbm).
 vec3 ground_albedo(vec2 xz, float px) {
-    float broad = fbm(xz * 0.04, px * 0.04, 3);
-    float clump = fbm(xz * 0.45 + 7.0, px * 0.45, 4);
-    float tuft = fbm(xz * 6.0 + 3.0, px * 6.0, 5);
+    float broad = fbm(xz * 0.04, px * 0.04, 3, 0.5);
+    float clump = fbm(xz * 0.45 + 7.0, px * 0.45, 4, 0.65);
+    float tuft = fbm(xz * 6.0 + 3.0, px * 6.0, 5, 0.8);
     vec3 grass = mix(srgb_to_linear(vec3(0.22, 0.36, 0.10)), srgb_to_linear(vec3(0.36, 0.47, 0.14)),
                      smoothstep(0.3, 0.7, broad));
     vec3 dry = srgb_to_linear(vec3(0.58, 0.54, 0.32));
-    grass = mix(grass, dry, 0.6 * smoothstep(0.5, 0.75, 0.5 * clump + 0.5 * broad + 0.2 * (tuft - 0.5)));
-    grass *= (0.6 + 0.8 * tuft) * (0.7 + 0.6 * clump);
+    grass = mix(grass, dry, 0.65 * smoothstep(0.45, 0.68, 0.5 * clump + 0.5 * broad + 0.2 * (tuft - 0.5)));
+    grass *= (1.0 + 2.0 * (tuft - 0.5)) * (0.7 + 0.6 * clump);
     vec3 soil = srgb_to_linear(vec3(0.35, 0.30, 0.23)) * (0.8 + 0.4 * tuft);
-    return mix(grass, soil, 0.8 * smoothstep(0.72, 0.84, clump + 0.3 * (tuft - 0.5)));
+    return mix(grass, soil, 0.8 * smoothstep(0.68, 0.78, clump + 0.3 * (tuft - 0.5)));
 }
 
 vec3 ground_color(vec2 xz, float px) {

@@ -21,10 +21,10 @@ vec2 clouds(vec3 dir) {
     float h = max(dir.y, 0.0);
     vec2 p = CLOUD_SCALE * dir.xz / (h + 0.1);
     float px = length(fwidth(p));
-    float d = fbm(p, px, 5);
+    float d = fbm(p, px, 5, 0.5);
     float edge = mix(0.75, 0.3, u_clouds);
     float cover = smoothstep(edge, edge + 0.25, d) * smoothstep(0.0, 0.12, h) * step(1e-3, u_clouds);
-    float towards_sun = fbm(p + 0.35 * normalize(u_sun_dir.xz + 1e-6), px, 3);
+    float towards_sun = fbm(p + 0.35 * normalize(u_sun_dir.xz + 1e-6), px, 3, 0.5);
     float lit = clamp(0.6 + 4.0 * (d - towards_sun), 0.0, 1.0) * (1.0 - 0.5 * smoothstep(edge + 0.1, edge + 0.45, d));
     return vec2(cover, lit);
 }
