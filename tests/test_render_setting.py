@@ -67,11 +67,11 @@ def test_the_sky_has_soft_clouds_and_none_when_clear(offscreen, tree):
     assert cloud_and_pixel_scale(clear, clear)[1] < 0.8  # a clear sky as smooth
 
 
-def rings(cam, radius, n=180, centre=(0.0, 0.0)):
-    """Points on the ground on circles of the given radii round ``centre``."""
+def rings(radii, n=180):
+    """Points on the ground on circles of the given radii round the trunk's foot (the origin)."""
     a = np.linspace(0.0, 2 * np.pi, n, endpoint=False)
-    r = np.asarray(radius, float)[:, None]
-    return np.stack([centre[0] + r * np.cos(a), np.zeros_like(r * a), centre[1] + r * np.sin(a)], -1).reshape(-1, 3)
+    r = np.asarray(radii, float)[:, None]
+    return np.stack([r * np.cos(a), np.zeros_like(r * a), r * np.sin(a)], -1).reshape(-1, 3)
 
 
 def redness(rgb):
@@ -85,8 +85,8 @@ def test_no_disc_of_soil_round_the_trunk_yet_the_ground_varies(offscreen, tree):
     gone), while grass and soil vary across it."""
     cam = OrbitCamera(target=(0.0, 0.0, 0.0), distance=14.0, azimuth=20.0, elevation=80.0)
     img = render(offscreen, tree, cam, shadow=False)
-    near = sample(img, cam, rings(cam, np.linspace(0.25, 0.6, 5)))
-    far = sample(img, cam, rings(cam, np.linspace(2.7, 3.3, 5)))
+    near = sample(img, cam, rings(np.linspace(0.25, 0.6, 5)))
+    far = sample(img, cam, rings(np.linspace(2.7, 3.3, 5)))
     assert len(near) > 500 and len(far) > 500
     assert abs(redness(near).mean() - redness(far).mean()) < 0.03, (redness(near).mean(), redness(far).mean())
     # Grass and soil vary across it (the picture: 13 × 9 m).
