@@ -112,9 +112,9 @@ class TreePass:
 
 class GroundPass:
     """The ground y = 0: grass and soil (``ground.frag``), the sky the crown hides and a contact
-    shadow at the trunk's foot; drawn as convex polygons in clip space (``ground.vert``), cut in front of the eye
-    (:func:`~.scene.clip_ground`), by one of two programs: with the sun's shadow (``SUN_SHADOW``
-    1, over the shadow's footprint only) or without.
+    shadow at the trunk's foot; drawn as convex polygons in clip space (``ground.vert``), cut in
+    front of the eye (:func:`~.scene.clip_ground`), by one of two programs: with the sun's shadow
+    (``SUN_SHADOW`` 1, over the shadow's footprint only) or without.
 
     Parameters
     ----------
