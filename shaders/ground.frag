@@ -22,10 +22,10 @@ vec3 ground_albedo(vec2 xz, float px) {
     vec3 grass = mix(srgb_to_linear(vec3(0.22, 0.36, 0.10)), srgb_to_linear(vec3(0.36, 0.47, 0.14)),
                      smoothstep(0.3, 0.7, broad));
     vec3 dry = srgb_to_linear(vec3(0.58, 0.54, 0.32));
-    grass = mix(grass, dry, 0.65 * smoothstep(0.45, 0.68, 0.5 * clump + 0.5 * broad + 0.2 * (tuft - 0.5)));
+    grass = mix(grass, dry, 0.5 * smoothstep(0.47, 0.7, 0.5 * clump + 0.5 * broad + 0.2 * (tuft - 0.5)));
     grass *= (1.0 + 2.0 * (tuft - 0.5)) * (0.7 + 0.6 * clump);
     vec3 soil = srgb_to_linear(vec3(0.35, 0.30, 0.23)) * (0.8 + 0.4 * tuft);
-    return mix(grass, soil, 0.8 * smoothstep(0.68, 0.78, clump + 0.3 * (tuft - 0.5)));
+    return mix(grass, soil, 0.7 * smoothstep(0.69, 0.79, clump + 0.3 * (tuft - 0.5)));
 }
 
 vec3 ground_color(vec2 xz, float px) {
