@@ -1,6 +1,6 @@
 // Shared lighting (any shader stage): one sun with its shadow map (sun.glsl), a sky/ground
-// hemisphere, distance haze, noise. Fragment shaders' own helpers are in pixel.glsl. Every
-// uniform is declared in uniforms.glsl, written from render/uniforms.py.
+// hemisphere, distance haze and the air's colour, noise. Fragment shaders' own helpers are in
+// pixel.glsl. Every uniform is declared in uniforms.glsl, written from render/uniforms.py.
 
 #include "uniforms.glsl"
 #include "sun.glsl"
@@ -12,13 +12,22 @@ vec3 hemisphere(vec3 n) {
     return u_ambient * mix(u_ground_bounce, sky, 0.5 + 0.5 * n.y);
 }
 
-// How much of the horizon's colour the air between the eye and `world` lays over it (0 .. 1).
+// The colour of the air seen towards `dir` (unit, world): the sky's horizon colour, brighter and
+// warmer towards the sun (the haze scatters sunlight forwards). The sky meets it at the horizon
+// and haze lays it over whatever is far, so sky, ground and trees fade into one colour.
+vec3 air_color(vec3 dir) {
+    float s = max(dot(dir, u_sun_dir), 0.0);
+    return u_sky_horizon + u_sun_color * (0.05 * s * s + 0.12 * pow(s, 8.0));
+}
+
+// How much of the air's colour the air between the eye and `world` lays over it (0 .. 1).
 float haze(vec3 world) {
     return 1.0 - exp(-length(world - u_camera_pos) / u_haze_distance);
 }
 
-vec3 apply_haze(vec3 c, vec3 world) {
-    return mix(c, u_sky_horizon, haze(world));
+// `c` at `world` as the eye sees it through the air: faded by `air` (haze(world)) into the air's colour.
+vec3 apply_haze(vec3 c, vec3 world, float air) {
+    return mix(c, air_color(normalize(world - u_camera_pos)), air);
 }
 
 float hash12(vec2 p) {

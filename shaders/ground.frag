@@ -1,25 +1,34 @@
 #version 330 core
-// The ground plane y = 0 found by casting each pixel's view ray: grass with soft variation, bare
-// earth round the trunk, the sky the crown hides and a contact shadow at the trunk's foot, an
-// optional 1 m grid, hazed into the horizon. With SUN_SHADOW 1 (the program the renderer draws
-// over the shadow's footprint only) also the tree's shadow from the sun's shadow map.
+// The ground plane y = 0 found by casting each pixel's view ray: grass at several scales with
+// patches of dry grass and soil, the sky the crown hides and a contact shadow at the trunk's
+// foot, an optional 1 m grid, hazed into the air's colour towards the horizon. With SUN_SHADOW 1
+// (the program the renderer draws over the shadow's footprint only) also the tree's shadow from
+// the sun's shadow map.
 
 #include "common.glsl"
 #include "pixel.glsl"
+#include "fbm.glsl"
 
 out vec4 f_color;
 
-vec3 ground_color(vec2 xz, float fade) {
-    float n1 = vnoise(xz * 0.23);
-    float n2 = vnoise(xz * 1.9 + 17.0);
-    float fine = vnoise(xz * 9.0 + 3.0);
-    vec3 grass = mix(srgb_to_linear(vec3(0.25, 0.39, 0.12)), srgb_to_linear(vec3(0.33, 0.45, 0.15)), n1);
-    grass *= (0.9 + 0.2 * n2) * (1.0 + 0.18 * (fine - 0.5) * fade);
-    vec3 earth = srgb_to_linear(vec3(0.36, 0.28, 0.19)) * (0.85 + 0.3 * n2);
-    float r = length(xz - u_ground_centre.xz);
-    float bare = 1.0 - smoothstep(0.4 * u_earth_radius, u_earth_radius, r + 0.3 * u_earth_radius * (n2 - 0.5));
-    vec3 albedo = mix(grass, earth, bare * step(1e-6, u_earth_radius));
+// The ground's colour at xz (linear), `px` a pixel's size there (metres): grass greener or
+// yellower in patches tens of metres across, clumps a metre or two across, tufts of a few
+// centimetres; dry grass and small patches of soil where the clumps' noise runs high. Detail
+// finer than a pixel fades to its mean (fbm).
+vec3 ground_albedo(vec2 xz, float px) {
+    float broad = fbm(xz * 0.04, px * 0.04, 3, 0.5);
+    float clump = fbm(xz * 0.45 + 7.0, px * 0.45, 4, 0.65);
+    float tuft = fbm(xz * 6.0 + 3.0, px * 6.0, 5, 0.8);
+    vec3 grass = mix(srgb_to_linear(vec3(0.22, 0.36, 0.10)), srgb_to_linear(vec3(0.36, 0.47, 0.14)),
+                     smoothstep(0.3, 0.7, broad));
+    vec3 dry = srgb_to_linear(vec3(0.58, 0.54, 0.32));
+    grass = mix(grass, dry, 0.5 * smoothstep(0.47, 0.7, 0.5 * clump + 0.5 * broad + 0.2 * (tuft - 0.5)));
+    grass *= (1.0 + 2.0 * (tuft - 0.5)) * (0.7 + 0.6 * clump);
+    vec3 soil = srgb_to_linear(vec3(0.35, 0.30, 0.23)) * (0.8 + 0.4 * tuft);
+    return mix(grass, soil, 0.7 * smoothstep(0.69, 0.79, clump + 0.3 * (tuft - 0.5)));
+}
 
+vec3 ground_color(vec2 xz, float px) {
     vec3 up = vec3(0.0, 1.0, 0.0);
 #if SUN_SHADOW
     float sun = sun_visibility(vec3(xz.x, 0.0, xz.y), up);
@@ -28,10 +37,10 @@ vec3 ground_color(vec2 xz, float fade) {
 #endif
     float ds = length(xz - u_occlusion_centre.xz) / max(u_occlusion_radius, 1e-6);
     float sky = 1.0 - 0.45 * exp(-2.0 * ds * ds) * step(1e-6, u_occlusion_radius);
-    float dt = max(r - u_trunk_radius, 0.0) / max(1.5 * u_trunk_radius, 1e-6);
+    float dt = max(length(xz - u_ground_centre.xz) - u_trunk_radius, 0.0) / max(1.5 * u_trunk_radius, 1e-6);
     float contact = 1.0 - 0.6 * exp(-dt * dt) * step(1e-6, u_trunk_radius);
     vec3 light = hemisphere(up) * sky + u_sun_color * max(u_sun_dir.y, 0.0) * sun;
-    return albedo * light * contact;
+    return ground_albedo(xz, px) * light * contact;
 }
 
 void main() {
@@ -39,12 +48,13 @@ void main() {
     float t = u_camera_pos.y / max(-dir.y, 1e-5);
     vec2 xz = u_camera_pos.xz + min(t, 1e5) * dir.xz;
     vec2 fw = fwidth(xz);
-    float fade = 1.0 - smoothstep(0.05, 0.2, length(fw) * 0.9);   // no shimmer far away
-    vec3 c = ground_color(xz, fade);
+    vec3 c = ground_color(xz, length(fw));
     if (u_grid > 0.0) {
+        float fade = 1.0 - smoothstep(0.05, 0.2, length(fw) * 0.9);   // no shimmer far away
         vec2 g = abs(fract(xz - 0.5) - 0.5) / max(fw, vec2(1e-6));
         float line = (1.0 - min(min(g.x, g.y), 1.0)) * fade;
         c = mix(c, c * 1.6 + 0.02, u_grid * line);
     }
-    f_color = to_display(apply_haze(c, vec3(xz.x, 0.0, xz.y)));
+    vec3 world = vec3(xz.x, 0.0, xz.y);
+    f_color = to_display(apply_haze(c, world, haze(world)));
 }

@@ -70,5 +70,5 @@ void main() {
     // a column apart then sum to its width, wherever it falls between them).
     float cover = PART == PART_LEAVES || v_half < 0.0 ? 1.0 : tent_integral(v_edge + v_half) - tent_integral(v_edge - v_half);
     float air = PART == PART_BLADES ? v_haze : haze(v_world);
-    f_color = vec4(to_display(mix(c, u_sky_horizon, air)).rgb, cover);
+    f_color = vec4(to_display(apply_haze(c, v_world, air)).rgb, cover);
 }

@@ -29,7 +29,7 @@ settings.load_profile("treeanim")
 #: Modules that draw through OpenGL (EGL offscreen; test_app: the app on a headless window), and
 #: those that open a window (Xvfb).
 GL_MODULES = {"test_render_gl", "test_render_look", "test_render_uniforms", "test_junctions", "test_offline",
-              "test_examples", "test_app", "test_scenes_gl"}
+              "test_examples", "test_app", "test_scenes_gl", "test_render_setting"}
 WINDOW_MODULES = {"test_app_window", "test_render_window"}
 #: Each test's measured CPU seconds (node id -> s), written by ``pytest --store-durations``.
 DURATIONS = Path(__file__).with_name("durations.json")

@@ -97,8 +97,8 @@ def test_the_crown_shades_itself(offscreen, sun):
 def test_a_leaf_lit_from_behind_glows_with_translucency(offscreen, tree):
     cam = OrbitCamera(target=(0.0, 1.5, 0.0), distance=2.5, azimuth=0.0, elevation=5.0)
     leaves = tree.kind == "leaf"
-    bare = render(offscreen, tree, cam, present=~leaves, shadow=False)
     for sun, least in [((0.0, 0.45, -1.0), 1.15), ((0.0, 0.45, 1.0), None)]:  # behind, then in front
+        bare = render(offscreen, tree, cam, present=~leaves, shadow=False, sun_direction=sun)  # the same sky
         glow = render(offscreen, tree, cam, shadow=False, sun_direction=sun, translucency=1.0)
         flat = render(offscreen, tree, cam, shadow=False, sun_direction=sun, translucency=0.0)
         leaf = np.abs(glow.astype(int) - bare.astype(int)).max(axis=2) > 24

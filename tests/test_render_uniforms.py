@@ -47,7 +47,7 @@ def test_a_uniform_never_set_stops_the_frame(offscreen, tree, monkeypatch):
     offscreen.resize(W, H)
     monkeypatch.setattr(SkyPass, "apply", lambda self, scene: None)
     offscreen.load(tree)
-    with pytest.raises(RuntimeError, match="uniform block Sky: show_sky never set"):
+    with pytest.raises(RuntimeError, match="uniform block Sky: clouds, show_sky never set"):
         offscreen.render(CAMERA)
 
 

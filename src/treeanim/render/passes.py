@@ -111,10 +111,10 @@ class TreePass:
 
 
 class GroundPass:
-    """The ground y = 0: bare earth round the trunk, the sky the crown hides and a contact shadow
-    at its foot; drawn as convex polygons in clip space (``ground.vert``), cut in front of the eye
-    (:func:`~.scene.clip_ground`), by one of two programs: with the sun's shadow (``SUN_SHADOW``
-    1, over the shadow's footprint only) or without.
+    """The ground y = 0: grass and soil (``ground.frag``), the sky the crown hides and a contact
+    shadow at the trunk's foot; drawn as convex polygons in clip space (``ground.vert``), cut in
+    front of the eye (:func:`~.scene.clip_ground`), by one of two programs: with the sun's shadow
+    (``SUN_SHADOW`` 1, over the shadow's footprint only) or without.
 
     Parameters
     ----------
@@ -153,11 +153,9 @@ class GroundPass:
         spread = np.percentile(np.linalg.norm(pts[:, [0, 2]] - crown[[0, 2]], axis=1), 85)
         self.occlusion_radius = float(max(1.1 * spread, 0.1 * float(np.max(hi - lo))))
         self.trunk_radius = float(0.5 * tree.node_diameter[trunks].max()) if len(trunks) else 0.0
-        earth = 5.0 * tree.node_diameter[trunks].max() if len(trunks) else 0.0
-        if isinstance(tree, TreeScene) and tree.n_trees > 1:  # one tree's earth, shade and foot: not a scene's
-            self.occlusion_radius = self.trunk_radius = earth = 0.0
-        self.block.set(ground_centre=(trunk_foot[0], 0.0, trunk_foot[2]), earth_radius=earth,
-                       occlusion_centre=(crown[0], 0.0, crown[2]))
+        if isinstance(tree, TreeScene) and tree.n_trees > 1:  # one tree's shade and foot: not a scene's
+            self.occlusion_radius = self.trunk_radius = 0.0
+        self.block.set(ground_centre=(trunk_foot[0], 0.0, trunk_foot[2]), occlusion_centre=(crown[0], 0.0, crown[2]))
 
     def apply(self, scene: Scene) -> None:
         """Take the scene's settings (the crown's shade and the trunk's contact shadow go with the
@@ -194,8 +192,8 @@ class GroundPass:
 
 
 class SkyPass:
-    """The sky: gradient, sun disc and glow (``sky.frag``), one full-screen triangle at the far
-    plane drawn with depth test <=, where nothing else was."""
+    """The sky: gradient, clouds, sun disc and glow (``sky.frag``), one full-screen triangle at the
+    far plane drawn with depth test <=, where nothing else was."""
 
     def __init__(self, ctx: moderngl.Context) -> None:
         self.ctx = ctx
@@ -209,8 +207,8 @@ class SkyPass:
             raise
 
     def apply(self, scene: Scene) -> None:
-        """Take the scene's settings (the sky shown, or a flat horizon colour)."""
-        self.block.set(show_sky=scene.show_sky)
+        """Take the scene's settings (the sky shown, or a flat horizon colour; its clouds)."""
+        self.block.set(show_sky=scene.show_sky, clouds=scene.clouds)
 
     def draw(self) -> None:
         """Draw the sky where the depth buffer is clear."""

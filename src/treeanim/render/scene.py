@@ -79,6 +79,7 @@ class Scene:
     exposure: float = 1.0
     haze_distance: float | None = None  # metres; None: from the tree's size
     ground_grid: float = 0.0            # strength of a 1 m grid on the ground (0: none)
+    clouds: float = 0.4                 # how much of the sky clouds cover (0: a clear sky .. 1)
     show_sky: bool = True
     show_ground: bool = True
     shadow: bool = True                 # the sun's shadows (tree on ground and on itself)

@@ -30,7 +30,7 @@ BLOCKS: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("vec3", "sun_dir", "unit, towards the sun"),
         ("vec3", "sun_color", "linear"),
         ("vec3", "sky_zenith", "linear"),
-        ("vec3", "sky_horizon", "linear (also the haze colour)"),
+        ("vec3", "sky_horizon", "linear (the air's colour away from the sun: haze)"),
         ("vec3", "ground_bounce", "linear, light from below"),
         ("float", "ambient", "strength of the sky/ground hemisphere light"),
         ("float", "haze_distance", "metres at which haze reaches 63 %"),
@@ -61,7 +61,6 @@ BLOCKS: dict[str, tuple[tuple[str, str, str], ...]] = {
     # GroundPass's (ground.frag).
     "Ground": (
         ("vec3", "ground_centre", "the trunk's foot"),
-        ("float", "earth_radius", "bare earth around the trunk (0: none)"),
         ("vec3", "occlusion_centre", "below the crown's centre: the sky is hidden there"),
         ("float", "occlusion_radius", "0: none"),
         ("float", "trunk_radius", "contact shadow round the trunk's foot (0: none)"),
@@ -70,6 +69,7 @@ BLOCKS: dict[str, tuple[tuple[str, str, str], ...]] = {
     # SkyPass's (sky.frag).
     "Sky": (
         ("int", "show_sky", "0: flat horizon colour"),
+        ("float", "clouds", "how much of the sky clouds cover: 0 clear .. 1"),
     ),
     # OverlayPass's (line_geom.glsl), set before each overlay.
     "Lines": (
@@ -186,7 +186,7 @@ class UniformBlock:
     Example
     -------
     >>> ground = UniformBlock(ctx, "Ground")
-    >>> ground.set(grid=0.5, earth_radius=0.4, ...)   # every member, before the first use()
+    >>> ground.set(grid=0.5, trunk_radius=0.2, ...)   # every member, before the first use()
     >>> ground.use()                                   # before drawing
     """
 
