@@ -20,6 +20,7 @@ from imgui_bundle import imgui
 from ..model.tree import KINDS, PLURAL
 from ..physics.wind import WIND_PRESETS, named_wind
 from .keys import help_lines
+from .plots import draw_plots
 from .settings import EI_SPAN, SETTINGS
 
 #: Width of the panel in screen units at UI scale 1.
@@ -216,6 +217,49 @@ class Panel:
         self._rect(rect)
         return pressed
 
+    def _timeline(self) -> None:
+        """The timeline: a slider over the kept states' times (moving it pauses there), ← and
+        → a state, and what it keeps."""
+        v = self.viewer
+        tl = v.timeline
+        times = tl.times
+        if len(times) < 2:
+            imgui.text_disabled("timeline: the last seconds, once the tree runs")
+            return
+        now = times[-1 if tl.cursor is None else tl.cursor]
+        changed, t = imgui.slider_float("timeline", float(now), float(times[0]), float(times[-1]), "%.2f s")
+        self._rect("timeline", frame_only=True)
+        if changed:
+            v.scrub(int(np.argmin(np.abs(times - t))))
+        if imgui.arrow_button("##back", imgui.Dir.left):
+            v.step_back()
+        imgui.same_line()
+        if imgui.arrow_button("##forward", imgui.Dir.right):
+            v.step_forward()
+        imgui.same_line()
+        imgui.text_disabled(f"{times[-1] - times[0]:.1f} s kept, {len(times)} states, {tl.memory / 2**20:.0f} MB")
+
+    def _hold(self) -> None:
+        """The grab's strength (with what it holds) and the pins, each with its × to let go."""
+        v = self.viewer
+        self.widget("grab_strength")
+        spring = f", now {v.grab.spring(v.sim):.3g} N/m" if v.grab is not None else ""
+        imgui.text_disabled(f"covers {100 * v.held_share():.1f} % of a drag{spring}")
+        springs = v.sim.drags
+        for j, p in enumerate(v.pins):
+            if imgui.small_button(f"x##pin{j}"):
+                v.unpin(j)
+                break
+            self._rect(f"unpin {j}")
+            imgui.same_line()
+            k = springs[p.object][1] if p.object in springs else 0.0
+            imgui.text(f"pin #{p.object} ({v.sim.tree.kind[p.object]}) s = {p.s:.2f}, {k:.3g} N/m")
+        if v.pins:
+            if imgui.small_button("unpin all"):
+                v.unpin_all()
+        else:
+            imgui.text_disabled("P or Shift + let go: pin the branch dragged")
+
     def _tuning_row(self) -> None:
         """Undo, Redo and Reset all (right-click a setting: that one back to its default)."""
         v = self.viewer
@@ -327,6 +371,16 @@ class Panel:
             imgui.same_line()
             if imgui.button("Frame"):
                 v.frame_camera()
+            self._timeline()
+
+        # --- grab strength, pins
+        if self._header("Grab and pins", open_=True):
+            self._hold()
+
+        # --- live plots
+        if self._header("Plots"):
+            w = imgui.get_content_region_avail().x
+            draw_plots(v.signals, w, 0.55 * w)
 
         # --- overlays
         if self._header("Overlays", open_=True):
