@@ -26,9 +26,9 @@ from ..physics.tree_sim import GRAB_STIFFNESS
 
 __all__ = ["ViewerHold", "GRAB_STRENGTHS"]
 
-#: The grab strength's range (× the default spring): on the tree model 1× … 1000× the tree's
-#: stiffness at the point, a small drag covered 50 % … 99.9 %.
-GRAB_STRENGTHS = (1.0 / GRAB_STIFFNESS, 20.0)
+#: The grab strength's range (× the default spring): on the tree model 0.1× … 1000× the tree's
+#: stiffness at the point, a small drag covered 9 % … 99.9 %.
+GRAB_STRENGTHS = (0.1 / GRAB_STIFFNESS, 20.0)
 
 
 class ViewerHold:

@@ -208,7 +208,7 @@ SETTINGS: dict[str, Setting] = {
     "paused": _check("paused", "paused", "set_paused"),
     # the mouse's spring × its default (hold.py)
     "grab_strength": Setting("grab strength", "grab_strength", "set_grab_strength", lo=GRAB_STRENGTHS[0],
-                             hi=GRAB_STRENGTHS[1], fmt="%.2f×", log=True, clamp=True),
+                             hi=GRAB_STRENGTHS[1], fmt="%.3g×", log=True, clamp=True),
     # draft mode for slow renderers: half resolution, no MSAA, no shadows (not undone or reset)
     "draft": _check("draft", "draft", "set_draft"),
     # overlays
