@@ -47,13 +47,13 @@ def test_grab_strength_sets_how_far_the_branch_follows_the_cursor(viewer):
         start, target = drag_across(v, obj, x, y, 1.0)  # about 1 cm: no joint near what the wood bears
         shares[strength] = covered(v, start, target)
         s = GRAB_STIFFNESS * strength
-        if s < 10:  # (a stiffer spring holds the point where the leaves' motion about it still tells)
+        if s < 10:  # (at s = 50 the few percent left are within what the joints-only compliance misses)
             assert shares[strength] == pytest.approx(s / (1 + s), abs=0.02), strength
         assert v.grab.spring(v.sim) == pytest.approx(v.sim.drags[obj][1])
         v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
     assert shares[1.0] > 0.9 and np.all(np.diff(list(shares.values())) > 0.05), "a stiffer grab follows closer"
     assert v.held_share() == pytest.approx(50 / 51)
-    # the panel says it in physical units; a refusal is one line; undo takes it back
+    # the panel's slider; a refusal is one line; undo takes a change back
     v.show_panel = True
     press(v, x, y)
     v.frame(DT)

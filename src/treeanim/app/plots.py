@@ -1,12 +1,12 @@
 """Live plots in the panel (issue 31), drawn with ImPlot: the pulled point's trace (its
-displacement from rest over the last seconds) and the spectra of the wind at the canopy top and
-of the trunk top's sway (log-log).
+displacement from rest over the last seconds) and the spectra of the wind at the canopy top, of
+the trunk top's sway and of the grabbed point's (log-log).
 
 :class:`Signals` records, after every step, the time, the wind speed at the canopy top (above
 the first trunk's base, at the tree's height), the trunk top's displacement and the traced
 (grabbed) point's displacement from rest, over the last :data:`SECONDS` seconds.
-:meth:`Signals.spectra` takes the power spectra of the wind speed and of the sway
-(:func:`spectrum`), at most :data:`REFRESH` times a second of wall time (cached between); the
+:meth:`Signals.spectra` takes the power spectra of the wind speed, of the trunk top's sway and
+of the grabbed point's (:func:`spectrum`), at most :data:`REFRESH` times a second of wall time (cached between); the
 panel draws what they hold (:func:`draw_plots`).
 """
 
@@ -46,9 +46,9 @@ def spectrum(t: np.ndarray, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         Power per hertz (the signal's unit² / Hz) of the mean-removed, Hann-windowed signal.
     """
     t = np.asarray(t, float)
-    x = np.asarray(x, float).reshape(len(t), -1)
     if len(t) < 8:
         return np.zeros(0), np.zeros(0)
+    x = np.asarray(x, float).reshape(len(t), -1)
     dt = float(np.median(np.diff(t)))
     grid = np.arange(t[0], t[-1] + 0.5 * dt, dt)
     y = np.stack([np.interp(grid, t, x[:, c]) for c in range(x.shape[1])], axis=1)
@@ -137,13 +137,16 @@ class Signals:
         return t[keep] - (t[-1] if len(t) else 0.0), x[keep, 4:]
 
     def spectra(self, now: float | None = None) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-        """{'wind': (f, power (m/s)²/Hz), 'sway': (f, power m²/Hz)} of the samples kept; worked
+        """{'wind': (f, power (m/s)²/Hz), 'sway': (f, power m²/Hz) of the trunk top, 'grabbed':
+        (f, power m²/Hz) of the traced point (since it was grabbed)} of the samples kept; worked
         out again at most :data:`REFRESH` times a second of wall time ``now`` (None: read the
         clock) while samples come in."""
         now = time.perf_counter() if now is None else now
         if self._cache is None or (self._cache[1] != self._n and now - self._cache[0] >= 1.0 / REFRESH):
             t, x = self.window()
-            self._cache = (now, self._n, {"wind": spectrum(t, x[:, 0]), "sway": spectrum(t, x[:, 1:4])})
+            held = np.isfinite(x[:, 4])
+            self._cache = (now, self._n, {"wind": spectrum(t, x[:, 0]), "sway": spectrum(t, x[:, 1:4]),
+                                          "grabbed": spectrum(t[held], x[held, 4:])})
         return self._cache[2]
 
 
@@ -165,14 +168,16 @@ def draw_plots(signals: Signals, width: float, height: float) -> None:
                 implot.plot_line(name, np.ascontiguousarray(t), np.ascontiguousarray(d[:, c]))
         implot.end_plot()
     sp = signals.spectra()
-    imgui.text_disabled(f"peaks: wind {_peak(*sp['wind'])}, trunk top {_peak(*sp['sway'])}")
+    imgui.text_disabled(f"peaks: wind {_peak(*sp['wind'])}, trunk top {_peak(*sp['sway'])}, "
+                        f"grabbed {_peak(*sp['grabbed'])}")
     if implot.begin_plot("spectra##spectra", size, implot.Flags_.no_menus | implot.Flags_.no_box_select):
         implot.setup_axes("Hz", "m²/Hz", implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
         implot.setup_axis(implot.ImAxis_.y2, "(m/s)²/Hz", implot.AxisFlags_.auto_fit | implot.AxisFlags_.opposite)
         for axis in (implot.ImAxis_.x1, implot.ImAxis_.y1, implot.ImAxis_.y2):
             implot.setup_axis_scale(axis, implot.Scale_.log10)
-        for name, axis in (("trunk top", implot.ImAxis_.y1), ("wind", implot.ImAxis_.y2)):
-            f, p = sp["sway" if axis == implot.ImAxis_.y1 else "wind"]
+        for name, key, axis in (("trunk top", "sway", implot.ImAxis_.y1), ("grabbed", "grabbed", implot.ImAxis_.y1),
+                                ("wind", "wind", implot.ImAxis_.y2)):
+            f, p = sp[key]
             ok = p > 0
             if ok.sum() > 1:
                 implot.set_axes(implot.ImAxis_.x1, axis)

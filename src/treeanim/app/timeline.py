@@ -75,8 +75,8 @@ class Timeline:
 
     @property
     def interval(self) -> float:
-        """Simulated seconds between kept states: 0 (every step) while the span fits in the
-        budget, else the span over the states that fit."""
+        """Simulated seconds between kept states: the span over the states that fit in the
+        budget (0 before the first; a step as long or longer: every step kept)."""
         if not self._bytes:
             return 0.0
         return self.seconds / max(self.budget // self._bytes, 1)
@@ -136,8 +136,11 @@ class ViewerTimeline:
 
     def step_back(self) -> bool:
         """Pause and go back one kept state (←)."""
-        cursor = self.timeline.cursor
-        index = len(self.timeline) - 2 if cursor is None else cursor - 1  # the newest is now
+        tl = self.timeline
+        if tl.cursor is not None:
+            index = tl.cursor - 1
+        else:  # live: the newest kept state, unless it is the state shown
+            index = len(tl) - 1 - bool(len(tl) and tl.times[-1] >= self.sim.time)
         return index >= 0 and self.scrub(index)
 
     def step_forward(self) -> bool:
