@@ -9,7 +9,7 @@ import glfw
 import numpy as np
 import pytest
 
-from app_helpers import DT, H, branch_on_screen, centre, click, press, reveal
+from app_helpers import DT, branch_on_screen, centre, click, press, reveal
 from treeanim.app.plots import spectrum
 from treeanim.app.timeline import Timeline
 
@@ -40,8 +40,8 @@ def test_scrubbing_back_restores_a_state_exactly_and_resuming_continues_from_it(
     # the panel's slider: moved back, it pauses and shows the state kept then
     v.show_panel = True
     v.frame(DT)
-    x0, y0, x1, y1 = reveal(v, "timeline") and v.panel.item_rects["timeline"]
-    click(v, x0 + 0.5 * (x1 - x0), 0.5 * (y0 + y1))
+    reveal(v, "timeline")
+    click(v, *centre(v.panel.item_rects["timeline"]))  # the middle of the slider: half way back
     assert v.paused and v.timeline.cursor is not None
     t = v.sim.time
     assert t in poses and t < times[-1] - 0.2

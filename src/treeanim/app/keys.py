@@ -55,7 +55,7 @@ BINDINGS = (
     Binding((glfw.KEY_SPACE,), "Space", "toggle_pause", "pause (resume: from the timeline's state)"),
     Binding((glfw.KEY_LEFT,), "Left", "step_back", "pause, step back"),
     Binding((glfw.KEY_RIGHT,), "Right", "step_forward", "step forward"),
-    Binding((glfw.KEY_P,), "P", "pin", "pin the branch dragged", shift=False),
+    Binding((glfw.KEY_P,), "P", "pin", "pin the branch dragged (or let go with Shift)", shift=False),
     Binding((glfw.KEY_P,), "Shift+P", "unpin_all", "unpin all", shift=True),
     Binding((glfw.KEY_R,), "R", "reset", "reset"),
     Binding((glfw.KEY_H,), "H", "toggle_panel", "hide the panel"),
@@ -73,7 +73,7 @@ BINDINGS = (
 )
 #: The mouse: (what, does).
 MOUSE = (
-    ("left-drag a branch or leaf", "drag it, let go: swing (with Shift held: pin it)"),
+    ("left-drag a branch or leaf", "drag it, let go: swing"),
     ("left-drag the sky", "orbit"),
     ("right/middle-drag", "pan"),
     ("wheel", "zoom"),

@@ -218,26 +218,29 @@ class Panel:
         return pressed
 
     def _timeline(self) -> None:
-        """The timeline: a slider over the kept states' times (moving it pauses there), ← and
-        → a state, and what it keeps."""
+        """The timeline in one row: ← and → a kept state, a slider over the kept states' times
+        (moving it pauses there); what it keeps in its tooltip."""
         v = self.viewer
         tl = v.timeline
         times = tl.times
-        if len(times) < 2:
-            imgui.text_disabled("timeline: the last seconds, once the tree runs")
-            return
-        now = times[-1 if tl.cursor is None else tl.cursor]
-        changed, t = imgui.slider_float("timeline", float(now), float(times[0]), float(times[-1]), "%.2f s")
-        self._rect("timeline", frame_only=True)
-        if changed:
-            v.scrub(int(np.argmin(np.abs(times - t))))
         if imgui.arrow_button("##back", imgui.Dir.left):
             v.step_back()
         imgui.same_line()
         if imgui.arrow_button("##forward", imgui.Dir.right):
             v.step_forward()
         imgui.same_line()
-        imgui.text_disabled(f"{times[-1] - times[0]:.1f} s kept, {len(times)} states, {tl.memory / 2**20:.0f} MB")
+        imgui.push_item_width(imgui.calc_item_width() - imgui.get_cursor_pos_x() + imgui.get_style().window_padding.x)
+        now = times[-1 if tl.cursor is None else tl.cursor] if len(times) else v.sim.time
+        lo, hi = (float(times[0]), float(times[-1])) if len(times) > 1 else (now, now + 1e-6)
+        changed, t = imgui.slider_float("timeline", float(now), lo, hi, "%.2f s")
+        imgui.pop_item_width()
+        self._rect("timeline", frame_only=True)
+        if changed and len(times):
+            v.scrub(int(np.argmin(np.abs(times - t))))
+        if imgui.is_item_hovered():
+            imgui.set_tooltip(f"the last {hi - lo:.1f} s: {len(times)} states, {tl.memory / 2**20:.0f} MB "
+                              f"(at most {tl.seconds:.0f} s, {tl.budget / 2**20:.0f} MB)\n"
+                              "drag back to pause there; Space resumes from it, forgetting what came after")
 
     def _hold(self) -> None:
         """The grab's strength (with what it holds) and the pins, each with its × to let go."""
@@ -373,6 +376,13 @@ class Panel:
                 v.frame_camera()
             self._timeline()
 
+        # --- overlays
+        if self._header("Overlays", open_=True):
+            self.widget("show_trace")
+            imgui.same_line()
+            self.widget("show_frames")
+            self.widget("show_wind")
+
         # --- grab strength, pins
         if self._header("Grab and pins", open_=True):
             self._hold()
@@ -380,14 +390,7 @@ class Panel:
         # --- live plots
         if self._header("Plots"):
             w = imgui.get_content_region_avail().x
-            draw_plots(v.signals, w, 0.55 * w)
-
-        # --- overlays
-        if self._header("Overlays", open_=True):
-            self.widget("show_trace")
-            imgui.same_line()
-            self.widget("show_frames")
-            self.widget("show_wind")
+            draw_plots(v.signals, w, 0.65 * w, shown=v.sim.time if v.timeline.cursor is not None else None)
 
         # --- light
         if self._header("Light"):

@@ -1,6 +1,7 @@
 """Live plots in the panel (issue 31), drawn with ImPlot: the pulled point's trace (its
 displacement from rest over the last seconds) and the spectra of the wind at the canopy top, of
-the trunk top's sway and of the grabbed point's (log-log).
+the trunk top's sway and of the grabbed point's (log-log, each over its total power, so their
+shapes share one axis).
 
 :class:`Signals` records, after every step, the time, the wind speed at the canopy top (above
 the first trunk's base, at the tree's height), the trunk top's displacement and the traced
@@ -154,32 +155,37 @@ def _peak(f: np.ndarray, p: np.ndarray) -> str:
     return f"{f[int(np.argmax(p))]:.2f} Hz" if len(p) and p.max() > 0 else "–"
 
 
-def draw_plots(signals: Signals, width: float, height: float) -> None:
-    """Draw the trace and the spectra plots (inside the panel's window)."""
+def draw_plots(signals: Signals, width: float, height: float, shown: float | None = None) -> None:
+    """Draw the trace and the spectra plots (inside the panel's window); ``shown``: the time of
+    the state shown, marked on the trace when the timeline is scrubbed back."""
     from imgui_bundle import imgui, implot
 
     size = imgui.ImVec2(width, height)
+    flags = implot.Flags_.no_menus | implot.Flags_.no_box_select
     t, d = signals.trace()
-    if implot.begin_plot("grabbed point##trace", size, implot.Flags_.no_menus | implot.Flags_.no_box_select):
+    if implot.begin_plot("grabbed point##trace", size, flags):
         implot.setup_axes("s", "m", implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
         implot.setup_axis_limits(implot.ImAxis_.x1, -TRACE_SECONDS, 0.0, implot.Cond_.always)
-        for c, name in enumerate("xyz"):
-            if len(t) > 1:
+        implot.setup_legend(implot.Location_.north, implot.LegendFlags_.horizontal | implot.LegendFlags_.outside)
+        if len(t) > 1:
+            for c, name in enumerate("xyz"):
                 implot.plot_line(name, np.ascontiguousarray(t), np.ascontiguousarray(d[:, c]))
+        newest = signals.window()[0]
+        if shown is not None and len(newest) and shown < newest[-1]:
+            implot.plot_inf_lines("shown", np.array([shown - newest[-1]]))
         implot.end_plot()
     sp = signals.spectra()
-    imgui.text_disabled(f"peaks: wind {_peak(*sp['wind'])}, trunk top {_peak(*sp['sway'])}, "
+    imgui.text_disabled(f"peaks: wind {_peak(*sp['wind'])}, trunk {_peak(*sp['sway'])}, "
                         f"grabbed {_peak(*sp['grabbed'])}")
-    if implot.begin_plot("spectra##spectra", size, implot.Flags_.no_menus | implot.Flags_.no_box_select):
-        implot.setup_axes("Hz", "m²/Hz", implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
-        implot.setup_axis(implot.ImAxis_.y2, "(m/s)²/Hz", implot.AxisFlags_.auto_fit | implot.AxisFlags_.opposite)
-        for axis in (implot.ImAxis_.x1, implot.ImAxis_.y1, implot.ImAxis_.y2):
-            implot.setup_axis_scale(axis, implot.Scale_.log10)
-        for name, key, axis in (("trunk top", "sway", implot.ImAxis_.y1), ("grabbed", "grabbed", implot.ImAxis_.y1),
-                                ("wind", "wind", implot.ImAxis_.y2)):
+    if implot.begin_plot("spectra, each ÷ its power##spectra", imgui.ImVec2(width, 1.2 * height), flags):
+        implot.setup_axes("Hz", "1/Hz", implot.AxisFlags_.auto_fit, implot.AxisFlags_.auto_fit)
+        implot.setup_legend(implot.Location_.north, implot.LegendFlags_.horizontal | implot.LegendFlags_.outside)
+        implot.setup_axis_scale(implot.ImAxis_.x1, implot.Scale_.log10)
+        implot.setup_axis_scale(implot.ImAxis_.y1, implot.Scale_.log10)
+        for name, key in (("trunk top", "sway"), ("grabbed", "grabbed"), ("wind", "wind")):
             f, p = sp[key]
             ok = p > 0
-            if ok.sum() > 1:
-                implot.set_axes(implot.ImAxis_.x1, axis)
-                implot.plot_line(name, np.ascontiguousarray(f[ok]), np.ascontiguousarray(p[ok]))
+            if ok.sum() > 1:  # shapes compared on one axis: each spectrum over its total power
+                share = p[ok] / (p.sum() * (f[1] - f[0]))
+                implot.plot_line(name, np.ascontiguousarray(f[ok]), np.ascontiguousarray(share))
         implot.end_plot()
