@@ -88,3 +88,39 @@ def test_grabbing_a_leaf_on_the_tree_model_holds_it_where_it_hangs():
     np.testing.assert_allclose(g.anchor(sim), picked, atol=1e-9)
     g.release(sim)
     assert not sim.drags
+
+
+def test_the_tree_model_holds_several_drags_each_with_its_own_spring():
+    sim = ta.Simulation(ta.load_preset("small_cherry"), wind=None)
+    tree = sim.tree
+    a, b = (int(i) for i in np.flatnonzero((tree.kind == "branch") & (tree.level == 2))[:2])
+    for _ in range(60):  # settled under its weight
+        sim.step(1 / 60)
+    pa = sim.point_position(a, 1.0)
+
+    def across(i):  # 1 cm level and square to the branch: it bends, not stretches
+        nodes = tree.rest_positions[tree.object_nodes(i)]
+        d = np.cross(nodes[-1] - nodes[0], [0.0, 1.0, 0.0])
+        return 0.01 * d / np.linalg.norm(d)
+
+    sim.drag(a, pa + across(a))  # the default: 50 times as stiff as the tree there
+    k50 = sim.drags[a][1]
+    sim.drag(a, pa + across(a), 1.0, stiffness=1.0)  # again: as stiff as the tree
+    assert sim.drags[a][1] == pytest.approx(k50 / 50)
+    for _ in range(180):
+        sim.step(1 / 60)
+    # the point held by its spring in series with the tree: s / (1 + s) of its drag
+    assert (sim.point_position(a, 1.0) - pa) @ across(a) / 1e-4 == pytest.approx(0.5, abs=0.03)
+    pb = sim.point_position(b, 1.0)
+    sim.drag(b, pb + across(b))  # a second drag: both held (b's bends the trunk a carries on)
+    assert sorted(sim.drags) == sorted([a, b])
+    for _ in range(180):
+        sim.step(1 / 60)
+    assert (sim.point_position(b, 1.0) - pb) @ across(b) / 1e-4 > 0.9
+    assert (sim.point_position(a, 1.0) - pa) @ across(a) / 1e-4 > 0.3
+    sim.release(a)
+    assert list(sim.drags) == [b]
+    for bad in (0.0, -1.0, float("nan"), 1e5):
+        with pytest.raises(ValueError, match="stiffness") as e:
+            sim.drag(a, pa, 1.0, stiffness=bad)
+        assert "\n" not in str(e.value)
