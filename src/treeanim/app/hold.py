@@ -80,17 +80,13 @@ class ViewerHold:
         return True
 
     def unpin(self, index: int | None = None) -> int:
-        """Let go of pin ``index`` (in :attr:`pins`; None: of all): the branch swings back.
-        Returns how many were let go."""
+        """Let go of pin ``index`` (in :attr:`pins`; None: of all, Shift+P): the branch swings
+        back. Returns how many were let go."""
         gone = self.pins if index is None else self.pins[index:index + 1]
         for p in gone:
             p.release(self.sim)
         self.pins = [] if index is None else self.pins[:index] + self.pins[index + 1:]
         return len(gone)
-
-    def unpin_all(self) -> int:
-        """Let go of every pin (Shift+P)."""
-        return self.unpin(None)
 
     def _take_pin(self, obj: int) -> None:
         """A new grab of ``obj`` takes over its pin (the simulation holds one drag an object)."""

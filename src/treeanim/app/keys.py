@@ -56,7 +56,7 @@ BINDINGS = (
     Binding((glfw.KEY_LEFT,), "Left", "step_back", "pause, step back"),
     Binding((glfw.KEY_RIGHT,), "Right", "step_forward", "step forward"),
     Binding((glfw.KEY_P,), "P", "pin", "pin the branch dragged (or let go with Shift)", shift=False),
-    Binding((glfw.KEY_P,), "Shift+P", "unpin_all", "unpin all", shift=True),
+    Binding((glfw.KEY_P,), "Shift+P", "unpin", "unpin all", shift=True),
     Binding((glfw.KEY_R,), "R", "reset", "reset"),
     Binding((glfw.KEY_H,), "H", "toggle_panel", "hide the panel"),
     Binding((glfw.KEY_S, glfw.KEY_F12), "S/F12", "request_screenshot", "screenshot"),

@@ -248,18 +248,16 @@ class Panel:
         self.widget("grab_strength")
         spring = f", now {v.grab.spring(v.sim):.3g} N/m" if v.grab is not None else ""
         imgui.text_disabled(f"covers {100 * v.held_share():.1f} % of a drag{spring}")
-        springs = v.sim.drags
         for j, p in enumerate(v.pins):
             if imgui.small_button(f"x##pin{j}"):
                 v.unpin(j)
                 break
             self._rect(f"unpin {j}")
             imgui.same_line()
-            k = springs[p.object][1] if p.object in springs else 0.0
-            imgui.text(f"pin #{p.object} ({v.sim.tree.kind[p.object]}) s = {p.s:.2f}, {k:.3g} N/m")
+            imgui.text(f"pin #{p.object} ({v.sim.tree.kind[p.object]}) s = {p.s:.2f}, {p.spring(v.sim):.3g} N/m")
         if v.pins:
             if imgui.small_button("unpin all"):
-                v.unpin_all()
+                v.unpin()
         else:
             imgui.text_disabled("P or Shift + let go: pin the branch dragged")
 
