@@ -233,8 +233,8 @@ class Panel:
         now = times[-1 if tl.cursor is None else tl.cursor] if len(times) else v.sim.time
         lo, hi = (float(times[0]), float(times[-1])) if len(times) > 1 else (now, now + 1e-6)
         changed, t = imgui.slider_float("timeline", float(now), lo, hi, "%.2f s")
+        self._rect("timeline", frame_only=True)  # (the slider's own width, pushed)
         imgui.pop_item_width()
-        self._rect("timeline", frame_only=True)
         if changed and len(times):
             v.scrub(int(np.argmin(np.abs(times - t))))
         if imgui.is_item_hovered():
