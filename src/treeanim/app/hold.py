@@ -42,15 +42,14 @@ class ViewerHold:
         The pinned drags, oldest first.
     """
 
-    grab_strength: float = 1.0
-
     def _init_hold(self) -> None:
         self.grab_strength = 1.0
         self.pins: list[TreeDrag] = []
 
     def set_grab_strength(self, strength: float) -> None:
         """The grab's spring × its default, clamped to :data:`GRAB_STRENGTHS` (ValueError: not
-        a number); a grab in progress takes it at once."""
+        a number); a drag in progress (the tree model) takes it at once, a spring pull the next
+        time."""
         strength = float(strength)
         if math.isnan(strength):
             raise ValueError("grab strength: expected a number, got nan")
