@@ -90,10 +90,11 @@ def check_tree_and_panel(v, samples):
     assert differs[:, x1 + 4:].mean() < 0.01
 
 
-def branch_on_screen(v, w=W, h=H):
-    """A branch whose tip region is visible and picks as itself: (object, x, y)."""
+def branch_on_screen(v, w=W, h=H, exclude=()):
+    """A branch (not one of ``exclude``) whose tip region is visible and picks as itself:
+    (object, x, y)."""
     tree, P = v.tree, v.sim.positions
-    branches = [i for i in np.flatnonzero(tree.kind == "branch") if tree.level[i] >= 2]
+    branches = [i for i in np.flatnonzero(tree.kind == "branch") if tree.level[i] >= 2 and i not in exclude]
 
     def length(i):
         return np.linalg.norm(np.diff(tree.rest_positions[tree.object_nodes(i)], axis=0), axis=1).sum()

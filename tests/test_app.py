@@ -78,7 +78,7 @@ def test_dragging_a_branch_moves_it_to_the_cursor_and_it_swings_back_after_relea
             moved.append(v.camera.project(p, W, H)[0, :2])
         assert calls[-1] == obj, "the grabbed branch is drawn highlighted"
         if model == "tree":
-            assert v.sim.dragging[0] == obj and not v.sim.pulls
+            assert list(v.sim.drags) == [obj] and not v.sim.pulls
         else:
             assert obj in v.sim.pulls
         gap0 = np.linalg.norm(target - start)
@@ -98,7 +98,7 @@ def test_dragging_a_branch_moves_it_to_the_cursor_and_it_swings_back_after_relea
         # Let go: it swings back towards (and, the paper's, through) its rest pose.
         tip_held = v.sim.tip_position(obj)
         v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
-        assert v.grab is None and not v.sim.pulls and v.sim.dragging is None and v._mode is None
+        assert v.grab is None and not v.sim.pulls and not v.sim.drags and v._mode is None
         assert calls[-1] == obj
         v.frame(DT)
         assert calls[-1] is None
@@ -131,8 +131,8 @@ def test_a_drag_on_the_tree_model_goes_through_sim_drag_and_release_lets_go(view
     sim = v.sim
     drags, releases = [], []
     drag, release = type(sim).drag, type(sim).release
-    monkeypatch.setattr(type(sim), "drag", lambda self, i, target, s=1.0: (drags.append((i, np.array(target), s)),
-                                                                              drag(self, i, target, s))[1])
+    monkeypatch.setattr(type(sim), "drag", lambda self, i, target, s=1.0, stiffness=50.0: (
+        drags.append((i, np.array(target), s)), drag(self, i, target, s, stiffness))[1])
     monkeypatch.setattr(type(sim), "release", lambda self, i=None: (releases.append(i), release(self, i))[1])
     obj, x, y = branch_on_screen(v)
     hit = v.pick(x, y)
@@ -160,9 +160,9 @@ def test_a_drag_on_the_tree_model_goes_through_sim_drag_and_release_lets_go(view
     np.testing.assert_allclose(drags[1][1], g.target - g.offset)
     v.advance(DT)
     assert len(drags) == 2, "a target that did not move is not handed over again"
-    assert v.sim.dragging[0] == obj and not v.sim.pulls
+    assert list(v.sim.drags) == [obj] and not v.sim.pulls
     v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
-    assert releases == [obj] and v.sim.dragging is None and v.grab is None and v._mode is None
+    assert releases == [obj] and not v.sim.drags and v.grab is None and v._mode is None
 
 
 def test_losing_focus_mid_drag_lets_go(viewer):
@@ -171,9 +171,9 @@ def test_losing_focus_mid_drag_lets_go(viewer):
     press(v, x, y)
     v.on_cursor_pos(x + 40, y)
     v.frame(DT)
-    assert v.sim.dragging[0] == obj
+    assert list(v.sim.drags) == [obj]
     v.on_focus(False)
-    assert v.grab is None and v.sim.dragging is None and not v.sim.pulls and v._mode is None
+    assert v.grab is None and not v.sim.drags and not v.sim.pulls and v._mode is None
     v.on_focus(True)
     v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)  # the late release does nothing
     v.frame(DT)
@@ -484,7 +484,7 @@ def test_switching_the_model_mid_drag_lets_go(viewer):
     v = viewer
     obj, x, y = branch_on_screen(v)
     press(v, x, y)
-    assert isinstance(v.grab, TreeDrag) and v.sim.dragging is not None
+    assert isinstance(v.grab, TreeDrag) and v.sim.drags
     v.set_model("paper")
     assert v.grab is None and v._mode is None and v.traced is None and len(v.trace) == 0
     assert not v.sim.pulls and v.sim.model == "paper"
@@ -849,7 +849,7 @@ def test_grab_substeps_follow_the_grabbed_point_not_the_whole_pose(viewer, monke
         if model == "paper":
             assert obj in v.sim.pulls
         else:
-            assert v.sim.dragging[0] == obj
+            assert list(v.sim.drags) == [obj]
     finally:
         monkeypatch.undo()
         v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)

@@ -49,15 +49,15 @@ def test_a_drag_on_the_tree_model_holds_the_picked_point_where_it_was_picked():
     assert g.s == pytest.approx((L[:4].sum() + 0.5 * L[4]) / L.sum(), abs=1e-6)
     np.testing.assert_allclose(g.offset, [0.0, 0.0, 0.01], atol=1e-9)
     np.testing.assert_allclose(g.anchor(sim), picked, atol=1e-9)  # the picked point itself: no jump
-    obj, target = sim.dragging
-    assert obj == 0
+    assert list(sim.drags) == [0]
+    target = sim.drags[0][0]
     np.testing.assert_allclose(target, sim.point_position(0, g.s), atol=1e-9)
     g.aim(picked + [0.0, 0.0, 5.0], [0.03, 0.0, -1.0])  # 15 cm sideways in the plane z = picked z
     np.testing.assert_allclose(g.target, picked + [0.15, 0.0, 0.0], atol=1e-12)
     g.step(sim, 1 / 60)
-    np.testing.assert_allclose(sim.dragging[1], g.target - g.offset)
+    np.testing.assert_allclose(sim.drags[0][0], g.target - g.offset)
     g.release(sim)
-    assert sim.dragging is None
+    assert not sim.drags
 
 
 @pytest.mark.parametrize("segment", [9, 4], ids=["tip", "middle"])
@@ -75,7 +75,7 @@ def test_a_drag_on_the_tree_model_brings_the_grabbed_point_to_the_cursor(segment
     assert abs(gap[0]) < 0.1 * 0.1 and np.linalg.norm(gap) < 0.3 * 0.1, "the grabbed point follows the cursor"
     assert np.array_equal(g.grabbed_point(sim, exact=False), g.anchor(sim))
     g.release(sim)
-    assert sim.dragging is None
+    assert not sim.drags
 
 
 def test_grabbing_a_leaf_on_the_tree_model_holds_it_where_it_hangs():
@@ -84,7 +84,43 @@ def test_grabbing_a_leaf_on_the_tree_model_holds_it_where_it_hangs():
     nodes = sim.tree.object_nodes(leaf)
     picked = sim.positions[nodes[-1]]
     g = grab(sim, leaf, picked, plane_normal=(0.0, 0.0, -1.0))
-    assert isinstance(g, TreeDrag) and sim.dragging[0] == leaf
+    assert isinstance(g, TreeDrag) and list(sim.drags) == [leaf]
     np.testing.assert_allclose(g.anchor(sim), picked, atol=1e-9)
     g.release(sim)
-    assert sim.dragging is None
+    assert not sim.drags
+
+
+def test_the_tree_model_holds_several_drags_each_with_its_own_spring():
+    sim = ta.Simulation(ta.load_preset("small_cherry"), wind=None)
+    tree = sim.tree
+    a, b = (int(i) for i in np.flatnonzero((tree.kind == "branch") & (tree.level == 2))[:2])
+    for _ in range(60):  # settled under its weight
+        sim.step(1 / 60)
+    pa = sim.point_position(a, 1.0)
+
+    def across(i):  # 1 cm level and square to the branch: it bends, not stretches
+        nodes = tree.rest_positions[tree.object_nodes(i)]
+        d = np.cross(nodes[-1] - nodes[0], [0.0, 1.0, 0.0])
+        return 0.01 * d / np.linalg.norm(d)
+
+    sim.drag(a, pa + across(a))  # the default: 50 times as stiff as the tree there
+    k50 = sim.drags[a][1]
+    sim.drag(a, pa + across(a), 1.0, stiffness=1.0)  # again: as stiff as the tree
+    assert sim.drags[a][1] == pytest.approx(k50 / 50)
+    for _ in range(180):
+        sim.step(1 / 60)
+    # the point held by its spring in series with the tree: s / (1 + s) of its drag
+    assert (sim.point_position(a, 1.0) - pa) @ across(a) / 1e-4 == pytest.approx(0.5, abs=0.03)
+    pb = sim.point_position(b, 1.0)
+    sim.drag(b, pb + across(b))  # a second drag: both held (b's bends the trunk a carries on)
+    assert sorted(sim.drags) == sorted([a, b])
+    for _ in range(180):
+        sim.step(1 / 60)
+    assert (sim.point_position(b, 1.0) - pb) @ across(b) / 1e-4 > 0.9
+    assert (sim.point_position(a, 1.0) - pa) @ across(a) / 1e-4 > 0.3
+    sim.release(a)
+    assert list(sim.drags) == [b]
+    for bad in (0.0, -1.0, float("nan"), 1e5):
+        with pytest.raises(ValueError, match="stiffness") as e:
+            sim.drag(a, pa, 1.0, stiffness=bad)
+        assert "\n" not in str(e.value)

@@ -121,7 +121,7 @@ def test_a_scripted_drag_moves_the_beams_tip_toward_the_target():
     for _ in frames(sim, 20, 10, [Drag(0, tuple(target), 0.0, 2.5)]):
         pass
     assert np.linalg.norm(sim.tip_position(0) - target) < 0.3 * 0.1
-    assert sim.dragging is None, "let go at the end"
+    assert not sim.drags, "let go at the end"
 
 
 @pytest.mark.parametrize("text,drag", [

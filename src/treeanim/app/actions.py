@@ -1,6 +1,6 @@
 """What the panel, the keys and scripts do to the viewer, each a plain method: open a preset or a
 file, save, switch the model, set the season, the wind, the physics, the time scale, the light
-and the overlays, pause, take a screenshot, say a line in the status line.
+and the overlays, take a screenshot, say a line in the status line.
 
 Mixed into :class:`treeanim.app.viewer.Viewer`, whose simulation, scene and window they change.
 The setters go through the simulation's checked properties and raise ValueError on a refusal
@@ -114,8 +114,7 @@ class ViewerActions:
         self._end_drag()
         self.sim.model = name
         self._model = self.sim.model
-        self.trace.clear()
-        self.traced = None
+        self._restarted()
         self._uploaded = None
         self.note_defaults()  # the paper model's settings, the first time it runs on this tree
 
@@ -200,15 +199,6 @@ class ViewerActions:
         if math.isnan(scale):
             raise ValueError("time scale: expected a number, got nan")
         self.time_scale = min(max(scale, TIME_SCALES[0]), TIME_SCALES[1])
-
-    # ------------------------------------------------------------------ time
-    def set_paused(self, paused: bool) -> None:
-        """Pause (True) or resume the simulation."""
-        self.paused = bool(paused)
-
-    def toggle_pause(self) -> None:
-        """Pause or resume the simulation."""
-        self.set_paused(not self.paused)
 
     # ------------------------------------------------------------------ the look
     @property

@@ -18,7 +18,7 @@ from __future__ import annotations
 import os
 
 import glfw
-from imgui_bundle import imgui
+from imgui_bundle import imgui, implot
 
 #: GLFW key → ImGui key, for the keys a panel uses (text fields, navigation, shortcuts).
 _KEYS: dict[int, "imgui.Key"] = {
@@ -74,6 +74,7 @@ class Gui:
         self.scale = float(scale)
         self.ctx = imgui.create_context()
         imgui.set_current_context(self.ctx)
+        self.plot_ctx = implot.create_context()  # the panel's live plots (ImPlot)
         self.io = io = imgui.get_io()
         io.set_ini_filename(None)  # no imgui.ini in the user's folder
         io.config_flags &= ~imgui.ConfigFlags_.nav_enable_keyboard
@@ -195,6 +196,7 @@ class Gui:
     def new_frame(self, width: int, height: int, fb_width: int, fb_height: int, dt: float) -> None:
         """Begin a frame over a window of ``width`` × ``height`` screen units."""
         imgui.set_current_context(self.ctx)
+        implot.set_current_context(self.plot_ctx)
         io = self.io
         io.display_size = imgui.ImVec2(float(width), float(height))
         if width > 0 and height > 0:
@@ -225,4 +227,5 @@ class Gui:
         if self.in_frame:
             imgui.end_frame()
         imgui.backends.opengl3_shutdown()
+        implot.destroy_context(self.plot_ctx)
         imgui.destroy_context(self.ctx)

@@ -1,8 +1,8 @@
 """The viewer's input handlers: what a GLFW window's callbacks call, and what tests and scripts
 call directly on a headless app. Buttons, actions and keys are GLFW's codes (plain constants).
 
-A left-drag on an object drags it (the tree model; the paper's pulls it with a spring),
-elsewhere it orbits; a right or middle drag pans, the wheel
+A left-drag on an object drags it (the tree model; the paper's pulls it with a spring; let go
+with Shift held, the drag stays pinned), elsewhere it orbits; a right or middle drag pans, the wheel
 zooms; keys act through the table in :mod:`treeanim.app.keys`; the panel gets the mouse and
 the keyboard while it wants them. Mixed into :class:`treeanim.app.viewer.Viewer`, whose
 camera, panel, gui, window and grabs they drive.
@@ -70,7 +70,9 @@ class ViewerInput:
         elif action == glfw.RELEASE:
             self.gui.mouse_button(button, False)
             if button == self._mode_button:
-                self._end_drag()
+                # let go with Shift held: the drag stays, pinned (hold.py)
+                if not (mods & glfw.MOD_SHIFT and self._mode == "pull" and self.pin()):
+                    self._end_drag()
 
     def on_scroll(self, dx: float, dy: float) -> None:
         """Wheel turned (dy > 0: away from the user, zooms in)."""

@@ -52,7 +52,11 @@ _DIGITS = (glfw.KEY_1, glfw.KEY_2, glfw.KEY_3, glfw.KEY_4)
 #: Every shortcut, in the order the help lists them.
 BINDINGS = (
     Binding((glfw.KEY_F,), "F", "frame_camera", "frame the tree"),
-    Binding((glfw.KEY_SPACE,), "Space", "toggle_pause", "pause"),
+    Binding((glfw.KEY_SPACE,), "Space", "toggle_pause", "pause (resume: from the timeline's state)"),
+    Binding((glfw.KEY_LEFT,), "Left", "step_back", "pause, step back"),
+    Binding((glfw.KEY_RIGHT,), "Right", "step_forward", "step forward"),
+    Binding((glfw.KEY_P,), "P", "pin", "pin the branch dragged (or let go with Shift)", shift=False),
+    Binding((glfw.KEY_P,), "Shift+P", "unpin", "unpin all", shift=True),
     Binding((glfw.KEY_R,), "R", "reset", "reset"),
     Binding((glfw.KEY_H,), "H", "toggle_panel", "hide the panel"),
     Binding((glfw.KEY_S, glfw.KEY_F12), "S/F12", "request_screenshot", "screenshot"),

@@ -20,6 +20,7 @@ from imgui_bundle import imgui
 from ..model.tree import KINDS, PLURAL
 from ..physics.wind import WIND_PRESETS, named_wind
 from .keys import help_lines
+from .plots import draw_plots
 from .settings import EI_SPAN, SETTINGS
 
 #: Width of the panel in screen units at UI scale 1.
@@ -216,6 +217,50 @@ class Panel:
         self._rect(rect)
         return pressed
 
+    def _timeline(self) -> None:
+        """The timeline in one row: ← and → a kept state, a slider over the kept states' times
+        (moving it pauses there); what it keeps in its tooltip."""
+        v = self.viewer
+        tl = v.timeline
+        times = tl.times
+        if imgui.arrow_button("##back", imgui.Dir.left):
+            v.step_back()
+        imgui.same_line()
+        if imgui.arrow_button("##forward", imgui.Dir.right):
+            v.step_forward()
+        imgui.same_line()
+        imgui.push_item_width(imgui.calc_item_width() - imgui.get_cursor_pos_x() + imgui.get_style().window_padding.x)
+        now = times[-1 if tl.cursor is None else tl.cursor] if len(times) else v.sim.time
+        lo, hi = (float(times[0]), float(times[-1])) if len(times) > 1 else (now, now + 1e-6)
+        changed, t = imgui.slider_float("timeline", float(now), lo, hi, "%.2f s")
+        self._rect("timeline", frame_only=True)  # (the slider's own width, pushed)
+        imgui.pop_item_width()
+        if changed and len(times):
+            v.scrub(int(np.argmin(np.abs(times - t))))
+        if imgui.is_item_hovered():
+            imgui.set_tooltip(f"the last {hi - lo:.1f} s: {len(times)} states, {tl.memory / 2**20:.0f} MB "
+                              f"(at most {tl.seconds:.0f} s, {tl.budget / 2**20:.0f} MB)\n"
+                              "drag back to pause there; Space resumes from it, forgetting what came after")
+
+    def _hold(self) -> None:
+        """The grab's strength (with what it holds) and the pins, each with its × to let go."""
+        v = self.viewer
+        self.widget("grab_strength")
+        spring = f", now {v.grab.spring(v.sim):.3g} N/m" if v.grab is not None else ""
+        imgui.text_disabled(f"covers {100 * v.held_share():.1f} % of a drag{spring}")
+        for j, p in enumerate(v.pins):
+            if imgui.small_button(f"x##pin{j}"):
+                v.unpin(j)
+                break
+            self._rect(f"unpin {j}")
+            imgui.same_line()
+            imgui.text(f"pin #{p.object} ({v.sim.tree.kind[p.object]}) s = {p.s:.2f}, {p.spring(v.sim):.3g} N/m")
+        if v.pins:
+            if imgui.small_button("unpin all"):
+                v.unpin()
+        else:
+            imgui.text_disabled("P or Shift + let go: pin the branch dragged")
+
     def _tuning_row(self) -> None:
         """Undo, Redo and Reset all (right-click a setting: that one back to its default)."""
         v = self.viewer
@@ -327,6 +372,7 @@ class Panel:
             imgui.same_line()
             if imgui.button("Frame"):
                 v.frame_camera()
+            self._timeline()
 
         # --- overlays
         if self._header("Overlays", open_=True):
@@ -334,6 +380,15 @@ class Panel:
             imgui.same_line()
             self.widget("show_frames")
             self.widget("show_wind")
+
+        # --- grab strength, pins
+        if self._header("Grab and pins", open_=True):
+            self._hold()
+
+        # --- live plots
+        if self._header("Plots"):
+            w = imgui.get_content_region_avail().x
+            draw_plots(v.signals, w, 0.65 * w, shown=v.sim.time if v.timeline.cursor is not None else None)
 
         # --- light
         if self._header("Light"):

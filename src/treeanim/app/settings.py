@@ -21,6 +21,7 @@ from ..model.params import MODE_PARAMS, PARAMS
 from ..model.tree import KINDS
 from ..physics.oscillator import INTEGRATORS
 from .actions import SUN_ELEVATIONS, TIME_SCALES
+from .hold import GRAB_STRENGTHS
 
 __all__ = ["Setting", "SETTINGS", "EI_SPAN"]
 
@@ -205,6 +206,9 @@ SETTINGS: dict[str, Setting] = {
     "physical_modes": _check("physical modes (beam theory)", _physical_modes, "set_physical_modes",
                              shown=_paper_model, paper_only=True),
     "paused": _check("paused", "paused", "set_paused"),
+    # the mouse's spring × its default (hold.py)
+    "grab_strength": Setting("grab strength", "grab_strength", "set_grab_strength", lo=GRAB_STRENGTHS[0],
+                             hi=GRAB_STRENGTHS[1], fmt="%.3g×", log=True, clamp=True),
     # draft mode for slow renderers: half resolution, no MSAA, no shadows (not undone or reset)
     "draft": _check("draft", "draft", "set_draft"),
     # overlays

@@ -10,7 +10,10 @@ input handlers (``on_mouse_button``, ``on_cursor_pos``, ``on_scroll``, ``on_key`
 and tests call directly; its actions (open, save, the model, the settings, the light, the
 overlays, screenshots: :mod:`~treeanim.app.actions`), which the panel, the keys and scripts
 call; and :meth:`Viewer.frame`, which advances the simulation by the elapsed time and draws one
-frame. :func:`run` is the main loop. The controls are the table in :mod:`treeanim.app.keys`.
+frame. Beside them: the tuning tool (:mod:`~treeanim.app.tuning`), the grab's strength and
+pins (:mod:`~treeanim.app.hold`), the timeline (:mod:`~treeanim.app.timeline`) and the plots'
+signals (:mod:`~treeanim.app.plots`). :func:`run` is the main loop. The controls are the table
+in :mod:`treeanim.app.keys`.
 """
 
 from __future__ import annotations
@@ -29,14 +32,17 @@ from ..physics.simulation import Simulation
 from ..physics.wind import WindField
 from ..physics.wind import wind_preset as wind_preset_kwargs
 from ..render.camera import TREE_ELEVATION, OrbitCamera, frame_tree
-from ..render.overlays import LocalFrames, PullTrace, WindArrow, WindSlices
+from ..render.overlays import LocalFrames, Markers, PullTrace, WindArrow, WindSlices
 from ..render.picking import Picker
 from ..render.renderer import Renderer
 from ..render.scene import Scene
 from .actions import ViewerActions
 from .gui import Gui
+from .hold import ViewerHold
 from .input import ViewerInput
+from .plots import Signals
 from .protocol import AppWindow
+from .timeline import Timeline, ViewerTimeline
 from .tuning import DRAFT_SCALE, ViewerTuning
 from .winddir import wind_direction
 
@@ -64,7 +70,7 @@ class _Ema:
         self.value = x if self.value is None else self.value + self.w * (x - self.value)
 
 
-class Viewer(ViewerInput, ViewerActions, ViewerTuning):
+class Viewer(ViewerInput, ViewerActions, ViewerTuning, ViewerHold, ViewerTimeline):
     """A tree in wind in a window: simulation, renderer, camera, mouse and keys, panel.
 
     Parameters
@@ -111,6 +117,12 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning):
     traced : (int, float) or None
         (object, s) of the point the trace follows: the grabbed point (tree model) or the
         object's tip (s = 1; the paper's model).
+    timeline : Timeline
+        The last seconds of states, to scrub back through (:mod:`~treeanim.app.timeline`).
+    signals : Signals
+        What the panel's plots draw (:mod:`~treeanim.app.plots`).
+    pins : list of TreeDrag
+        The pinned drags (:mod:`~treeanim.app.hold`).
     last_sim_s, last_draw_s : float
         Wall time of the last frame's simulation sub-steps and of its drawing (pose upload,
         draw calls, panel), seconds; ``sim_ms`` and ``render_ms`` are their moving averages.
@@ -156,6 +168,8 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning):
         self.renderer: Renderer | None = None
         self.scene = Scene()  # sun, shadows and leaves' translucency, kept across trees
         self._init_tuning()  # undo history, defaults, camera bookmarks, draft mode (tuning.py)
+        self._init_hold()  # the grab's strength, pins (hold.py)
+        self.timeline = Timeline()
         self._draft_target = None
         named = wind_preset_kwargs(wind_preset) if wind_preset else {}
         if wind_speed is not None:
@@ -202,14 +216,14 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning):
             self.renderer.release()
         self.sim, self.renderer = sim, renderer
         self.picker = Picker(tree)
-        self.trace.clear()
-        self.traced = None
-        self.driver.reset()
+        self.signals = Signals(tree)
+        self._restarted()
         lo, hi = renderer.bounds()
         self.local_frames = LocalFrames(scale=0.25)
         size = float(np.max(hi - lo))
         self.wind_slices = WindSlices(self._wind_at, (lo, hi), resolution=9, reference_speed=None)
         self.wind_arrow = WindArrow(length=0.35 * size, reference_speed=10.0)
+        self.pin_markers = Markers(size=0.04 * size)
         self._wind_arrow_anchor = (0.5 * (lo + hi), 0.65 * size)
         self._follow_file_name()
         self.frame_camera()
@@ -264,11 +278,38 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning):
         the trace following the grabbed point). Returns the steps taken."""
         if self.paused:
             return 0
-        follow = None if self.traced is None else (lambda: self.trace.push(self.traced_point()))
-        n = self.driver.advance(self.sim, real_dt, self.grab, follow)
+        n = self.driver.advance(self.sim, real_dt, self.grab, self._after_step)
         if n:
             self.sim.positions, self.sim.rotations  # the pose is built lazily: count it as simulation
         return n
+
+    def _steps(self, n: int) -> None:
+        """Take ``n`` steps now (paused or not), as :meth:`advance` takes them."""
+        for j in range(n):
+            if self.grab is not None:
+                self.grab.step(self.sim, self.substep, exact=j == 0)
+            self.sim.step(self.substep)
+            self._after_step()
+
+    def _after_step(self) -> None:
+        """After every step: the trace follows the grabbed point, the timeline and the plots'
+        signals record."""
+        at = None
+        if self.traced is not None:
+            at = self.traced_point()
+            self.trace.push(at)
+        self.timeline.record(self.sim)
+        self.signals.record(self.sim, self.traced, at)
+
+    def _restarted(self) -> None:
+        """The simulation starts again (a new tree or model, a reset): no trace, pins,
+        timeline or signals; nothing due."""
+        self.trace.clear()
+        self.traced = None
+        self.pins = []
+        self.timeline.clear()
+        self.signals.clear()
+        self.driver.reset()
 
     # ------------------------------------------------------------------ frames
     def frame(self, dt: float | None = None) -> bool:
@@ -336,6 +377,9 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning):
         out = []
         if self.show_trace and len(self.trace) > 1:
             out.append(self.trace)
+        if self.pins:
+            self.pin_markers.points = self.pinned_points()
+            out.append(self.pin_markers)
         if self.show_frames:
             out.append(self.local_frames)
         if self.show_wind and not self.sim.wind.calm:
@@ -385,7 +429,8 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning):
         hit = self.pick(x, y)
         if hit is None:
             return False
-        self.grab = grab_object(self.sim, hit.object, hit.point, self.camera.forward)
+        self._take_pin(hit.object)
+        self.grab = grab_object(self.sim, hit.object, hit.point, self.camera.forward, self.grab_strength)
         self.trace.clear()
         self.traced = (hit.object, self.grab.s if isinstance(self.grab, TreeDrag) else 1.0)
         self.trace.push(self.traced_point())
@@ -417,12 +462,10 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning):
 
     # ------------------------------------------------------------------ actions (the rest: actions.py)
     def reset(self) -> None:
-        """Back to rest: the simulation at time 0, no grab, no trace."""
+        """Back to rest: the simulation at time 0, no grab, pins, trace or timeline."""
         self._end_drag()
         self.sim.reset()
-        self.trace.clear()
-        self.traced = None
-        self.driver.reset()
+        self._restarted()
 
     def release(self) -> None:
         """Free the GL resources (the window stays open)."""

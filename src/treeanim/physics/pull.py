@@ -4,7 +4,10 @@
 point), its force low-passed and capped, applied through :meth:`Simulation.pull`).
 
 Both have the same interface for the viewer: ``object``, ``target``, ``aim``, ``step``,
-``anchor``, ``grabbed_point``, ``release``; :func:`grab` makes the one ``sim.model`` takes.
+``anchor``, ``grabbed_point``, ``spring``, ``release``; :func:`grab` makes the one ``sim.model``
+takes, its spring scaled by a strength (1: :data:`~treeanim.physics.tree_sim.GRAB_STIFFNESS`
+times the tree's own stiffness at the point on the tree model, a loop gain of :data:`GAIN` on
+the paper's).
 
 The SpringPull's stiffness comes from the simulation's own compliance at the grabbed point
 (:meth:`Simulation.compliance`, the stiffness the bending uses), so the grabbed point covers a
@@ -19,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .simulation import MAX_PULL
+from .tree_sim import GRAB_STIFFNESS
 
 __all__ = ["grab", "TreeDrag", "SpringPull", "TAU", "GAIN", "MAX_LENGTHS"]
 
@@ -56,11 +60,12 @@ def _nearest(P: np.ndarray, nodes: np.ndarray, point: np.ndarray) -> tuple[int, 
     return k, float(s[k]), near[k]
 
 
-def grab(sim, obj: int, point, plane_normal):
+def grab(sim, obj: int, point, plane_normal, strength: float = 1.0):
     """The mouse's grab of object ``obj`` at world ``point`` for ``sim``'s model: a
-    :class:`TreeDrag` on the tree model, a :class:`SpringPull` on the paper's."""
+    :class:`TreeDrag` on the tree model, a :class:`SpringPull` on the paper's; ``strength``
+    scales its spring (1: the default of each)."""
     cls = TreeDrag if sim.model == "tree" else SpringPull
-    return cls.grab(sim, obj, point, plane_normal)
+    return cls.grab(sim, obj, point, plane_normal, strength)
 
 
 @dataclass
@@ -84,6 +89,8 @@ class TreeDrag(_Aimed):
         The plane the target moves in (facing the camera through the picked point).
     target : (3,) float
         The cursor's point in that plane.
+    stiffness : float
+        The spring, in units of the tree's own stiffness at the held point.
     sent : (3,) float or None
         The target last handed to :meth:`Simulation.drag` (the held point's).
     """
@@ -94,14 +101,16 @@ class TreeDrag(_Aimed):
     plane_point: np.ndarray
     plane_normal: np.ndarray
     target: np.ndarray
+    stiffness: float = GRAB_STIFFNESS
     sent: np.ndarray | None = None
 
     @classmethod
-    def grab(cls, sim, obj: int, point, plane_normal) -> "TreeDrag":
+    def grab(cls, sim, obj: int, point, plane_normal, strength: float = 1.0) -> "TreeDrag":
         """Grab object ``obj`` of ``sim`` (model 'tree') at world ``point``: ``s`` is the
         fraction of its length at the point of its current pose nearest ``point`` (measured on
         the rest lengths, as :meth:`Simulation.drag` takes it). The drag starts at once, its
-        target where the held point is (nothing moves until the cursor does)."""
+        target where the held point is (nothing moves until the cursor does), its spring
+        ``strength`` × :data:`~treeanim.physics.tree_sim.GRAB_STIFFNESS`."""
         tree = sim.tree
         nodes = tree.object_nodes(obj)
         point = np.asarray(point, float)
@@ -113,7 +122,8 @@ class TreeDrag(_Aimed):
             s = float(min(max((L[:k].sum() + t * L[k]) / L.sum(), 0.0), 1.0))
         held = np.asarray(sim.point_position(obj, s), float)
         d = cls(object=int(obj), s=s, offset=point - held, plane_point=point.copy(),
-                plane_normal=np.asarray(plane_normal, float).copy(), target=point.copy())
+                plane_normal=np.asarray(plane_normal, float).copy(), target=point.copy(),
+                stiffness=GRAB_STIFFNESS * float(strength))
         d.step(sim, 0.0)
         return d
 
@@ -130,8 +140,12 @@ class TreeDrag(_Aimed):
         solved inside the step)."""
         want = self.target - self.offset
         if self.sent is None or not np.array_equal(want, self.sent):
-            sim.drag(self.object, want, self.s)
+            sim.drag(self.object, want, self.s, self.stiffness)
             self.sent = want
+
+    def spring(self, sim) -> float:
+        """The spring (N/m) holding the point."""
+        return sim.drags[self.object][1]
 
     def release(self, sim) -> None:
         """Let go: the object swings freely from where it is."""
@@ -185,13 +199,13 @@ class SpringPull(_Aimed):
     frame_tip: np.ndarray | None = None
 
     @classmethod
-    def grab(cls, sim, obj: int, point, plane_normal) -> "SpringPull":
+    def grab(cls, sim, obj: int, point, plane_normal, strength: float = 1.0) -> "SpringPull":
         """Grab object ``obj`` of ``sim`` at world ``point`` (on it, or on its lamina), the
         target to move in the plane through ``point`` normal to ``plane_normal``.
 
         The anchor is the nearest point of the object's current pose; the spring constant is
-        :data:`GAIN` over :meth:`Simulation.compliance` there, and the force is capped at the
-        spring force of a drag :data:`MAX_LENGTHS` object lengths long.
+        ``strength`` × :data:`GAIN` over :meth:`Simulation.compliance` there, and the force is
+        capped at the spring force of a drag :data:`MAX_LENGTHS` object lengths long.
         """
         tree = sim.tree
         nodes = tree.object_nodes(obj)
@@ -200,7 +214,7 @@ class SpringPull(_Aimed):
         offset = point - near
         G = max(sim.compliance(obj, k, s, offset), 1e-12)
         G_tip = max(sim.compliance(obj, len(nodes) - 2, 1.0), 1e-12)
-        spring = GAIN / G
+        spring = float(strength) * GAIN / G
         length = float(np.sum(np.linalg.norm(np.diff(tree.rest_positions[nodes], axis=0), axis=1)))
         length += float(tree.lamina_length[obj])
         return cls(object=int(obj), node=int(nodes[k]), s=s, offset=offset, plane_point=point.copy(),
@@ -233,6 +247,10 @@ class SpringPull(_Aimed):
             raw *= f_max / mag
         self.force += (h / (TAU + h)) * (raw - self.force)
         sim.pull(self.object, self.force)
+
+    def spring(self, sim) -> float:
+        """The spring (N/m) pulling the point."""
+        return self.k
 
     def release(self, sim) -> None:
         """Let go: the object swings freely from where it is."""

@@ -20,7 +20,7 @@ import numpy as np
 from ..model.tree import Tree
 from ..validate import finite_float, finite_vector3, float_within, object_index
 from .paper_sim import MAX_FREQUENCY, MAX_PULL, MAX_STEP, MAX_ZETA, PaperSim
-from .tree_sim import TreeSim
+from .tree_sim import GRAB_STIFFNESS, MAX_GRAB_STIFFNESS, TreeSim
 from .wind import fit_to_tree
 
 __all__ = ["Simulation", "MODELS", "MAX_PULL", "MAX_STEP", "MAX_FREQUENCY", "MAX_ZETA"]
@@ -288,34 +288,45 @@ class Simulation:
             raise ValueError(f"force_xyz must have a magnitude of at most {MAX_PULL:g} N, got {f.tolist()}")
         self._impl.pull(i, f)
 
-    def drag(self, i: int, target, s: float = 1.0) -> None:
+    def drag(self, i: int, target, s: float = 1.0, stiffness: float = GRAB_STIFFNESS) -> None:
         """Drag the point at fraction ``s`` of object ``i``'s length (from its base) toward the
         world ``target`` through a stiff spring solved inside the step (tree model).
 
         The held shape is the static balance of the spring and the tree, the same at any frame
         rate; the spring bends no joint past what green wood bears and its target stays above
         the ground. Call again to move the target; :meth:`release` lets go. A leaf is held where
-        it hangs from its twig.
+        it hangs from its twig. Several objects may be dragged at once (:attr:`drags`).
+
+        Parameters
+        ----------
+        stiffness : float
+            The spring in units of the tree's own stiffness at the point, in (0,
+            :data:`~treeanim.physics.tree_sim.MAX_GRAB_STIFFNESS`]: a small drag moves the point
+            stiffness / (1 + stiffness) of the way to the target (the default, 50: 98 %).
 
         Raises
         ------
         ValueError
-            Unknown object, a non-finite target, ``s`` outside [0, 1], or the paper model
-            (whose objects are independent: use :meth:`pull`).
+            Unknown object, a non-finite target, ``s`` outside [0, 1], a stiffness out of
+            range, or the paper model (whose objects are independent: use :meth:`pull`).
         """
         i = self._check_object(i)
         t = finite_vector3("target", target)
         s = finite_float("s", s)
         if not 0.0 <= s <= 1.0:
             raise ValueError(f"s must be in [0, 1], got {s!r}")
+        stiffness = finite_float("stiffness", stiffness)
+        if not 0.0 < stiffness <= MAX_GRAB_STIFFNESS:
+            raise ValueError(f"stiffness must be in (0, {MAX_GRAB_STIFFNESS:g}], got {stiffness!r}")
         if self._model != "tree":
             raise ValueError("drag needs model='tree' (the paper's objects are independent: use pull)")
-        self._impl.drag(i, t, s)
+        self._impl.drag(i, t, s, stiffness)
 
     @property
-    def dragging(self):
-        """(object, target) of the drag in progress, or None."""
-        return getattr(self._impl, "dragging", None)
+    def drags(self) -> dict[int, tuple[np.ndarray, float]]:
+        """The drags held (tree model): object → (target (3,), the spring in N/m); empty on
+        the paper's model."""
+        return getattr(self._impl, "drags", {})
 
     def release(self, i: int | None = None) -> None:
         """Let go of object ``i`` (its pull and drag), or of everything when None."""

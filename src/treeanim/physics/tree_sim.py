@@ -18,7 +18,7 @@ from .falling import FallingLeaves
 from .structure import Structure
 from .treestep import Grab, TreeState, Work
 
-__all__ = ["TreeSim", "SimState", "WOOD_RUPTURE", "GRAB_STIFFNESS"]
+__all__ = ["TreeSim", "SimState", "WOOD_RUPTURE", "GRAB_STIFFNESS", "MAX_GRAB_STIFFNESS"]
 
 #: Green wood's modulus of rupture (Pa; cherry, oak, maple 55–65 MPa green, Wood Handbook
 #: FPL-GTR-190 Table 5-3a, less for the knots of a branch): a grab never bends a joint on the way
@@ -27,6 +27,9 @@ WOOD_RUPTURE = 5.0e7
 #: A grab's spring, in units of the tree's own stiffness at the grabbed point: the point covers
 #: GRAB_STIFFNESS/(1 + GRAB_STIFFNESS) of a small drag (98 %), far stiffer than the branch.
 GRAB_STIFFNESS = 50.0
+#: The stiffest grab :meth:`TreeSim.drag` takes, in the same units (a stiffer spring holds the
+#: point no closer and only stiffens the step's equations).
+MAX_GRAB_STIFFNESS = 1e4
 #: The ground: a grab's target is kept this far above it (m).
 GROUND_CLEARANCE = 0.02
 
@@ -70,8 +73,7 @@ class TreeSim:
         self._next = self._st.copy()
         self._fallen = FallingLeaves(tree.object_start, tree.object_count, tree.rest_w, self._seed)
         self._pulls: dict[int, tuple[int, np.ndarray, np.ndarray, np.ndarray]] = {}  # body, offset, applied, asked
-        self._grab: Grab | None = None
-        self._grab_obj: int | None = None
+        self._grabs: dict[int, tuple[Grab, float, float]] = {}  # object -> grab, s, stiffness
         self.wind = wind
         self._pos = self._rot = None
 
@@ -84,8 +86,8 @@ class TreeSim:
     def _rebuild(self) -> None:
         self._s = Structure.build(self._tree, self._physics, self._present)
         self._work.theta_h = None  # the joints' θ follow their frequencies
-        if self._grab is not None:  # its spring follows the stiffness
-            self.drag(self._grab_obj, self._grab.target, self._grab_s)
+        for i, (g, s, stiffness) in list(self._grabs.items()):  # their springs follow the stiffness
+            self.drag(i, g.target, s, stiffness)
 
     @property
     def season(self) -> float:
@@ -155,7 +157,7 @@ class TreeSim:
         self._next = self._st.copy()
         self._fallen.clear()
         self._pulls.clear()
-        self._grab = None
+        self._grabs.clear()
         self._pos = self._rot = None
 
     @property
@@ -171,7 +173,8 @@ class TreeSim:
         t = st.time
         U = self._sample(treestep.sample_points(s, st), t)
         pulls = [(b, ofs, f) for b, ofs, f, _ in self._pulls.values()]
-        treestep.step(s, st, self._next, U, dt, self._work, pulls, self._grab, self._physics.leaf_flutter)
+        treestep.step(s, st, self._next, U, dt, self._work, pulls,
+                       [g for g, _, _ in self._grabs.values()], self._physics.leaf_flutter)
         if len(self._fallen):
             self._fallen.step(None if self.wind is None else (lambda p: self._sample(p, t)), dt)
         self._st, self._next = self._next, self._st
@@ -261,33 +264,34 @@ class TreeSim:
             j = int(st.parent[j])
         return compliance, f_max
 
-    def drag(self, i: int, target: np.ndarray, s: float = 1.0) -> None:
+    def drag(self, i: int, target: np.ndarray, s: float = 1.0, stiffness: float = GRAB_STIFFNESS) -> None:
         """Hold the point at fraction ``s`` along object ``i`` with a stiff spring toward the
         world ``target`` (kept :data:`GROUND_CLEARANCE` above the ground), solved inside the
-        step; call again to move the target."""
+        step; call again to move the target. ``stiffness``: the spring in units of the tree's
+        own stiffness at the point (validated by the façade). Several objects may be held at
+        once, each by a drag of its own."""
         b, ofs = self._point(i, s)
         target = np.asarray(target, float).copy()
         target[1] = max(target[1], GROUND_CLEARANCE)
         compliance, f_max = self._strength(b, ofs)
-        k = GRAB_STIFFNESS / max(compliance, 1e-30)
+        k = stiffness / max(compliance, 1e-30)
         m = float(self._s.subtree_mass[b])
-        self._grab = Grab(body=b, offset=ofs, target=target, k=k, c=2.0 * np.sqrt(k * m), f_max=float(f_max), mass=m)
-        self._grab_obj, self._grab_s = i, s
+        g = Grab(body=b, offset=ofs, target=target, k=k, c=2.0 * np.sqrt(k * m), f_max=float(f_max), mass=m)
+        self._grabs[i] = (g, s, float(stiffness))
 
     @property
-    def dragging(self) -> tuple[int, np.ndarray] | None:
-        """(object, target) of the drag in progress, or None."""
-        return None if self._grab is None else (self._grab_obj, self._grab.target.copy())
+    def drags(self) -> dict[int, tuple[np.ndarray, float]]:
+        """The drags held: object → (target (3,), spring N/m) (copies)."""
+        return {i: (g.target.copy(), g.k) for i, (g, _, _) in self._grabs.items()}
 
     def release(self, i: int | None = None) -> None:
         """Let go of object ``i``'s pull and drag (None: of everything)."""
         if i is None:
             self._pulls.clear()
-            self._grab = None
+            self._grabs.clear()
             return
         self._pulls.pop(i, None)
-        if self._grab_obj == i:
-            self._grab = None
+        self._grabs.pop(i, None)
 
     def tip_position(self, i: int) -> np.ndarray:
         """Posed world position of object ``i``'s tip node."""

@@ -7,7 +7,7 @@ and writes the next one. One step:
 1. the wind at every segment's middle (the pose at the start), a leaf taking its twig's;
 2. the air's force on every segment, ½ρC_d·d·ℓ|U⊥|U⊥ of the wind normal to it relative to the
    segment's own motion, and the leaves' forces of the last step, with the damping of both
-   implicit; pulls (constant forces) and a grab (a stiff spring to a target, implicit);
+   implicit; pulls (constant forces) and grabs (stiff springs to targets, implicit);
 3. the articulated-body step (:func:`~treeanim.physics.articulated.articulated_step`);
 4. the new pose of every body, kept above the ground (:func:`~treeanim.physics.kinematics.ground_contact`);
 5. every leaf's flutter and petiole joint (:func:`~treeanim.physics.leafjoint.leaf_step`), its
@@ -17,6 +17,7 @@ and writes the next one. One step:
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
+from typing import Sequence
 
 import numpy as np
 
@@ -240,7 +241,7 @@ class Work:
 
 
 def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: float, work: Work,
-         pulls: list[tuple[int, np.ndarray, np.ndarray]] = (), grab: Grab | None = None,
+         pulls: list[tuple[int, np.ndarray, np.ndarray]] = (), grabs: Sequence[Grab] = (),
          leaf_flutter: float = 0.0) -> None:
     """Advance ``st`` by ``dt`` into ``out`` (which may be ``st`` itself).
 
@@ -255,7 +256,8 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     work : Work
     pulls : list of (body, rest offset from its joint (3,), world force (3,))
         Constant forces.
-    grab : Grab or None
+    grabs : sequence of Grab
+        The points held by springs (each solved inside the step).
     leaf_flutter : float
         The largest flutter angle of a lamina about its midrib (rad), reached edge-on in a strong wind.
     """
@@ -269,8 +271,8 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
                 out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, out.leaf_speed, w.F, w.kap)
     for b, ofs, f in pulls:
         _point_force(b, out.R[b] @ ofs, np.asarray(f, float), dt, out, w)
-    if grab is not None:
-        _grab_force(s, grab, out, dt, w)
+    for g in grabs:
+        _grab_force(s, g, out, dt, w)
     tb, tt = _thetas(s, dt, work)
     articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.kb, s.kt, s.dk, out.R, out.P, out.Q, out.w,
                      out.Om, out.V, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.Ur, w.u, w.acc)

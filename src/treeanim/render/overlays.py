@@ -10,6 +10,7 @@ node and skinned on the GPU like the tree (so a static overlay costs no CPU per 
 - :class:`WindSlices`: wind arrows on a few horizontal planes sampled from ``wind(points)``,
   coloured by speed (Fig. 7b).
 - :class:`WindArrow`: the wind vector as a red arrow with small blue squares (Fig. 7).
+- :class:`Markers`: crosses at points (the viewer's pins).
 """
 
 from __future__ import annotations
@@ -124,6 +125,32 @@ class PullTrace(Overlay):
         col[:, 3] *= 0.15 + 0.85 * age
         idx = np.repeat(np.arange(len(p)), 2)[1:-1]
         return LineSet(p[idx], col[idx])
+
+
+# ---------------------------------------------------------------------------- markers
+class Markers(Overlay):
+    """A three-armed cross at each of :attr:`points` ((K, 3) world), arms ``size`` m long.
+
+    Parameters
+    ----------
+    size : float
+        Length of each arm (m).
+    color : (4,) float
+    """
+
+    def __init__(self, size: float = 0.1, color=(0.35, 0.9, 1.0, 1.0), width: float = 3.0) -> None:
+        self.size = float(size)
+        self.color = np.asarray(color, float)
+        self.width = width
+        self.points = np.zeros((0, 3))
+
+    def lines(self, tree: Tree) -> LineSet | None:
+        p = np.asarray(self.points, float).reshape(-1, 3)
+        if not len(p):
+            return None
+        arms = 0.5 * self.size * np.repeat(np.eye(3), 2, axis=0) * np.tile([[-1.0], [1.0]], (3, 1))  # (6, 3)
+        pts = (p[:, None, :] + arms[None]).reshape(-1, 3)
+        return LineSet(pts, np.tile(self.color, (len(pts), 1)))
 
 
 # ---------------------------------------------------------------------------- local frames
