@@ -13,6 +13,8 @@ in vec3 in_normal;   // rest normal
 in vec4 in_extra;    // weight of prev, per-object jitter, ambient occlusion, key
 in vec2 in_uv;       // surface coordinates (see render/mesh.py)
 in vec2 in_curve;    // t along the segment, 1 where it ends at the object's tip
+in vec3 in_tangent0; // the rest curve's tangents at the segment's ends
+in vec3 in_tangent1;
 
 out vec3 v_world;
 out vec3 v_normal;
@@ -64,7 +66,7 @@ void main() {
     }
     mat3 R;
     vec3 centre;
-    skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, v_world, R, centre);
+    skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, in_tangent0, in_tangent1, v_world, R, centre);
     v_normal = R * in_normal;
     v_edge = 0.0;
     v_half = -1.0;
