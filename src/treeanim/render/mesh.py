@@ -200,8 +200,13 @@ def _object_nodes(tree: Tree, objs: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     return np.repeat(tree.object_start[objs], counts) + k, k, np.repeat(objs, counts)
 
 
-def _node_tangents(tree: Tree, nodes: np.ndarray, k: np.ndarray, obj: np.ndarray):
-    """Unit tangents at nodes (bisector at inner joints), plus base/tip masks and neighbours."""
+def _node_tangents(tree: Tree, nodes: np.ndarray, k: np.ndarray, obj: np.ndarray, arc: bool = False):
+    """Unit tangents at nodes (bisector at inner joints), plus base/tip masks and neighbours.
+
+    ``arc`` (a branch's rest curve): an object's end turns from its chord as much as the
+    curve does at the next node in, the other way (as a circular arc through three nodes), so
+    its curvature runs on evenly to its ends; else an end's tangent is its chord.
+    """
     P = tree.rest_positions
     N = len(P)
     n = tree.object_count[obj]
@@ -211,6 +216,11 @@ def _node_tangents(tree: Tree, nodes: np.ndarray, k: np.ndarray, obj: np.ndarray
     d_next = _unit(P[nxt] - P[nodes])
     d_prev = _unit(P[nodes] - P[prv])
     t = np.where(base[:, None], d_next, np.where(tip[:, None], d_prev, _unit(d_prev + d_next, d_next)))
+    if arc:
+        for end, chord, step in ((base & (n > 2), d_next, 1), (tip & (n > 2), d_prev, -1)):
+            i, c = nodes[end], chord[end]
+            inner = _unit(c + _unit(P[i + 2 * step] - P[i + step]) * step, c)  # the next node in's tangent
+            t[end] = _unit(2.0 * np.sum(c * inner, axis=1, keepdims=True) * c - inner, c)
     return t, base, tip, nxt, prv
 
 
@@ -258,7 +268,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
         return
     P = tree.rest_positions
     nodes, k, obj = _object_nodes(tree, objs)
-    tangent, base, tip, nxt, prv = _node_tangents(tree, nodes, k, obj)
+    tangent, base, tip, nxt, prv = _node_tangents(tree, nodes, k, obj, curved)
     r = 0.5 * tree.node_diameter
     inner = ~(base | tip)
     # T₀ of the segment leaving each node (module notes).

@@ -83,7 +83,7 @@ class Picker:
         j = nodes[src]
         j1 = np.minimum(j + 1, N - 1)
         # A branch's rest axis: each segment's Hermite curve (render/skinning.py).
-        tangent = _node_tangents(tree, nodes, k, obj)[0]
+        tangent = _node_tangents(tree, nodes, k, obj, True)[0]
         length = np.where(curved[src], np.linalg.norm(P[j1] - P[j], axis=1), 0.0)[:, None]
         d0 = length * tangent[src]
         d1 = length * tangent[np.minimum(src + 1, len(nodes) - 1)]
