@@ -8,6 +8,7 @@ import numpy as np
 
 from conftest import identity, rot
 from treeanim.model.build import ObjectSpec, assemble
+from treeanim.model.look import Bark
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.mesh import MATERIAL_BARK, build_mesh
 from treeanim.render.scene import Scene
@@ -79,13 +80,15 @@ def test_the_rings_turn_evenly_through_a_joint():
     assert len(corners) >= 3 and corners.max() < 0.6 * TURN, corners
 
 
-def test_a_tube_thinning_into_a_line_runs_on_without_a_gap(offscreen):
-    """A limb tapering from 3 px to a fifth of a pixel, side on against the sky, no MSAA: how
-    much it darkens each column falls along it and never dips below the thinner columns
-    after it (a flat cap and a gap showed where the tube handed over to the line)."""
+def test_a_tube_thinning_into_a_line_runs_on_without_a_gap_in_the_woods_colour(offscreen):
+    """A limb tapering from 8 px to a tenth of a pixel, side on against the sky, no MSAA: how
+    much it darkens each column falls along it and never dips below the thinner columns after
+    it (a flat cap and a gap showed where the tube handed over to the line); and the line,
+    unblended from the sky by its true width, has the tube's colour (its mean across it)."""
     x = np.linspace(-1.5, 1.5, 7)
     pts = np.stack([x, np.full(7, 1.2), np.zeros(7)], 1)
-    tree = assemble([ObjectSpec(pts, np.geomspace(0.09, 0.004, 7), "branch", 1)], name="taper")
+    bark = Bark(color=(0.5, 0.47, 0.42), furrows=14.0, depth=0.55, interlace=0.9)  # the tulip poplar's
+    tree = assemble([ObjectSpec(pts, np.geomspace(0.25, 0.003, 7), "branch", 1)], name="taper", bark=bark)
     cam = OrbitCamera(target=(0.0, 1.2, 0.0), distance=6.0, elevation=0.0)
     W, H = 200, 150
     off = type(offscreen)(W, H, samples=0, ctx=offscreen.ctx)
@@ -100,7 +103,19 @@ def test_a_tube_thinning_into_a_line_runs_on_without_a_gap(offscreen):
         off.release()
     ends = cam.project(pts[[0, -1]], W, H)[:, 0]
     cols = np.arange(int(np.ceil(ends.min())) + 2, int(ends.max()) - 2)
-    cover = np.clip((sky - img) @ [0.2126, 0.7152, 0.0722], 0.0, None)[:, cols].sum(axis=0)
-    assert len(cols) > 90 and np.all(cover > 5.0)
+    diff = (img - sky)[:, cols]
+    cover = np.clip(-diff @ [0.2126, 0.7152, 0.0722], 0.0, None).sum(axis=0)
+    assert len(cols) > 90 and np.all(cover > 2.0)
     later = np.array([cover[i + 1:i + 8].max() for i in range(len(cover) - 2)])
     assert np.all(cover[:-2] > 0.6 * later), np.flatnonzero(cover[:-2] <= 0.6 * later)
+    # The colour: the tube's inner rows where it is over 5 px wide; the line's sum over each
+    # column (its coverage there sums to its true width) where it is under a pixel.
+    x = np.interp(cols, ends, pts[[0, -1], 0])
+    d = np.interp(x, pts[:, 0], tree.node_diameter)
+    width = np.abs(np.diff([cam.project(np.stack([x, 1.2 + s * d, 0 * x], 1), W, H)[:, 1] for s in (0.5, -0.5)],
+                           axis=0)[0])
+    tube = np.concatenate([img[np.flatnonzero(np.abs(diff[:, i]).max(axis=1) > 2)[1:-1], c]
+                           for i, c in enumerate(cols) if width[i] > 5])
+    line = sky[H // 2, cols] + diff.sum(axis=0) / width[:, None]
+    assert len(tube) > 50 and np.sum(width < 1) > 30
+    assert np.all(np.abs(line[width < 1].mean(axis=0) - tube.mean(axis=0)) < 8), (line[width < 1].mean(0), tube.mean(0))
