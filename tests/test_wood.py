@@ -65,8 +65,8 @@ def test_the_axis_has_one_tangent_at_each_inner_node_at_rest_and_bent():
 
 
 def test_the_rings_turn_evenly_through_a_joint():
-    """The polyline through the tube's ring centres at rest: its corners share a joint's turn
-    (straight segments put all of it at the node)."""
+    """The polyline through the tube's ring centres at rest turns less than 5° at every ring,
+    the joints' 22.5° shared out between them (straight segments put all of it at the node)."""
     tree = crooked_limb()
     mesh = build_mesh(tree)
     pts, _ = mesh.skin(tree.rest_positions, identity(tree))
@@ -77,7 +77,7 @@ def test_the_rings_turn_evenly_through_a_joint():
     centres = centres[count == 16]  # the end fans' centres are left out
     d = np.diff(centres, axis=0)
     corners = angles(d[1:], d[:-1])
-    assert len(corners) >= 3 and corners.max() < 0.6 * TURN, corners
+    assert len(corners) >= 3 * 4 and corners.max() < 5.0, corners
 
 
 def test_a_tube_thinning_into_a_line_runs_on_without_a_gap_in_the_woods_colour(offscreen):

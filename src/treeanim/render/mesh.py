@@ -286,7 +286,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
 
     # Rings: bands per segment from each non-tip node, then the object's end ring (t = 1 on
     # the last segment where curved, else the tip node's own ring).
-    bands = curve_bands(tree.object_count[obj]) if curved else np.ones(len(nodes), np.int64)
+    bands = curve_bands(tree.object_count[obj], tree.joint_turn()[obj]) if curved else np.ones(len(nodes), np.int64)
     reps = np.where(tip, 1, bands)
     src = np.repeat(np.arange(len(nodes)), reps)
     t = (np.arange(len(src)) - np.repeat(np.cumsum(reps) - reps, reps)) / bands[src]

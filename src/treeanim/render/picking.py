@@ -60,7 +60,7 @@ class Picker:
         base, tip = k == 0, k == count - 1
         inner = ~(base | tip)
         curved = kind[obj] == "branch"
-        bands = np.where(curved, curve_bands(count), 1)
+        bands = np.where(curved, curve_bands(count, tree.joint_turn()[obj]), 1)
         reps = np.where(tip, 1, bands)
         src = np.repeat(np.arange(len(nodes)), reps)
         t = (np.arange(len(src)) - np.repeat(np.cumsum(reps) - reps, reps)) / bands[src]
