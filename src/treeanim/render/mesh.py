@@ -35,8 +35,8 @@ Geometry per object kind (triangle counts equal :meth:`Tree.triangles_per_object
   normals (the shading runs on across the joint), and its base fan a cone from the rim down
   to an *apex* sunk in the parent, out of sight. Along a parent the rim is
   ρ = clip(½(R + r), 1.15 r, 1.5 r) (at most 0.95 R) from the child's axis, each side as far
-  out along the child as it meets the parent's tube (radius R about the parent's segment
-  behind or ahead of the joint), and the apex on the parent's axis. At a fork (a child on its
+  out along the child as it meets the parent's tube (radius R about the parent's tangent at
+  the joint), and the apex on the parent's axis. At a fork (a child on its
   parent's tip) the rim is the parent's end ring, widened to max(R, 1.15 r) and raised so
   that the cone from the apex, 2 R below the end, passes through the end ring: the parent's
   silhouette runs on into each child's; a child turned more than 70° from the parent tilts its
