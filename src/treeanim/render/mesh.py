@@ -18,7 +18,8 @@ The skinning itself, and :meth:`TreeMesh.skin`, its CPU mirror, are in
 :mod:`treeanim.render.skinning`: a vertex with t > 0 (the rings inside a branch's segments,
 and its tip) rides the segment's cubic Hermite curve, whose rest tangents at its ends (the
 vertex's ``tangent0`` and ``tangent1``, the chord's length along the object's unit tangents at
-the nodes: the bisector of the neighbouring chords at an inner node) make the axis through an
+the nodes: the bisector of the neighbouring chords at an inner node, and at an object's ends
+turned from the chord as a circular arc through three nodes would be) make the axis through an
 object's nodes one smooth curve at rest and bent. So a one-segment twig pulled by its tip
 bends as a rod, t²(3 − t)/2 of its tip deflection at t, welded to its parent's (or the
 ground's) direction at its base; and a chain of segments has no corner at its inner nodes.
@@ -224,6 +225,12 @@ def _node_tangents(tree: Tree, nodes: np.ndarray, k: np.ndarray, obj: np.ndarray
     return t, base, tip, nxt, prv
 
 
+def segment_tangents(tangent: np.ndarray, src: np.ndarray, length: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rest curve's tangents d₀, d₁ (metres) of the segments leaving rows ``src`` of the
+    flattened nodes whose unit ``tangent`` :func:`_node_tangents` gives, ``length`` long."""
+    return length[:, None] * tangent[src], length[:, None] * tangent[np.minimum(src + 1, len(tangent) - 1)]
+
+
 class _Parts:
     """Accumulates vertex and triangle blocks."""
 
@@ -304,8 +311,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     node_slope = np.where(span > 1e-12, (r[nxt] - r[prv])[src] / np.where(span > 1e-12, span, 1.0), 0.0)
     # The rest axis: each segment's Hermite curve, tangent to the object's node tangents
     # (render/skinning.py); a petiole's rings stand on its nodes.
-    d0 = np.where(curved, seg_len, 0.0)[:, None] * tangent[src]
-    d1 = np.where(curved, seg_len, 0.0)[:, None] * tangent[np.minimum(src + 1, len(nodes) - 1)]
+    d0, d1 = segment_tangents(tangent, src, seg_len if curved else np.zeros(len(src)))
     centre, dq = hermite(t, chord, d0, d1)
     tan = _unit(dq, tangent[src])
     slope = np.where(t == 0, node_slope, seg_slope)

@@ -23,7 +23,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..model.tree import Tree, curve_bands
-from .mesh import _node_tangents, _object_nodes, lamina_frames
+from .mesh import _node_tangents, _object_nodes, lamina_frames, segment_tangents
 from .skinning import hermite, skin_points
 
 
@@ -83,10 +83,8 @@ class Picker:
         j = nodes[src]
         j1 = np.minimum(j + 1, N - 1)
         # A branch's rest axis: each segment's Hermite curve (render/skinning.py).
-        tangent = _node_tangents(tree, nodes, k, obj, True)[0]
-        length = np.where(curved[src], np.linalg.norm(P[j1] - P[j], axis=1), 0.0)[:, None]
-        d0 = length * tangent[src]
-        d1 = length * tangent[np.minimum(src + 1, len(nodes) - 1)]
+        length = np.where(curved[src], np.linalg.norm(P[j1] - P[j], axis=1), 0.0)
+        d0, d1 = segment_tangents(_node_tangents(tree, nodes, k, obj, True)[0], src, length)
         offset = hermite(t, P[j1] - P[j], d0, d1)[0]
         radius = (1.0 - t) * r[j] + t * r[j1]
         first_cap = np.flatnonzero(~end)  # a piece from each ring to the next, within an object
