@@ -32,16 +32,16 @@ mat3 orthonormal(mat3 m) {  // Gram-Schmidt on the columns
     return mat3(c0, c1, cross(c0, c1));
 }
 
-// Where a mesh vertex goes and the frame it turns with (render/mesh.py's notes; TreeMesh.skin
-// is the same on the CPU). The vertex lies at t along the segment leaving `node`; T0 is the
-// segment's frame at the node (R[node] blended with R[prev], the ground's identity for
-// prev < 0), T1 at its far end (a joint's mean, or at an object's tip 1.5 R - 0.5 T0). Inside
-// a segment the vertex rides the cubic Hermite curve between the ends with tangents T0 c and
-// T1 c, c the segment's rest chord, turned by the frame that carries c onto the curve's tangent.
-// `centre` is the point on the segment's axis (the node itself where t = 0) the vertex is
-// offset from.
-void skin_transform(int node, int prev, float weight, vec2 curve, vec3 offset, out vec3 world, out mat3 R,
-                    out vec3 centre) {
+// Where a mesh vertex goes and the frame it turns with (render/skinning.py's notes; it is the
+// same on the CPU). The vertex lies at t along the segment leaving `node`; T0 is the segment's
+// frame at the node (R[node] blended with R[prev], the ground's identity for prev < 0), T1 at
+// its far end (a joint's mean, or at an object's tip 1.5 R - 0.5 T0). Inside a segment the
+// vertex rides the cubic Hermite curve between the ends with tangents T0 d0 and T1 d1, d0 and
+// d1 the rest curve's (tangent0, tangent1), turned by the frame that carries the rest curve's
+// tangent onto the bent one. `centre` is the point on the axis (the node itself where t = 0)
+// the vertex is offset from.
+void skin_transform(int node, int prev, float weight, vec2 curve, vec3 offset, vec3 d0, vec3 d1, out vec3 world,
+                    out mat3 R, out vec3 centre) {
     vec3 p0;
     mat3 Rs;
     node_transform(node, p0, Rs);
@@ -66,8 +66,9 @@ void skin_transform(int node, int prev, float weight, vec2 curve, vec3 offset, o
     mat3 T1 = orthonormal(curve.y > 0.5 ? 1.5 * Rs - 0.5 * T0 : 0.5 * (Rs + R1));
     float t2 = t * t;
     float t3 = t2 * t;
-    centre = (2.0 * t3 - 3.0 * t2 + 1.0) * p0 + (3.0 * t2 - 2.0 * t3) * p1
-                + (t3 - 2.0 * t2 + t) * (T0 * c) + (t3 - t2) * (T1 * c);
+    vec3 h = vec3(3.0 * t2 - 2.0 * t3, t3 - 2.0 * t2 + t, t3 - t2);   // Hermite weights of p1 - p0, d0, d1
+    vec3 rest = h.x * c + h.y * d0 + h.z * d1;
+    centre = p0 + h.x * (p1 - p0) + h.y * (T0 * d0) + h.z * (T1 * d1);
     R = orthonormal((3.0 * t2 - 4.0 * t + 1.0) * T0 + (6.0 * t - 6.0 * t2) * Rs + (3.0 * t2 - 2.0 * t) * T1);
-    world = centre + R * (offset - t * c);
+    world = centre + R * (offset - rest);
 }

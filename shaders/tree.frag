@@ -48,7 +48,7 @@ float tent_integral(float x) {
 }
 
 void main() {
-    if (PART == PART_BARK && v_half >= 0.0 && !gl_FrontFacing) discard;  // a thin twig, flat: its far half
+    if (PART == PART_BARK && !gl_FrontFacing) discard;  // a closed tube's far side; a thin twig's, flat
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;                 // double-sided: laminas, blades
     vec3 V = normalize(u_camera_pos - v_world);

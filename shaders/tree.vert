@@ -13,6 +13,8 @@ in vec3 in_normal;   // rest normal
 in vec4 in_extra;    // weight of prev, per-object jitter, ambient occlusion, key
 in vec2 in_uv;       // surface coordinates (see render/mesh.py)
 in vec2 in_curve;    // t along the segment, 1 where it ends at the object's tip
+in vec3 in_tangent0; // the rest curve's tangents at the segment's ends
+in vec3 in_tangent1;
 
 out vec3 v_world;
 out vec3 v_normal;
@@ -22,7 +24,7 @@ out vec2 v_uv;
 flat out int v_material;
 flat out float v_highlight;
 noperspective out float v_edge;  // thin twigs and blades: distance from the axis on screen, px
-out float v_half;                // their true half width on screen, px (< 0: not thin)
+out float v_half;                // their true half width on screen, px (< 0: solid)
 out vec3 v_light;                // blades: their light at the vertex, and ...
 out float v_haze;                // ... the haze over it (see below)
 
@@ -64,10 +66,11 @@ void main() {
     }
     mat3 R;
     vec3 centre;
-    skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, v_world, R, centre);
+    skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, in_tangent0, in_tangent1, v_world, R, centre);
     v_normal = R * in_normal;
     v_edge = 0.0;
     v_half = -1.0;
+    bool thin = false;
     if (PART != PART_LEAVES) {
         // Thinner than a few pixels, a twig or a blade would fall between pixel centres and
         // break into dots that crawl as it sways. It is drawn flat, facing the eye, a pixel
@@ -88,10 +91,15 @@ void main() {
                 v_edge = edge;
             }
             v_half = px > 0.0 ? half_px : 0.0;
+            thin = true;
+        } else if (PART == PART_BARK) {
+            // A tube's vertex: on the axis as far as coverage goes, and whole, so a band from
+            // a tube's ring to a twig's flattened one is covered all along its axis (no gap).
+            v_half = max(px, 1.0);
         }
     }
     gl_Position = u_view_proj * vec4(v_world, 1.0);
-    if (PART == PART_BARK && v_half >= 0.0) {
+    if (PART == PART_BARK && thin) {
         // A faint twig writes depth like any surface, so a leaf drawn after it, behind it,
         // would be kept out and the sky show through the twig (streaks across a crown in a
         // gale). Drawn at the back of the depth range instead, it loses to every solid

@@ -166,12 +166,13 @@ def test_collar_flares_onto_its_parents_surface(built):
     perimeter = np.linalg.norm(np.roll(ring, -1, axis=1) - ring, axis=2).sum(axis=1)
     base = 32 * r * np.sin(np.pi / 16)  # the child's base section, a 16-gon of radius r
     assert np.all(perimeter > 1.1 * base), np.min(perimeter / base)
-    # Along a parent (a rim is put on cylinders about the parent's segments at the joint, of
-    # the parent's radius there: the parent's taper and the joint's corner put it a few % off).
-    centres, radii = rest_tubes(tree)
+    # Along a parent (a rim is put on the cylinder about the parent's tangent at the joint, of
+    # the parent's radius there: the parent's taper and its curve away from the tangent, and
+    # the rings' polyline inside the curve, put it a few % off the drawn tube).
+    centres, radii = skinned_tubes(tree, mesh, rest, tree.parent[objs])
     dist, rad, _ = from_tube(centres, radii, np.repeat(tree.parent[objs], 16), ring.reshape(-1, 3))
     dist, rad = dist.reshape(-1, 16), rad.reshape(-1, 16)
-    assert np.all(dist[~tip] < 1.1 * rad[~tip]), np.max(dist[~tip] / rad[~tip])
+    assert np.all(dist[~tip] < 1.2 * rad[~tip]), np.max(dist[~tip] / rad[~tip])
     assert np.all(np.mean(np.abs(dist[~tip] / rad[~tip] - 1) < 0.1, axis=1) >= 0.5)
     # On a parent's tip.
     d = tree.rest_positions[tree.object_start[objs] + 1] - tree.rest_positions[tree.object_start[objs]]

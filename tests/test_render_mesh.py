@@ -22,6 +22,7 @@ from treeanim.render.mesh import (
 )
 from treeanim.render.picking import Picker, pick
 from treeanim.render.shaders import shader_source
+from treeanim.render.skinning import hermite
 
 
 @pytest.fixture(scope="module", params=["tree", "grass", "beam"])
@@ -111,9 +112,9 @@ def test_rest_geometry():
     mesh = build_mesh(tree)
     pts, normals = mesh.skin(tree.rest_positions, identity(tree))
     node = mesh.node
-    # Tube rings lie on the segments' chords at the tapering radius (the end fans' centres, on
-    # the axis, are left out): one ring at every band's ends, but where a child's base ring is
-    # its collar (tests/test_junctions.py).
+    # Tube rings lie on the segments' rest curves at the tapering radius (the end fans' centres,
+    # on the axis, are left out): one ring at every band's ends, but where a child's base ring
+    # is its collar (tests/test_junctions.py).
     P, r = tree.rest_positions, 0.5 * tree.node_diameter
     t = mesh.vertices["curve"][:, 0]
     obj = mesh.object
@@ -121,7 +122,9 @@ def test_rest_geometry():
     bark = np.flatnonzero((mesh.material == MATERIAL_BARK) & ~collar)
     j = node[bark]
     axis = P[np.minimum(j + 1, len(P) - 1)] - P[j]
-    centre = P[j] + t[bark, None] * axis
+    curve, tangent = hermite(t[bark], axis, mesh.vertices["tangent0"][bark], mesh.vertices["tangent1"][bark])
+    centre = P[j] + curve
+    axis = np.where(t[bark, None] > 0, tangent, axis)
     dist = np.linalg.norm(pts[bark] - centre, axis=1)
     ring = np.linalg.norm(np.cross(pts[bark] - centre, _unit(axis)), axis=1) > 1e-6
     branch = tree.kind == "branch"
@@ -131,7 +134,7 @@ def test_rest_geometry():
     assert np.sum(collar & (mesh.material == MATERIAL_BARK)) == 2 * 16 * children  # rim and sunk apex
     radius = (1 - t[bark]) * r[j] + t[bark] * r[np.minimum(j + 1, len(P) - 1)]
     assert np.allclose(dist[ring], radius[ring], rtol=1e-5)
-    inside = ring & (t[bark] > 0)  # rings inside a segment stand square to it
+    inside = ring & (t[bark] > 0)  # rings inside a segment stand square to its curve
     assert inside.any() and np.allclose(np.sum((pts[bark] - centre)[inside] * axis[inside], axis=1), 0, atol=1e-7)
     # The lamina's tip (0, 1) sits one lamina length along the petiole's last segment.
     leaves = np.flatnonzero(tree.kind == "leaf")

@@ -335,8 +335,8 @@ def _tree_spec(data: dict, source: str) -> TreeSpec:
 
 
 def _tube_triangles(segments):
-    """Triangles of a branch tube of ``segments`` segments (:meth:`Tree.triangles_per_object`)."""
-    return 2 * BRANCH_SIDES * (segments * curve_bands(np.asarray(segments) + 1) + 1)
+    """Most triangles of a branch tube of ``segments`` segments (:meth:`Tree.triangles_per_object`)."""
+    return 2 * BRANCH_SIDES * (segments * curve_bands(np.asarray(segments) + 1, np.pi) + 1)
 
 
 def estimate_size(spec: TreeSpec) -> dict[str, float]:

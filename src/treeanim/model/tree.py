@@ -26,18 +26,27 @@ PLURAL = {"branch": "branches", "leaf": "leaves", "blade": "blades"}
 BRANCH_SIDES = 16
 
 #: A branch's tube has at least this many bands along its length, so that a bent branch is
-#: drawn as a curve however few segments it has (see :func:`curve_bands`).
+#: drawn as a curve however few segments it has (see :func:`curve_bands`) ...
 CURVE_BANDS = 4
+#: ... and enough bands a segment that its rings turn at most this many degrees from one to the
+#: next where its chords turn at a joint at rest (the rest curve shares a joint's turn out
+#: evenly, render/skinning.py) ...
+CURVE_TURN = 4.0
+#: ... but at most this many.
+CURVE_MOST = 6
 
 
-def curve_bands(object_count: np.ndarray) -> np.ndarray:
-    """Bands per segment of a branch tube with ``object_count`` nodes: ⌈4 / segments⌉.
+def curve_bands(object_count: np.ndarray, turn: np.ndarray | float = 0.0) -> np.ndarray:
+    """Bands per segment of a branch tube with ``object_count`` nodes whose chords turn at most
+    ``turn`` radians at a joint (:meth:`Tree.joint_turn`): max(⌈4 / segments⌉, ⌈turn / 4°⌉),
+    the latter at most 6.
 
-    A one-segment twig is drawn in four bands along the beam's deflection curve, a limb of
-    four or more segments in one band per segment.
+    A one-segment twig is drawn in four bands along the beam's deflection curve, a straight limb
+    of four or more segments in one band per segment, a crooked one in more.
     """
     segments = np.maximum(np.asarray(object_count) - 1, 1)
-    return -(-CURVE_BANDS // segments)
+    crooked = np.minimum(np.ceil(np.degrees(turn) / CURVE_TURN - 1e-6), CURVE_MOST).astype(np.int64)
+    return np.maximum(-(-CURVE_BANDS // segments), crooked)
 
 
 @dataclass(frozen=True)
@@ -154,6 +163,19 @@ class Tree:
         """(N,) int: the object each node belongs to."""
         return np.repeat(np.arange(self.n_objects), self.object_count)
 
+    def joint_turn(self) -> np.ndarray:
+        """(M,) float: the largest angle between consecutive chords of each object at rest,
+        radians (0 for one segment)."""
+        P = self.rest_positions
+        chord = np.diff(P, axis=0)
+        chord /= np.maximum(np.linalg.norm(chord, axis=1, keepdims=True), 1e-12)
+        k, n = self.node_index, self.object_count[self.node_object]
+        inner = np.flatnonzero((k > 0) & (k < n - 1))
+        turn = np.zeros(self.n_objects)
+        cos = np.clip(np.sum(chord[inner - 1] * chord[inner], axis=1), -1.0, 1.0)
+        np.maximum.at(turn, self.node_object[inner], np.arccos(cos))
+        return turn
+
     @property
     def node_index(self) -> np.ndarray:
         """(N,) int: each node's index within its object (0 = base)."""
@@ -230,7 +252,8 @@ class Tree:
         lamina_tris = 0 if self.lamina is None else len(self.lamina.triangles)
         return np.select(
             [self.kind == "branch", self.kind == "leaf"],
-            [2 * BRANCH_SIDES * ((n - 1) * curve_bands(n) + 1), 2 * self.petiole_sides * (n - 1) + lamina_tris],
+            [2 * BRANCH_SIDES * ((n - 1) * curve_bands(n, self.joint_turn()) + 1),
+             2 * self.petiole_sides * (n - 1) + lamina_tris],
             2 * (n - 1) + 1,
         )
 

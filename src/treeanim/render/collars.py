@@ -70,18 +70,15 @@ def collars(tree: Tree, child: np.ndarray, d: np.ndarray, radial: np.ndarray, ro
     P = tree.rest_positions
     r = 0.5 * tree.node_diameter
     att = tree.attach_node[child]
-    a, _, end, nxt, prv = parent_tangents
+    a, _, end, _, prv = parent_tangents
     R, rc = r[att], r[tree.object_start[child]]
     cos = np.sum(a * d, axis=1)
     am = a[:, None, :]
     # Along a parent: each side of the child's tube, widened to ρ, runs out along the child to
-    # where it leaves the parent's tube (radius R about the segment behind or ahead of the
-    # joint, on whichever side of it that is), at most half the first band out.
+    # where it leaves the parent's tube (radius R about the parent's tangent at the joint,
+    # which its curve follows there), at most half the first band out.
     rho = np.minimum(np.clip(0.5 * (R + rc), COLLAR_FLARE[0] * rc, COLLAR_FLARE[1] * rc), COLLAR_FIT * R)
-    s = _leave(d, radial, rho, am, R)
-    ahead = np.sum((s[..., None] * d[:, None, :] + rho[:, None, None] * radial) * am, axis=2) >= 0
-    segment = np.where(ahead[..., None], _unit(P[nxt] - P[att], a)[:, None], _unit(P[att] - P[prv], a)[:, None])
-    s = np.clip(_leave(d, radial, rho, segment, R), 0.0, 0.5 * room[:, None])
+    s = np.clip(_leave(d, radial, rho, am, R), 0.0, 0.5 * room[:, None])
     side = s[..., None] * d[:, None, :] + rho[:, None, None] * radial
     # At a fork (on the parent's tip): the parent's end ring, widened at least to the flare
     # and then raised as far as a cone from the apex sunk below the end rises through the end

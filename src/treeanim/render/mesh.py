@@ -13,31 +13,31 @@ T₁ = orthonormalise(½(R[j] + R[j+1])) at an inner joint or, where the segment
 object's free tip, orthonormalise(1.5·R[j] − ½·T₀) (a cantilever's tip turns 1.5 times its
 chord; ``in_curve.y`` = 1). A tip that carries branches ends in their base frame R[j+1] = R[j]
 instead (``in_curve.y`` = 0), so a fork's rims stay on it.
-A vertex with t = 0 is placed at ``positions[j] + T₀ @ offset``. One with t > 0 (the rings
-inside a branch's segments, and its tip) follows the cubic Hermite curve between the segment's
-ends with tangents T₀c and T₁c (c = R[j]ᵀ(p[j+1] − p[j]), the segment's rest chord), turned by
-the frame orthonormalise((3t²−4t+1)·T₀ + (6t−6t²)·R[j] + (3t²−2t)·T₁), the rotation that
-carries c onto the curve's tangent::
 
-    world = H(t) + F(t) @ (offset − t·c)
-
-so a one-segment twig pulled by its tip bends as a rod, t²(3 − t)/2 of its tip deflection
-at t, welded to its parent's (or the ground's) direction at its base.
+The skinning itself, and :meth:`TreeMesh.skin`, its CPU mirror, are in
+:mod:`treeanim.render.skinning`: a vertex with t > 0 (the rings inside a branch's segments,
+and its tip) rides the segment's cubic Hermite curve, whose rest tangents at its ends (the
+vertex's ``tangent0`` and ``tangent1``, the chord's length along the object's unit tangents at
+the nodes: the bisector of the neighbouring chords at an inner node, and at an object's ends
+turned from the chord as a circular arc through three nodes would be) make the axis through an
+object's nodes one smooth curve at rest and bent. So a one-segment twig pulled by its tip
+bends as a rod, t²(3 − t)/2 of its tip deflection at t, welded to its parent's (or the
+ground's) direction at its base; and a chain of segments has no corner at its inner nodes.
 
 Geometry per object kind (triangle counts equal :meth:`Tree.triangles_per_object`):
 
 - branch: a ``BRANCH_SIDES`` (16)-sided tapered tube whose segments are split in
   :func:`~treeanim.model.tree.curve_bands` bands each (four along a one-segment twig), a ring
-  of 16 vertices at each band's ends, closed by a 16-triangle fan at each end: the tip fan is
-  a low cone, so tips look rounded (flat where branches sit on the tip, under their collars);
-  a root's base fan is a flat disc on the ground.
+  of 16 vertices at each band's ends, square to the rest curve, closed by a 16-triangle fan
+  at each end: the tip fan is a low cone, so tips look rounded (flat where branches sit on
+  the tip, under their collars); a root's base fan is a flat disc on the ground.
   A child branch's base is a welded collar (R the parent's radius at the joint, r the
   child's): its base ring is a *rim* on the parent's surface, with the parent's surface
   normals (the shading runs on across the joint), and its base fan a cone from the rim down
   to an *apex* sunk in the parent, out of sight. Along a parent the rim is
   ρ = clip(½(R + r), 1.15 r, 1.5 r) (at most 0.95 R) from the child's axis, each side as far
-  out along the child as it meets the parent's tube (radius R about the parent's segment
-  behind or ahead of the joint), and the apex on the parent's axis. At a fork (a child on its
+  out along the child as it meets the parent's tube (radius R about the parent's tangent at
+  the joint), and the apex on the parent's axis. At a fork (a child on its
   parent's tip) the rim is the parent's end ring, widened to max(R, 1.15 r) and raised so
   that the cone from the apex, 2 R below the end, passes through the end ring: the parent's
   silhouette runs on into each child's; a child turned more than 70° from the parent tilts its
@@ -53,7 +53,7 @@ Geometry per object kind (triangle counts equal :meth:`Tree.triangles_per_object
   ``node_diameter``; the strip's face contains the blade's tangent and faces along the bending
   plane), plus one tip triangle to an apex half a segment beyond the tip: 2·(n−1) + 1.
 
-Vertex layout (:data:`VERTEX_DTYPE`, 72 bytes, interleaved, attribute format
+Vertex layout (:data:`VERTEX_DTYPE`, 96 bytes, interleaved, attribute format
 :data:`VERTEX_FORMAT`)::
 
     in_ids    ivec4  (node j, prev, object, material)
@@ -65,6 +65,8 @@ Vertex layout (:data:`VERTEX_DTYPE`, 72 bytes, interleaved, attribute format
                      metres along the object); laminas (x, y) in leaf units; blades
                      (−1 / +1 across, fraction along)
     in_curve  vec2   (t along the segment, 1 where the segment ends at the object's tip)
+    in_tangent0, in_tangent1 vec3   the segment's rest curve's tangents at its ends, metres
+                     (branches; 0 elsewhere)
 
 ``key`` depends on the material: for lamina and petiole vertices the leaf's drop order
 normalised to [0, 1] (0 falls first, and turns colour first); for blades the fraction along
@@ -83,6 +85,7 @@ from ..model.geometry import perpendicular as _perpendicular
 from ..model.geometry import unit as _unit
 from ..model.tree import BRANCH_SIDES, Tree, curve_bands
 from .collars import collars, outward
+from .skinning import hermite, skin_points
 
 MATERIAL_BARK = 0
 MATERIAL_PETIOLE = 1
@@ -95,11 +98,11 @@ PARTS = {"LEAVES": (MATERIAL_PETIOLE, MATERIAL_LAMINA), "BARK": (MATERIAL_BARK,)
 
 VERTEX_DTYPE = np.dtype(
     [("ids", "<i4", (4,)), ("offset", "<f4", (3,)), ("normal", "<f4", (3,)), ("extra", "<f4", (4,)),
-     ("uv", "<f4", (2,)), ("curve", "<f4", (2,))]
+     ("uv", "<f4", (2,)), ("curve", "<f4", (2,)), ("tangent0", "<f4", (3,)), ("tangent1", "<f4", (3,))]
 )
 #: moderngl buffer format and attribute names matching :data:`VERTEX_DTYPE`.
-VERTEX_FORMAT = "4i 3f 3f 4f 2f 2f"
-VERTEX_ATTRIBUTES = ("in_ids", "in_offset", "in_normal", "in_extra", "in_uv", "in_curve")
+VERTEX_FORMAT = "4i 3f 3f 4f 2f 2f 3f 3f"
+VERTEX_ATTRIBUTES = ("in_ids", "in_offset", "in_normal", "in_extra", "in_uv", "in_curve", "in_tangent0", "in_tangent1")
 
 
 @dataclass(eq=False)
@@ -184,75 +187,9 @@ class TreeMesh:
         """
         v = self.vertices
         points, F = skin_points(positions, rotations, v["ids"][:, 0], v["ids"][:, 1], v["extra"][:, 0],
-                                v["curve"][:, 0], v["curve"][:, 1] > 0.5, v["offset"])
+                                v["curve"][:, 0], v["curve"][:, 1] > 0.5, v["offset"], v["tangent0"], v["tangent1"])
         normals = np.einsum("vij,vj->vi", F, v["normal"].astype(float))
         return points, normals
-
-
-def skin_points(positions, rotations, node, prev, weight, t, tip, offset) -> tuple[np.ndarray, np.ndarray]:
-    """Where the vertex shader (``shaders/skin.glsl``) puts points, and the frames they turn with.
-
-    The formula of the module notes, vectorised: a point with ``t`` = 0 is placed at
-    ``positions[node] + T₀ @ offset``, one with ``t`` > 0 on the cubic Hermite curve of the
-    segment leaving ``node``. :meth:`TreeMesh.skin` places the mesh's vertices with it, the
-    picker (:mod:`treeanim.render.picking`) the centres of the tube's rings.
-
-    Parameters
-    ----------
-    positions : (N, 3) float
-        Node positions, world.
-    rotations : (N, 3, 3) float
-        Node rotations relative to rest.
-    node, prev : (V,) int
-        The node each point follows, and the node whose rotation T₀ blends in (< 0: the
-        ground's identity).
-    weight : (V,) float
-        Weight of ``prev``'s rotation in T₀ (0: T₀ = ``rotations[node]``).
-    t : (V,) float
-        Fraction along the segment leaving ``node``, in [0, 1].
-    tip : (V,) bool
-        The segment ends at its object's free tip (T₁ = orthonormalise(1.5 R − ½ T₀)).
-    offset : (V, 3) float
-        Rest offset from ``node``'s rest position, metres.
-
-    Returns
-    -------
-    points : (V, 3) float64
-    frames : (V, 3, 3) float64
-        The rotation each point turns with (T₀ where ``t`` = 0).
-    """
-    j, prev = np.asarray(node), np.asarray(prev)
-    w = np.asarray(weight, float)[:, None, None]
-    t = np.asarray(t, float)
-    offset = np.asarray(offset, float)
-    P = np.asarray(positions, float)
-    R = np.asarray(rotations, float)
-    Rs = R[j]
-    Rp = np.where(prev[:, None, None] >= 0, R[np.maximum(prev, 0)], np.eye(3))
-    F = np.where(w > 0, blend_rotations(Rs * (1.0 - w) + Rp * w), Rs)  # T₀
-    points = P[j] + np.einsum("vij,vj->vi", F, offset)
-    m = np.flatnonzero(t > 0)
-    if len(m):
-        jm, tm, T0, Rm = j[m], t[m, None], F[m], Rs[m]
-        c = np.einsum("vji,vj->vi", Rm, P[jm + 1] - P[jm])  # rest chord
-        end = np.asarray(tip, bool)[m, None, None]
-        T1 = blend_rotations(np.where(end, 1.5 * Rm - 0.5 * T0, 0.5 * (Rm + R[jm + 1])))
-        t2, t3 = tm * tm, tm * tm * tm
-        centre = ((2 * t3 - 3 * t2 + 1) * P[jm] + (3 * t2 - 2 * t3) * P[jm + 1]
-                  + (t3 - 2 * t2 + tm) * np.einsum("vij,vj->vi", T0, c)
-                  + (t3 - t2) * np.einsum("vij,vj->vi", T1, c))
-        t2, tm = t2[:, :, None], tm[:, :, None]
-        F[m] = blend_rotations((3 * t2 - 4 * tm + 1) * T0 + (6 * tm - 6 * t2) * Rm + (3 * t2 - 2 * tm) * T1)
-        points[m] = centre + np.einsum("vij,vj->vi", F[m], offset[m] - tm[:, 0] * c)
-    return points, F
-
-
-def blend_rotations(m: np.ndarray) -> np.ndarray:
-    """Gram–Schmidt on the columns of linearly blended rotations (..., 3, 3), as the shader does."""
-    c0 = _unit(m[..., :, 0])
-    c1 = m[..., :, 1] - np.sum(m[..., :, 1] * c0, axis=-1, keepdims=True) * c0
-    c1 = _unit(c1)
-    return np.stack([c0, c1, np.cross(c0, c1)], axis=-1)
 
 
 def _object_nodes(tree: Tree, objs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -264,8 +201,13 @@ def _object_nodes(tree: Tree, objs: np.ndarray) -> tuple[np.ndarray, np.ndarray,
     return np.repeat(tree.object_start[objs], counts) + k, k, np.repeat(objs, counts)
 
 
-def _node_tangents(tree: Tree, nodes: np.ndarray, k: np.ndarray, obj: np.ndarray):
-    """Unit tangents at nodes (bisector at inner joints), plus base/tip masks and neighbours."""
+def _node_tangents(tree: Tree, nodes: np.ndarray, k: np.ndarray, obj: np.ndarray, arc: bool = False):
+    """Unit tangents at nodes (bisector at inner joints), plus base/tip masks and neighbours.
+
+    ``arc`` (a branch's rest curve): an object's end turns from its chord as much as the
+    curve does at the next node in, the other way (as a circular arc through three nodes), so
+    its curvature runs on evenly to its ends; else an end's tangent is its chord.
+    """
     P = tree.rest_positions
     N = len(P)
     n = tree.object_count[obj]
@@ -275,7 +217,18 @@ def _node_tangents(tree: Tree, nodes: np.ndarray, k: np.ndarray, obj: np.ndarray
     d_next = _unit(P[nxt] - P[nodes])
     d_prev = _unit(P[nodes] - P[prv])
     t = np.where(base[:, None], d_next, np.where(tip[:, None], d_prev, _unit(d_prev + d_next, d_next)))
+    if arc:
+        for end, chord, step in ((base & (n > 2), d_next, 1), (tip & (n > 2), d_prev, -1)):
+            i, c = nodes[end], chord[end]
+            inner = _unit(c + _unit(P[i + 2 * step] - P[i + step]) * step, c)  # the next node in's tangent
+            t[end] = _unit(2.0 * np.sum(c * inner, axis=1, keepdims=True) * c - inner, c)
     return t, base, tip, nxt, prv
+
+
+def segment_tangents(tangent: np.ndarray, src: np.ndarray, length: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The rest curve's tangents d₀, d₁ (metres) of the segments leaving rows ``src`` of the
+    flattened nodes whose unit ``tangent`` :func:`_node_tangents` gives, ``length`` long."""
+    return length[:, None] * tangent[src], length[:, None] * tangent[np.minimum(src + 1, len(tangent) - 1)]
 
 
 class _Parts:
@@ -287,7 +240,8 @@ class _Parts:
         self.tri_obj: list[np.ndarray] = []
         self.count = 0
 
-    def add(self, node, prev, obj, material, offset, normal, weight, jitter, key, uv=0.0, curve=0.0) -> int:
+    def add(self, node, prev, obj, material, offset, normal, weight, jitter, key, uv=0.0, curve=0.0,
+            tangents=(0.0, 0.0)) -> int:
         v = np.zeros(len(node), VERTEX_DTYPE)
         v["ids"] = np.stack([node, prev, obj, np.broadcast_to(material, node.shape)], axis=1)
         v["offset"] = offset
@@ -297,6 +251,7 @@ class _Parts:
         v["extra"][:, 3] = key
         v["uv"] = uv
         v["curve"] = curve
+        v["tangent0"], v["tangent1"] = tangents
         base = self.count
         self.verts.append(v)
         self.count += len(v)
@@ -320,7 +275,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
         return
     P = tree.rest_positions
     nodes, k, obj = _object_nodes(tree, objs)
-    tangent, base, tip, nxt, prv = _node_tangents(tree, nodes, k, obj)
+    tangent, base, tip, nxt, prv = _node_tangents(tree, nodes, k, obj, curved)
     r = 0.5 * tree.node_diameter
     inner = ~(base | tip)
     # T₀ of the segment leaving each node (module notes).
@@ -338,7 +293,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
 
     # Rings: bands per segment from each non-tip node, then the object's end ring (t = 1 on
     # the last segment where curved, else the tip node's own ring).
-    bands = curve_bands(tree.object_count[obj]) if curved else np.ones(len(nodes), np.int64)
+    bands = curve_bands(tree.object_count[obj], tree.joint_turn()[obj]) if curved else np.ones(len(nodes), np.int64)
     reps = np.where(tip, 1, bands)
     src = np.repeat(np.arange(len(nodes)), reps)
     t = (np.arange(len(src)) - np.repeat(np.cumsum(reps) - reps, reps)) / bands[src]
@@ -354,9 +309,12 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     seg_slope = (r[n1] - r[n0]) / np.where(seg_len > 1e-12, seg_len, 1.0)
     span = np.linalg.norm(P[nxt] - P[prv], axis=1)[src]
     node_slope = np.where(span > 1e-12, (r[nxt] - r[prv])[src] / np.where(span > 1e-12, span, 1.0), 0.0)
-    at_node = t == 0
-    tan = np.where(at_node[:, None], tangent[src], _unit(chord, tangent[src]))
-    slope = np.where(at_node, node_slope, seg_slope)
+    # The rest axis: each segment's Hermite curve, tangent to the object's node tangents
+    # (render/skinning.py); a petiole's rings stand on its nodes.
+    d0, d1 = segment_tangents(tangent, src, seg_len if curved else np.zeros(len(src)))
+    centre, dq = hermite(t, chord, d0, d1)
+    tan = _unit(dq, tangent[src])
+    slope = np.where(t == 0, node_slope, seg_slope)
     radius = (1.0 - t) * r[n0] + t * r[n1]
     ring_obj = obj[src]
 
@@ -367,7 +325,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     b = np.cross(tan, a)
     ang = 2.0 * np.pi * np.arange(sides) / sides
     radial = np.cos(ang)[None, :, None] * a[:, None, :] + np.sin(ang)[None, :, None] * b[:, None, :]
-    offset = t[:, None, None] * chord[:, None, :] + radius[:, None, None] * radial
+    offset = centre[:, None, :] + radius[:, None, None] * radial
     normal = _unit(radial - slope[:, None, None] * tan[:, None, :])
     along = arc_length(tree)[n0] + t * seg_len
     # A child's base ring is its collar's rim, on the parent's surface with its normals.
@@ -385,7 +343,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     rep = lambda x: np.repeat(x, sides, axis=0)  # noqa: E731
     v0 = parts.add(rep(n0), rep(ring_prev), rep(ring_obj), material, offset.reshape(-1, 3),
                    normal.reshape(-1, 3), rep(ring_weight), rep(jitter[ring_obj]), rep(key[ring_obj]),
-                   uv, rep(curve))
+                   uv, rep(curve), (rep(d0), rep(d1)))
 
     ring = v0 + sides * np.arange(len(src))  # first vertex of each ring
     s0 = np.arange(sides)
@@ -408,7 +366,8 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
         face[kb] = outward(0.5 * (offset[ic][:, s0] + offset[ic][:, s1]), axis)
         cb = parts.add(rep(n0[ib]), rep(ring_prev[ib]), rep(ring_obj[ib]), material, rep(peak),
                        face.reshape(-1, 3), rep(ring_weight[ib]), rep(jitter[ring_obj[ib]]), rep(key[ring_obj[ib]]),
-                       np.stack([np.tile((s0 + 0.5) / sides, len(ib)), rep(along[ib])], -1), rep(curve[ib]))
+                       np.stack([np.tile((s0 + 0.5) / sides, len(ib)), rep(along[ib])], -1), rep(curve[ib]),
+                       (rep(d0[ib]), rep(d1[ib])))
         parts.triangles(np.stack([cb + sides * np.arange(len(ib))[:, None] + s0, ring[ib, None] + s1,
                                   ring[ib, None] + s0], -1), ring_obj[ib, None])
         # Tip fans: a low cone; flat under the collars of branches on the tip.
@@ -416,7 +375,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
         rise = np.where(carries[ring_obj[it]], 0.0, 0.5 * radius[it])
         ct = parts.add(n0[it], ring_prev[it], ring_obj[it], material, chord[it] + rise[:, None] * tan[it],
                        tan[it], ring_weight[it], jitter[ring_obj[it]], key[ring_obj[it]],
-                       np.stack([np.zeros(len(it)), along[it]], -1), curve[it])
+                       np.stack([np.zeros(len(it)), along[it]], -1), curve[it], (d0[it], d1[it]))
         parts.triangles(np.stack([np.broadcast_to(ct + np.arange(len(it))[:, None], (len(it), sides)),
                                   ring[it, None] + s0, ring[it, None] + s1], -1), ring_obj[it, None])
 

@@ -2,7 +2,7 @@
 
 The axis of every tube is the polyline through the centres of its mesh rings
 (:mod:`treeanim.render.mesh`), placed each pick by the vertex shader's own formula
-(:func:`~treeanim.render.mesh.skin_points`): a branch's segment runs along its cubic Hermite
+(:func:`~treeanim.render.skinning.skin_points`): a branch's segment runs along its cubic Hermite
 curve in :func:`~treeanim.model.tree.curve_bands` bands (four along a one-segment twig), a
 petiole's and a blade's straight from node to node, a blade on to its apex half a segment
 beyond its tip. Each piece of the polyline is a capsule of the tube's radius (a blade: half its
@@ -23,7 +23,8 @@ from typing import NamedTuple
 import numpy as np
 
 from ..model.tree import Tree, curve_bands
-from .mesh import _object_nodes, lamina_frames, skin_points
+from .mesh import _node_tangents, _object_nodes, lamina_frames, segment_tangents
+from .skinning import hermite, skin_points
 
 
 class PickHit(NamedTuple):
@@ -59,7 +60,7 @@ class Picker:
         base, tip = k == 0, k == count - 1
         inner = ~(base | tip)
         curved = kind[obj] == "branch"
-        bands = np.where(curved, curve_bands(count), 1)
+        bands = np.where(curved, curve_bands(count, tree.joint_turn()[obj]), 1)
         reps = np.where(tip, 1, bands)
         src = np.repeat(np.arange(len(nodes)), reps)
         t = (np.arange(len(src)) - np.repeat(np.cumsum(reps) - reps, reps)) / bands[src]
@@ -81,7 +82,10 @@ class Picker:
         free_end = curved[src] & tip[np.minimum(src + 1, len(nodes) - 1)] & ~carries[ring_obj]
         j = nodes[src]
         j1 = np.minimum(j + 1, N - 1)
-        offset = t[:, None] * (P[j1] - P[j])
+        # A branch's rest axis: each segment's Hermite curve (render/skinning.py).
+        length = np.where(curved[src], np.linalg.norm(P[j1] - P[j], axis=1), 0.0)
+        d0, d1 = segment_tangents(_node_tangents(tree, nodes, k, obj, True)[0], src, length)
+        offset = hermite(t, P[j1] - P[j], d0, d1)[0]
         radius = (1.0 - t) * r[j] + t * r[j1]
         first_cap = np.flatnonzero(~end)  # a piece from each ring to the next, within an object
 
@@ -117,6 +121,8 @@ class Picker:
         self.t = np.concatenate([t, z])
         self.free_end = np.concatenate([free_end, z > 0])
         self.offset = np.concatenate([offset, 0.5 * (P[bt] - P[bt - 1]), lam_start, lam_end])
+        self.d0 = np.concatenate([d0, np.zeros((len(z), 3))])
+        self.d1 = np.concatenate([d1, np.zeros((len(z), 3))])
 
         # Capsules: from point ia to ib, radius r0 there and r1 at ib.
         self.cap_a = np.concatenate([first_cap, blade_end, lam_a])
@@ -142,7 +148,7 @@ class Picker:
             The capsules run from row :attr:`cap_a` to row :attr:`cap_b` of it.
         """
         return skin_points(positions, rotations, self.node, self.prev, self.weight, self.t, self.free_end,
-                           self.offset)[0]
+                           self.offset, self.d0, self.d1)[0]
 
     def pick(self, positions: np.ndarray, rotations: np.ndarray, origin, direction, *,
              present: np.ndarray | None = None, pixel_angle: float = 0.0,

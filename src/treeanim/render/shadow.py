@@ -21,7 +21,7 @@ from .shaders import load_program
 from .uniforms import UniformBlock
 
 #: Attributes the shadow pass reads; the rest of each vertex is skipped.
-SHADOW_ATTRIBUTES = ("in_ids", "in_offset", "in_extra", "in_curve")
+SHADOW_ATTRIBUTES = ("in_ids", "in_offset", "in_extra", "in_curve", "in_tangent0", "in_tangent1")
 #: The box round the tree at rest grows by this fraction of its size each way (sway room), but
 #: by no more than its height (nothing sways further than it stands tall: a meadow's box grows
 #: by a blade's length, not by 15 % of the meadow's width).
