@@ -88,7 +88,7 @@ def _fake_checkout(tmp_path: Path) -> tuple[Path, Path, dict]:
           f'if [ "$2" = "pip" ] && [ "$3" = "install" ] && [ "$5" = "-e" ]; then touch {tmp_path}/installed; fi\n')
     _fake(repo / ".venv" / "bin" / "treeanim", f'echo "treeanim $*" >> {log}\n')
     bin_ = tmp_path / "bin"
-    _fake(bin_ / "npm", f'echo "npm $*" >> {log}\nmkdir -p "$6/node_modules/gltf-validator"\n')
+    _fake(bin_ / "npm", f'echo "npm $*" >> {log}\nmkdir -p "$6/node_modules/gltf-validator" "$6/node_modules/three"\n')
     _fake(bin_ / "dpkg-query", "printf 'install ok installed'\n")
     _fake(bin_ / "python3", "exit 0\n")  # (venv and ensurepip are there: no apt-get)
     env = dict(os.environ, PATH=f"{bin_}{os.pathsep}{os.environ['PATH']}")
@@ -106,7 +106,7 @@ def test_scripts_test_says_what_it_installs_without_setuptools_box(tmp_path):
     assert res.returncode == 0, res.stderr
     said = res.stdout.splitlines()
     assert len(said) == 2 and said[0].startswith("Installing treeanim (editable) and its test extras into .venv")
-    assert said[1].startswith("Installing the Khronos glTF Validator into .venv/node with npm"), res.stdout
+    assert said[1].startswith("Installing the Khronos glTF Validator and three.js into .venv/node with npm"), res.stdout
     runs = log.read_text().splitlines()
     assert f"python PYTHONWARNINGS={QUIET_EDITABLE} -m pip install -q -e .[test]" in runs
     assert any(r.startswith("npm install") for r in runs) and runs[-1] == "python PYTHONWARNINGS= -m pytest -q"
