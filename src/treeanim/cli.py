@@ -281,6 +281,7 @@ def build_parser() -> argparse.ArgumentParser:
                              f"{k} {v}" for k, v in sorted(opt.JOINT_TARGETS.items()))
                          + " (Unreal's default of 256 bones per section; Unity and Godot stay responsive; "
                          "three.js with its bone texture)")
+    opt.add_precision_option(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_export)
 

@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 import pygltflib as gl
 
+from . import compact as cp
 from .files import remove_stale, write_bytes
 from .model.tree import Tree
 from .physics.rotation import matrix_to_quat
@@ -217,30 +218,36 @@ def vertex_colours(tree: Tree, mesh: TreeMesh, season: float) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- container
+_WIDTH = {gl.SCALAR: 1, gl.VEC3: 3, gl.VEC4: 4, gl.MAT4: 16}
+
+
 class _Blob:
     """The binary buffer, built as aligned buffer views and accessors."""
 
     def __init__(self, doc: gl.GLTF2) -> None:
         self.doc, self.parts, self.size = doc, [], 0
 
-    def view(self, data: bytes, target: int | None = None) -> int:
+    def view(self, data: bytes, target: int | None = None, stride: int | None = None) -> int:
         pad = (-self.size) % 4
         if pad:
             self.parts.append(b"\0" * pad)
             self.size += pad
-        self.doc.bufferViews.append(gl.BufferView(buffer=0, byteOffset=self.size, byteLength=len(data), target=target))
+        self.doc.bufferViews.append(gl.BufferView(buffer=0, byteOffset=self.size, byteLength=len(data), target=target,
+                                                  byteStride=stride))
         self.parts.append(data)
         self.size += len(data)
         return len(self.doc.bufferViews) - 1
 
     def accessor(self, array: np.ndarray, kind: str, component: int, target=None, normalized=None,
-                 minmax=False, view=None, offset=0, count=None) -> int:
+                 minmax=False, view=None, offset=0, count=None, stride=None) -> int:
+        """An accessor of ``array``'s rows (in a view of their own unless ``view`` is given); a
+        ``stride`` of more bytes than a row's ``kind`` uses pads each row (the row is wider)."""
         if view is None:
-            view = self.view(np.ascontiguousarray(array).tobytes(), target)
+            view = self.view(np.ascontiguousarray(array).tobytes(), target, stride)
         acc = gl.Accessor(bufferView=view, byteOffset=offset or None, componentType=component,
                           count=int(count if count is not None else len(array)), type=kind, normalized=normalized)
         if minmax:
-            flat = np.asarray(array).reshape(len(array), -1)
+            flat = np.asarray(array).reshape(len(array), -1)[:, :_WIDTH[kind]]
             acc.min = flat.min(axis=0).tolist()
             acc.max = flat.max(axis=0).tolist()
         self.doc.accessors.append(acc)
@@ -296,7 +303,8 @@ def skin(tree: Tree, mesh: TreeMesh, skel: Skeleton, present: np.ndarray | None 
 
 
 def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, mesh: TreeMesh | None = None,
-               present: np.ndarray | None = None, skel: Skeleton | None = None) -> tuple[gl.GLTF2, bytes]:
+               present: np.ndarray | None = None, skel: Skeleton | None = None,
+               precision: str = "full") -> tuple[gl.GLTF2, bytes]:
     """The glTF document and its binary buffer.
 
     Parameters
@@ -317,6 +325,9 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     skel : Skeleton, optional
         The joints ``keys`` are for: :func:`skeleton` ``(tree, present)`` by default, or one
         reduced to a joint budget (:func:`treeanim.joints.reduce`).
+    precision : {"full", "compact"}
+        Float32 attributes and every key, or quantised attributes and keys with each joint's
+        keys thinned within :data:`treeanim.compact.TOLERANCE` (:mod:`treeanim.compact`).
 
     Raises
     ------
@@ -338,16 +349,27 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     nrm = v["normal"].astype(np.float64)
     nrm = (nrm / np.linalg.norm(nrm, axis=1, keepdims=True)).astype(np.float32)
     col = np.round(vertex_colours(tree, mesh, season)[used] * 255).astype(np.uint8)
-    index = remap[mesh.indices[keep_tris]].astype(np.uint32)
-
+    compact = precision == "compact"
+    small = compact and skel.count <= 256  # 8-bit joint indices
+    index = remap[mesh.indices[keep_tris]].astype(np.uint16 if compact and len(pos) < 65536 else np.uint32)
+    if compact:  # KHR_mesh_quantization: positions scaled by 1/scale (undone in the inverse bind matrices)
+        qpos, scale = cp.positions(pos)
+        position = blob.accessor(qpos, gl.VEC3, gl.SHORT, gl.ARRAY_BUFFER, normalized=True, minmax=True, stride=8)
+        normal = blob.accessor(cp.unit(nrm), gl.VEC3, gl.BYTE, gl.ARRAY_BUFFER, normalized=True, stride=4)
+        doc.extensionsUsed = doc.extensionsRequired = ["KHR_mesh_quantization"]
+    else:
+        scale = 1.0
+        position = blob.accessor(pos, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER, minmax=True)
+        normal = blob.accessor(nrm, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER)
     attrs = gl.Attributes(
-        POSITION=blob.accessor(pos, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER, minmax=True),
-        NORMAL=blob.accessor(nrm, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
+        POSITION=position, NORMAL=normal,
         COLOR_0=blob.accessor(col, gl.VEC4, gl.UNSIGNED_BYTE, gl.ARRAY_BUFFER, normalized=True),
-        JOINTS_0=blob.accessor(joints, gl.VEC4, gl.UNSIGNED_SHORT, gl.ARRAY_BUFFER),
+        JOINTS_0=blob.accessor(joints.astype(np.uint8) if small else joints, gl.VEC4,
+                               gl.UNSIGNED_BYTE if small else gl.UNSIGNED_SHORT, gl.ARRAY_BUFFER),
         WEIGHTS_0=blob.accessor(weights, gl.VEC4, gl.UNSIGNED_BYTE, gl.ARRAY_BUFFER, normalized=True),
     )
-    indices = blob.accessor(index.ravel(), gl.SCALAR, gl.UNSIGNED_INT, gl.ELEMENT_ARRAY_BUFFER, minmax=True)
+    indices = blob.accessor(index.ravel(), gl.SCALAR, gl.UNSIGNED_SHORT if index.dtype == np.uint16 else gl.UNSIGNED_INT,
+                            gl.ELEMENT_ARRAY_BUFFER, minmax=True)
     doc.materials.append(gl.Material(
         name="tree", doubleSided=True,
         pbrMetallicRoughness=gl.PbrMetallicRoughness(baseColorFactor=[1, 1, 1, 1], metallicFactor=0.0, roughnessFactor=0.8),
@@ -366,7 +388,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
         t = local_t[j].tolist()
         doc.nodes.append(gl.Node(name=f"joint{j}", translation=t if any(t) else None, children=children[j] or None))
     ibm = np.zeros((J, 4, 4), np.float32)
-    ibm[:] = np.eye(4, dtype=np.float32)
+    ibm[:] = np.diag([scale, scale, scale, 1.0]).astype(np.float32)
     ibm[:, 3, :3] = -rest  # column-major: the translation column is stored last
     doc.skins.append(gl.Skin(name="skeleton", joints=list(range(first, first + J)), skeleton=first,
                              inverseBindMatrices=blob.accessor(ibm.reshape(J, 16), gl.MAT4, gl.FLOAT)))
@@ -374,16 +396,20 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     doc.scenes.append(gl.Scene(name=tree.name, nodes=[first, len(doc.nodes) - 1]))
     doc.scene = 0
 
-    # --- animation: one shared time accessor, one rotation accessor per joint in one view
-    F = len(keys)
-    times = (np.arange(F) / fps).astype(np.float32)
-    t_acc = blob.accessor(times, gl.SCALAR, gl.FLOAT, minmax=True)
-    per_joint = np.ascontiguousarray(np.transpose(keys.astype(np.float32), (1, 0, 2)))  # (J, F, 4)
-    view = blob.view(per_joint.tobytes())
+    # --- animation: a joint's every s-th key (s = 1 at full precision), one time accessor per
+    # stride, the rotation accessors in one view
+    stride = cp.thin(tree, skel, keys, pos, joints) if compact else np.ones(J, np.int64)
+    times = (np.arange(len(keys)) / fps).astype(np.float32)
+    t_acc = {s: blob.accessor(times[::s], gl.SCALAR, gl.FLOAT, minmax=True) for s in np.unique(stride[1:]).tolist()}
+    kept = [keys[::stride[j], j] for j in range(1, J)]
+    rot = cp.shorts(np.concatenate(kept)) if compact else np.concatenate(kept).astype(np.float32)
+    view = blob.view(rot.tobytes())
+    start = np.concatenate([[0], np.cumsum([len(k) for k in kept])]) * rot.itemsize * 4
     anim = gl.Animation(name="wind")
     for j in range(1, J):
-        out = blob.accessor(per_joint[j], gl.VEC4, gl.FLOAT, view=view, offset=j * F * 16, count=F)
-        anim.samplers.append(gl.AnimationSampler(input=t_acc, output=out, interpolation="LINEAR"))
+        out = blob.accessor(kept[j - 1], gl.VEC4, gl.SHORT if compact else gl.FLOAT, view=view,
+                            offset=int(start[j - 1]), normalized=compact or None)
+        anim.samplers.append(gl.AnimationSampler(input=t_acc[int(stride[j])], output=out, interpolation="LINEAR"))
         anim.channels.append(gl.AnimationChannel(sampler=j - 1, target=gl.AnimationChannelTarget(node=first + j, path="rotation")))
     doc.animations.append(anim)
     data = blob.bytes()

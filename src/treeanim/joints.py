@@ -34,7 +34,7 @@ import numpy as np
 from .export import Skeleton
 from .loop import _conj, _mul
 
-__all__ = ["fit", "motion_error", "rekey", "reduce", "report", "world_pose"]
+__all__ = ["displacement", "fit", "motion_error", "rekey", "reduce", "report", "world_pose"]
 
 def _levels(parent: np.ndarray) -> list[np.ndarray]:
     """Joints by depth (the root, depth 0, first); parents precede children in index order."""
@@ -237,19 +237,42 @@ def motion_error(tree, full: Skeleton, reduced: Skeleton, full_keys: np.ndarray,
     wf, pf = world if world is not None else world_pose(tree, full, full_keys)
     pick = np.unique(np.round(np.linspace(0, len(wf) - 1, min(len(wf), max(frames, 2)))).astype(np.int64))
     wf, pf = wf[pick], pf[pick]
-    wr, pr = world_pose(tree, reduced, rekey(full, reduced, wf))
     _, _, pos, jf, ww = skin(tree, mesh, full, present)
     _, _, _, jr, wr8 = skin(tree, mesh, reduced, present)
     pos = pos.astype(np.float64)
-    weights_f, weights_r = ww / 255.0, wr8 / 255.0
-    rest_f, rest_r = _rest(tree, full), _rest(tree, reduced)
+    return displacement(tree, (full, (wf, pf), pos, jf, ww), (reduced, world_pose(tree, reduced, rekey(full, reduced, wf)),
+                                                             pos, jr, wr8))
+
+
+def displacement(tree, a, b) -> tuple[float, float, int]:
+    """The distance between the mesh skinned two ways, frame by frame.
+
+    Parameters
+    ----------
+    tree : Tree
+    a, b : tuple
+        Each (skel, (world, position), pos, joints, weights): a skeleton, its joints' poses at
+        F frames (:func:`world_pose`), and the vertices at rest (V, 3), their joints (V, 4) and
+        weights (V, 4, summing to 255) as :func:`treeanim.export.skin` gives them.
+
+    Returns
+    -------
+    rms, worst : float
+        Root mean square over vertices and frames, and the largest (m).
+    frames : int
+        F.
+    """
+    (sa, (wa, pa), xa, ja, wta), (sb, (wb, pb), xb, jb, wtb) = a, b
+    ra, rb = _rest(tree, sa), _rest(tree, sb)
+    xa, xb = np.asarray(xa, np.float64), np.asarray(xb, np.float64)
+    wta, wtb = wta / 255.0, wtb / 255.0
     sse, worst = 0.0, 0.0
-    for f in range(len(wf)):  # a loop over frames; every vertex at once
-        d = _skinned(wf[f], pf[f], rest_f, pos, jf, weights_f) - _skinned(wr[f], pr[f], rest_r, pos, jr, weights_r)
+    for f in range(len(wa)):  # a loop over frames; every vertex at once
+        d = _skinned(wa[f], pa[f], ra, xa, ja, wta) - _skinned(wb[f], pb[f], rb, xb, jb, wtb)
         d2 = np.einsum("vi,vi->v", d, d)
         sse += float(d2.sum())
         worst = max(worst, float(d2.max()))
-    return float(np.sqrt(sse / max(len(pos) * len(wf), 1))), float(np.sqrt(worst)), len(pick)
+    return float(np.sqrt(sse / max(len(xa) * len(wa), 1))), float(np.sqrt(worst)), len(wa)
 
 
 def fit(tree, full: Skeleton, raw: np.ndarray, n: int, budget: int | None, present=None):

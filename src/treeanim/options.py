@@ -169,6 +169,16 @@ def add_season_option(p: argparse.ArgumentParser) -> None:
                    help=f"set one of the preset's physics parameters (repeatable; e.g. ei_max=3e4): {names}")
 
 
+def add_precision_option(p: argparse.ArgumentParser) -> None:
+    """``export --precision``: compact (the default) or full (:mod:`treeanim.compact`)."""
+    from treeanim.compact import PRECISIONS, TOLERANCE
+
+    p.add_argument("--precision", choices=PRECISIONS, default=PRECISIONS[0],
+                   help="compact (default): positions, normals and rotation keys quantised to 16 and 8 bits, and "
+                   f"each joint's keys thinned where its motion allows (no joint's keys move a vertex more than "
+                   f"{TOLERANCE * 1000:g} mm; the command prints the measured error); full: float32 and every key")
+
+
 def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
     """--wind and --wind-preset (the viewer's and the offline commands' wind)."""
     from treeanim.physics.wind import WIND_PRESETS

@@ -23,7 +23,7 @@ def cmd_export(args) -> int:
     """Bake the simulated motion into a glTF 2.0 or USD file: n frames at --fps make n + 1 keys,
     the last at exactly --seconds (a loop's repeats its first: :mod:`treeanim.loop`); or, with
     ``--motion shader``, write the static mesh with the shader-wind attributes."""
-    from .. import export, export_usd, joints, loop
+    from .. import compact, export, export_usd, joints, loop
 
     if args.motion == "shader":
         return _shader_export(args)
@@ -48,12 +48,15 @@ def cmd_export(args) -> int:
     if usd:
         files = export_usd.write_usd(out, tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel)
     else:
-        doc, data = export.build_gltf(tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel)
+        doc, data = export.build_gltf(tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel,
+                                      precision=args.precision)
         files = export.write_gltf(out, doc, data)
     size = sum(f.stat().st_size for f in files)
     print(f"wrote {', '.join(map(str, files))}: {skel.count} joints, {n} frames at {args.fps:g} fps, "
           f"{n + 1} keys from 0 to {n / args.fps:.2f} s, {size / 1e6:.1f} MB")
     print(joints.report(full, skel, budget, error))
+    if args.precision == "compact" and not usd:
+        print(compact.report(compact.error(tree, skel, keys, mesh, sim.present)))
     if fade:
         print(loop.seam(keys, raw).line())
     return 0
