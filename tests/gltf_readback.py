@@ -27,24 +27,32 @@ def accessor(doc, blob, index):
     dtype = np.dtype(_COMPONENTS[acc.componentType])
     width = _WIDTH[acc.type]
     start = (view.byteOffset or 0) + (acc.byteOffset or 0)
-    a = np.frombuffer(blob, dtype, count=acc.count * width, offset=start).reshape(acc.count, width)
+    row = (view.byteStride or dtype.itemsize * width) // dtype.itemsize  # a strided view pads each row
+    a = np.frombuffer(blob, dtype, count=(acc.count - 1) * row + width, offset=start)
+    a = np.lib.stride_tricks.as_strided(a, (acc.count, width), (row * dtype.itemsize, dtype.itemsize))
     if acc.normalized:
-        a = a.astype(np.float64) / np.iinfo(dtype).max
+        a = np.maximum(a.astype(np.float64) / np.iinfo(dtype).max, -1.0)
     return a
 
 
 def clip(doc, blob):
-    """The first animation's key times (F,) and rotation keys (F, C, 4), one per channel."""
+    """The first animation's key times (F,) and rotations (F, C, 4), one per channel, at every
+    key time of the clip: a channel with fewer keys (a compact file's) is played at those times."""
     anim = doc.animations[0]
-    times = accessor(doc, blob, anim.samplers[anim.channels[0].sampler].input)[:, 0]
-    keys = np.stack([accessor(doc, blob, anim.samplers[ch.sampler].output) for ch in anim.channels], axis=1)
-    return times, keys
+    samplers = [anim.samplers[ch.sampler] for ch in anim.channels]
+    inputs = {s.input: accessor(doc, blob, s.input)[:, 0] for s in samplers}
+    times = max(inputs.values(), key=len)
+    keys = [accessor(doc, blob, s.output) for s in samplers]
+    keys = [k if len(k) == len(times) else play(inputs[s.input], k[:, None], times, loop=False)[:, 0]
+            for s, k in zip(samplers, keys)]
+    return times, np.stack(keys, axis=1)
 
 
-def play(times, keys, t):
+def play(times, keys, t, loop=True):
     """Rotations (T, C, 4) a client shows at times ``t`` (T,) of a looping clip: the time modulo
-    the clip's length (three.js's LoopRepeat), then a slerp between the keys around it."""
-    t = np.mod(np.asarray(t, float), float(times[-1]))
+    the clip's length (three.js's LoopRepeat; not with ``loop`` False), then a slerp between the
+    keys around it."""
+    t = np.mod(np.asarray(t, float), float(times[-1])) if loop else np.asarray(t, float)
     i = np.clip(np.searchsorted(times, t, side="right") - 1, 0, len(times) - 2)
     u = np.clip((t - times[i]) / (times[i + 1] - times[i]), 0.0, 1.0)[:, None, None]
     a, b = keys[i].astype(float), keys[i + 1].astype(float)
@@ -68,14 +76,17 @@ def quat_to_matrix(q):
     ], -2)
 
 
-def joint_world_positions(doc, blob, frame):
-    """World position of every skin joint at key ``frame``, composed down the node hierarchy."""
+def joint_world(doc, blob, frame=None):
+    """World rotations (J, 3, 3) and positions (J, 3) of every skin joint at key ``frame`` of the
+    clip (:func:`clip`; None: at rest, the nodes' own rotations), composed down the node hierarchy."""
     skin = doc.skins[0]
     anim = doc.animations[0]
     rot = {}
-    for ch in anim.channels:
-        assert ch.target.path == "rotation"
-        rot[ch.target.node] = accessor(doc, blob, anim.samplers[ch.sampler].output)[frame]
+    if frame is not None:
+        keys = clip(doc, blob)[1][frame]
+        for c, ch in enumerate(anim.channels):
+            assert ch.target.path == "rotation"
+            rot[ch.target.node] = keys[c]
     parent = {}
     for i, node in enumerate(doc.nodes):
         for c in node.children or []:
@@ -101,4 +112,28 @@ def joint_world_positions(doc, blob, frame):
     sys.setrecursionlimit(100000)
     for j in skin.joints:
         pose(j)
-    return np.array([world_t[j] for j in skin.joints])
+    return np.array([world_R[j] for j in skin.joints]), np.array([world_t[j] for j in skin.joints])
+
+
+def joint_world_positions(doc, blob, frame):
+    """World position of every skin joint at key ``frame``."""
+    return joint_world(doc, blob, frame)[1]
+
+
+def skinned_vertices(doc, blob, frame=None):
+    """(V, 3) the mesh's vertices at key ``frame`` (None: at rest) as a client skins them:
+    Σ w_j M_j IBM_j x, the positions and weights decoded from their accessors (normalised
+    integers included), so in metres whatever the file's quantisation."""
+    R, t = joint_world(doc, blob, frame)
+    M = np.zeros((len(R), 4, 4))
+    M[:, :3, :3], M[:, :3, 3], M[:, 3, 3] = R, t, 1.0
+    ibm = accessor(doc, blob, doc.skins[0].inverseBindMatrices).reshape(-1, 4, 4).transpose(0, 2, 1)  # column-major
+    skinning = M @ ibm
+    prim = doc.meshes[0].primitives[0]
+    x = np.column_stack([accessor(doc, blob, prim.attributes.POSITION), np.ones(doc.accessors[prim.attributes.POSITION].count)])
+    joints = accessor(doc, blob, prim.attributes.JOINTS_0).astype(np.int64)
+    weights = accessor(doc, blob, prim.attributes.WEIGHTS_0)
+    out = np.zeros((len(x), 3))
+    for slot in range(4):
+        out += weights[:, slot, None] * np.einsum("vij,vj->vi", skinning[joints[:, slot]], x)[:, :3]
+    return out

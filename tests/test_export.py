@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import treeanim as ta
-from gltf_readback import accessor, clip, joint_world_positions, load, play
+from gltf_readback import accessor, clip, joint_world_positions, load, play, skinned_vertices
 from treeanim import scripted
 from treeanim.export import local_rotations, skeleton
 
@@ -87,7 +87,7 @@ def test_export_mesh_matches_tree(tmp_path):
     tree = ta.load_preset("small_cherry")
     prim = doc.meshes[0].primitives[0]
     assert doc.accessors[prim.indices].count == 3 * tree.stats()["triangles"]
-    pos = accessor(doc, blob, prim.attributes.POSITION)
+    pos = skinned_vertices(doc, blob)
     lo, hi = tree.rest_positions.min(axis=0), tree.rest_positions.max(axis=0)
     assert np.all(pos.min(axis=0) > lo - 0.2) and np.all(pos.max(axis=0) < hi + 0.2)
     w = accessor(doc, blob, prim.attributes.WEIGHTS_0)
@@ -205,7 +205,7 @@ def test_exported_leaf_colours_turn_with_the_season(tmp_path):
         doc, blob = load(out)
         prim = doc.meshes[0].primitives[0]
         col = accessor(doc, blob, prim.attributes.COLOR_0)[:, :3]
-        pos = accessor(doc, blob, prim.attributes.POSITION)
+        pos = skinned_vertices(doc, blob)
         crown = pos[:, 1] > 1.5  # leaves and twigs, not the trunk
         means.append(col[crown].mean(axis=0))
     (r0, g0, _), (r5, g5, _), (r1, g1, _) = means

@@ -40,7 +40,7 @@ __all__ = ["PRECISIONS", "TOLERANCE", "decode", "error", "positions", "reach", "
 #: ``export --precision``: ``compact`` (quantised, keys thinned) or ``full`` (float32, every key).
 PRECISIONS = ("compact", "full")
 #: The most one joint's thinned keys may move a vertex (m).
-TOLERANCE = 1e-3
+TOLERANCE = 2.5e-4
 _SHORT = 32767.0
 
 
@@ -162,7 +162,7 @@ def error(tree, skel, keys: np.ndarray, mesh=None, present=None, frames: int = 3
     _, _, pos, joints, weights = skin(tree, mesh if mesh is not None else build_mesh(tree), skel, present)
     n = len(keys) - 1
     m = min(frames, n)
-    pick = np.unique(np.round((np.arange(m) + 0.5) * n / m).astype(np.int64))
+    pick = np.unique(((np.arange(m) + 0.5) * n / m).astype(np.int64))
     q, h = positions(pos)
     exact = world_pose(tree, skel, np.asarray(keys, np.float64)[pick])
     played = world_pose(tree, skel, decode(keys, thin(tree, skel, keys, pos, joints))[pick])
