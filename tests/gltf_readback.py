@@ -35,6 +35,17 @@ def accessor(doc, blob, index):
     return a
 
 
+def attribute(doc, blob, name):
+    """A vertex attribute of the mesh, its primitives' in turn (a compact file's primitives hold
+    consecutive runs of the vertices)."""
+    return np.concatenate([accessor(doc, blob, getattr(p.attributes, name)) for p in doc.meshes[0].primitives])
+
+
+def triangles(doc):
+    """The number of triangles of the mesh, over its primitives."""
+    return sum(doc.accessors[p.indices].count for p in doc.meshes[0].primitives) // 3
+
+
 def clip(doc, blob):
     """The first animation's key times (F,) and rotations (F, C, 4), one per channel, at every
     key time of the clip: a channel with fewer keys (a compact file's) is played at those times."""
@@ -129,10 +140,10 @@ def skinned_vertices(doc, blob, frame=None):
     M[:, :3, :3], M[:, :3, 3], M[:, 3, 3] = R, t, 1.0
     ibm = accessor(doc, blob, doc.skins[0].inverseBindMatrices).reshape(-1, 4, 4).transpose(0, 2, 1)  # column-major
     skinning = M @ ibm
-    prim = doc.meshes[0].primitives[0]
-    x = np.column_stack([accessor(doc, blob, prim.attributes.POSITION), np.ones(doc.accessors[prim.attributes.POSITION].count)])
-    joints = accessor(doc, blob, prim.attributes.JOINTS_0).astype(np.int64)
-    weights = accessor(doc, blob, prim.attributes.WEIGHTS_0)
+    x = attribute(doc, blob, "POSITION")
+    x = np.column_stack([x, np.ones(len(x))])
+    joints = attribute(doc, blob, "JOINTS_0").astype(np.int64)
+    weights = attribute(doc, blob, "WEIGHTS_0")
     out = np.zeros((len(x), 3))
     for slot in range(4):
         out += weights[:, slot, None] * np.einsum("vij,vj->vi", skinning[joints[:, slot]], x)[:, :3]

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import treeanim as ta
-from gltf_readback import accessor, clip, joint_world_positions, load, play, skinned_vertices
+from gltf_readback import accessor, attribute, clip, joint_world_positions, load, play, skinned_vertices, triangles
 from treeanim import scripted
 from treeanim.export import local_rotations, skeleton
 
@@ -85,12 +85,11 @@ def test_export_mesh_matches_tree(tmp_path):
     assert export("small_cherry", "--seconds", "0.2", "--fps", "10", "--out", str(out)).returncode == 0
     doc, blob = load(out)
     tree = ta.load_preset("small_cherry")
-    prim = doc.meshes[0].primitives[0]
-    assert doc.accessors[prim.indices].count == 3 * tree.stats()["triangles"]
+    assert triangles(doc) == tree.stats()["triangles"]
     pos = skinned_vertices(doc, blob)
     lo, hi = tree.rest_positions.min(axis=0), tree.rest_positions.max(axis=0)
     assert np.all(pos.min(axis=0) > lo - 0.2) and np.all(pos.max(axis=0) < hi + 0.2)
-    w = accessor(doc, blob, prim.attributes.WEIGHTS_0)
+    w = attribute(doc, blob, "WEIGHTS_0")
     assert np.allclose(w.sum(axis=1), 1.0, atol=1e-6)
 
 
@@ -105,13 +104,13 @@ def test_winter_export_drops_leaves(tmp_path):
     tris, joints = [], []
     for path, season in ((summer, 0.0), (winter, 1.0)):
         doc, blob = load(path)
-        tris.append(doc.accessors[doc.meshes[0].primitives[0].indices].count // 3)
+        tris.append(triangles(doc))
         joints.append(len(doc.skins[0].joints))
         present = tree.leaves_present(season)
         segments = tree.object_count - 1  # one joint per segment, plus the root joint
         assert joints[-1] == 1 + segments[present].sum()
         assert len(doc.animations[0].channels) == joints[-1] - 1
-        used = np.unique(accessor(doc, blob, doc.meshes[0].primitives[0].attributes.JOINTS_0))
+        used = np.unique(attribute(doc, blob, "JOINTS_0"))
         assert used.max() < joints[-1]
     assert tris == [tree.stats(0.0)["triangles"], tree.stats(1.0)["triangles"]]
     assert joints[1] < joints[0] // 5, "a winter tree is mostly bare"
@@ -203,8 +202,7 @@ def test_exported_leaf_colours_turn_with_the_season(tmp_path):
         out = tmp_path / f"s{season}.glb"
         assert export("small_cherry", "--seconds", "0.2", "--fps", "10", "--season", season, "--out", str(out)).returncode == 0
         doc, blob = load(out)
-        prim = doc.meshes[0].primitives[0]
-        col = accessor(doc, blob, prim.attributes.COLOR_0)[:, :3]
+        col = attribute(doc, blob, "COLOR_0")[:, :3]
         pos = skinned_vertices(doc, blob)
         crown = pos[:, 1] > 1.5  # leaves and twigs, not the trunk
         means.append(col[crown].mean(axis=0))

@@ -11,8 +11,9 @@ What the file stores, and what it costs in motion:
   offset as a shift of the whole armature. On a 12 m tree a step is 0.37 mm, the error at
   most half of it.
 - **Normals** as normalised 8-bit integers (KHR_mesh_quantization): 0.45° at most.
-- **Joint indices** as 8-bit integers where the skin has at most 256 joints, **triangle
-  indices** as 16-bit where the mesh has fewer than 65,536 vertices (both core glTF).
+- **Triangle indices** as 16-bit integers: the mesh is cut into primitives of at most 65,535
+  vertices (:func:`runs`), which share the vertex buffers. **Joint
+  indices** as 8-bit integers where the skin has at most 256 joints (both core glTF).
 - **Rotation keys** as normalised 16-bit integers (core glTF): 8 bytes a key, not 16, and at
   most 0.0035° off (half a step, 1/65534, on each component).
 - **Fewer keys** where the motion allows: each joint keeps every s-th key, s the largest
@@ -34,7 +35,7 @@ import numpy as np
 
 from .loop import _conj, _exp, _log, _mul, angles
 
-__all__ = ["PRECISIONS", "TOLERANCE", "decode", "error", "positions", "reach", "report", "shorts", "strides", "thin",
+__all__ = ["PRECISIONS", "TOLERANCE", "decode", "error", "positions", "reach", "report", "runs", "shorts", "strides", "thin",
            "unit"]
 
 #: ``export --precision``: ``compact`` (quantised, keys thinned) or ``full`` (float32, every key).
@@ -63,6 +64,36 @@ def unit(v: np.ndarray) -> np.ndarray:
 def shorts(q: np.ndarray) -> np.ndarray:
     """Unit quaternions (..., 4) as normalised shorts."""
     return np.round(np.asarray(q, np.float64) * _SHORT).astype(np.int16)
+
+
+def runs(tris: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int, int, int]]]:
+    """The mesh's triangles (T, 3) in primitives of at most 65,535 vertices each (16-bit
+    indices; 65,535 itself is reserved): consecutive ranges of the vertices, cut where no
+    triangle straddles the cut.
+
+    Returns
+    -------
+    order : (T,) int
+        The triangles, reordered so that each primitive's are consecutive.
+    runs : list of (t0, t1, v0, v1)
+        Each primitive's triangles ``order[t0:t1]`` and its vertices [v0, v1).
+    """
+    lo, hi = tris.min(axis=1), tris.max(axis=1)
+    V = int(hi.max()) + 1
+    straddle = np.zeros(V + 1, np.int64)  # straddle[c] > 0: a triangle has lo < c <= hi
+    np.add.at(straddle, lo + 1, 1)
+    np.add.at(straddle, hi + 1, -1)
+    clean = np.flatnonzero(np.cumsum(straddle) == 0)
+    cuts = [0]
+    while cuts[-1] < V:
+        cut = int(clean[np.searchsorted(clean, cuts[-1] + 65535, side="right") - 1])
+        if cut == cuts[-1]:
+            raise ValueError("no cut of the mesh into primitives of at most 65,535 vertices")
+        cuts.append(cut)
+    run = np.searchsorted(cuts, lo, side="right") - 1
+    order = np.argsort(run, kind="stable")
+    t = np.searchsorted(run[order], np.arange(len(cuts)))
+    return order, [(int(t[k]), int(t[k + 1]), cuts[k], cuts[k + 1]) for k in range(len(cuts) - 1)]
 
 
 def reach(tree, skel, pos: np.ndarray, joint: np.ndarray) -> np.ndarray:

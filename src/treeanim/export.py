@@ -351,30 +351,36 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     col = np.round(vertex_colours(tree, mesh, season)[used] * 255).astype(np.uint8)
     compact = precision == "compact"
     small = compact and skel.count <= 256  # 8-bit joint indices
-    index = remap[mesh.indices[keep_tris]].astype(np.uint16 if compact and len(pos) < 65536 else np.uint32)
+    index = remap[mesh.indices[keep_tris]]
     if compact:  # KHR_mesh_quantization: positions scaled by 1/scale (undone in the inverse bind matrices)
         qpos, scale = cp.positions(pos)
-        position = blob.accessor(qpos, gl.VEC3, gl.SHORT, gl.ARRAY_BUFFER, normalized=True, minmax=True, stride=8)
-        normal = blob.accessor(cp.unit(nrm), gl.VEC3, gl.BYTE, gl.ARRAY_BUFFER, normalized=True, stride=4)
+        columns = {"POSITION": (qpos, gl.VEC3, gl.SHORT, True), "NORMAL": (cp.unit(nrm), gl.VEC3, gl.BYTE, True)}
         doc.extensionsUsed = doc.extensionsRequired = ["KHR_mesh_quantization"]
     else:
         scale = 1.0
-        position = blob.accessor(pos, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER, minmax=True)
-        normal = blob.accessor(nrm, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER)
-    attrs = gl.Attributes(
-        POSITION=position, NORMAL=normal,
-        COLOR_0=blob.accessor(col, gl.VEC4, gl.UNSIGNED_BYTE, gl.ARRAY_BUFFER, normalized=True),
-        JOINTS_0=blob.accessor(joints.astype(np.uint8) if small else joints, gl.VEC4,
-                               gl.UNSIGNED_BYTE if small else gl.UNSIGNED_SHORT, gl.ARRAY_BUFFER),
-        WEIGHTS_0=blob.accessor(weights, gl.VEC4, gl.UNSIGNED_BYTE, gl.ARRAY_BUFFER, normalized=True),
-    )
-    indices = blob.accessor(index.ravel(), gl.SCALAR, gl.UNSIGNED_SHORT if index.dtype == np.uint16 else gl.UNSIGNED_INT,
-                            gl.ELEMENT_ARRAY_BUFFER, minmax=True)
+        columns = {"POSITION": (pos, gl.VEC3, gl.FLOAT, None), "NORMAL": (nrm, gl.VEC3, gl.FLOAT, None)}
+    columns.update(COLOR_0=(col, gl.VEC4, gl.UNSIGNED_BYTE, True),
+                   JOINTS_0=(joints.astype(np.uint8), gl.VEC4, gl.UNSIGNED_BYTE, None) if small else
+                   (joints, gl.VEC4, gl.UNSIGNED_SHORT, None),
+                   WEIGHTS_0=(weights, gl.VEC4, gl.UNSIGNED_BYTE, True))
+    views = {name: blob.view(a.tobytes(), gl.ARRAY_BUFFER, a.strides[0]) for name, (a, *_) in columns.items()}
     doc.materials.append(gl.Material(
         name="tree", doubleSided=True,
         pbrMetallicRoughness=gl.PbrMetallicRoughness(baseColorFactor=[1, 1, 1, 1], metallicFactor=0.0, roughnessFactor=0.8),
     ))
-    doc.meshes.append(gl.Mesh(name=tree.name, primitives=[gl.Primitive(attributes=attrs, indices=indices, material=0)]))
+    # A compact file has one primitive per run of at most 65,535 vertices: 16-bit indices
+    order, runs = cp.runs(index) if compact else (slice(None), [(0, len(index), 0, len(pos))])
+    index = index[order]
+    primitives = []
+    for t0, t1, v0, v1 in runs:
+        attrs = {name: blob.accessor(a[v0:v1], kind, component, view=views[name], offset=v0 * a.strides[0],
+                                     normalized=norm, minmax=name == "POSITION")
+                 for name, (a, kind, component, norm) in columns.items()}
+        local = (index[t0:t1] - v0).ravel().astype(np.uint16 if compact else np.uint32)
+        indices = blob.accessor(local, gl.SCALAR, gl.UNSIGNED_SHORT if compact else gl.UNSIGNED_INT,
+                                gl.ELEMENT_ARRAY_BUFFER, minmax=True)
+        primitives.append(gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices, material=0))
+    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives))
 
     # --- joints: constant local translations, rotations animated
     J = skel.count
