@@ -63,7 +63,7 @@ def test_full_budget_is_todays_motion(tmp_path):
 
 def test_target_chooses_a_budget_and_merged_joints_ride_rigidly(tmp_path):
     out = tmp_path / "unreal.glb"
-    res = export(*ARGS, "--target", "unreal", "--out", str(out))
+    res = export(*ARGS, "--target", "unreal", "--precision", "full", "--out", str(out))
     assert res.returncode == 0, res.stderr
     doc, blob = load(out)
     assert len(doc.skins[0].joints) == 256 and "budget 256" in res.stdout
@@ -79,6 +79,24 @@ def test_target_chooses_a_budget_and_merged_joints_ride_rigidly(tmp_path):
     idx = joints.full_index(full, skel)
     baked = joint_world_positions(doc, blob, 10)
     assert np.max(np.linalg.norm(baked - pos[10, idx], axis=1)) <= error[1] + 1e-3
+
+
+def test_a_budget_with_a_loop_keeps_its_joints_and_closes(tmp_path):
+    """--joints 256 --loop: the reduced keys are closed as a full export's are (the last key is
+    the first, the seam is reported), and the budget and its error report stand."""
+    out = tmp_path / "loop.glb"
+    res = export("small_cherry", "--seconds", "2", "--fps", "10", "--wind", "8", "--joints", "256", "--loop", "0.5",
+                 "--out", str(out))
+    assert res.returncode == 0, res.stderr
+    assert REPORT.search(res.stdout)[1] == "256", res.stdout
+    m = re.search(r"loop seam: the last key is ([\d.]+)° off the first", res.stdout)
+    assert m and float(m[1]) == 0.0, res.stdout
+    report = validate(out)
+    assert (report["numErrors"], report["numWarnings"]) == (0, 0), report["messages"][:5]
+    doc, blob = load(out)
+    times, keys = clip(doc, blob)
+    assert len(doc.skins[0].joints) == 256 and keys.shape[1] == 255
+    assert times[-1] == np.float32(2.0) and np.array_equal(keys[-1], keys[0]), "the key at T repeats the first"
 
 
 def test_reduce_keeps_any_budget_as_a_hierarchy():
