@@ -29,6 +29,17 @@ def validate(path):
     return json.loads(res.stdout)
 
 
+def three(path, times):
+    """The file played by three.js (tests/gltf_three.mjs, in Node): the clip's duration and every
+    skinned vertex (V, 3) at each of ``times``."""
+    assert (NODE_MODULES / "three").is_dir(), f"three is not installed in {NODE_MODULES}: run scripts/test"
+    res = subprocess.run(["node", str(ROOT / "tests" / "gltf_three.mjs"), str(path), *map(str, times)], capture_output=True,
+                         text=True, env=dict(os.environ, NODE_PATH=str(NODE_MODULES.resolve())), timeout=600)
+    assert res.returncode == 0, res.stderr
+    out = json.loads(res.stdout)
+    return out["duration"], [np.reshape(out["vertices"][str(t)], (-1, 3)) for t in times]
+
+
 def export(*args):
     res = subprocess.run([sys.executable, "-m", "treeanim", "export", *args, "--quiet"], capture_output=True, text=True,
                          timeout=900)
@@ -224,6 +235,13 @@ def test_compact_file_is_smaller_by_its_layout_and_moves_within_a_millimetre(tmp
     m = re.search(r"compact: .* RMS ([\d.]+) cm, worst ([\d.]+) cm", reports["compact"])
     assert m and "compact:" not in reports["full"], reports
     assert 0 < float(m[1]) <= float(m[2]) <= worst * 100 + 1e-3, (m[0], worst)
+
+    # three.js decodes the compact file (quantised positions and keys, thinned channels, 16-bit
+    # primitives) and skins it as the file says; it plays as long as the full one.
+    duration, played = three(files["compact"], (0, 9 / 15, 28 / 15))  # at 2 s it loops to 0
+    assert duration == pytest.approx(2.0)
+    for k, v in zip((0, 9, 28), played):
+        assert np.max(np.linalg.norm(v - skinned_vertices(*compact, k), axis=1)) < 1e-5, k
 
 
 @pytest.mark.parametrize("args,words", [
