@@ -197,7 +197,6 @@ def error(tree, skel, keys: np.ndarray, mesh=None, present=None, frames: int = 3
     q, h = positions(pos)
     exact = world_pose(tree, skel, np.asarray(keys, np.float64)[pick])
     played = world_pose(tree, skel, decode(keys, thin(tree, skel, keys, pos, joints))[pick])
-    pos = pos.astype(np.float64)
     return displacement(tree, (skel, exact, pos, joints, weights),
                         (skel, played, q[:, :3] * (h / _SHORT), joints, weights))
 

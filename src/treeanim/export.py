@@ -6,8 +6,9 @@ parent is the previous segment's joint, or for an object's base the joint that c
 parent's attach node; every object root hangs under one root joint at the origin. Because the
 simulation keeps segment lengths exactly and children sit exactly on their parents' nodes,
 each joint's translation relative to its parent is constant: the animation holds rotations
-only, one float32 quaternion key per joint and frame, sharing one time accessor. Objects not
-present at the season (fallen leaves) have no joints and no triangles.
+only: one float32 quaternion key per joint and frame, sharing one time accessor, or in a
+compact file 16-bit keys, each joint's thinned where its motion allows (:mod:`treeanim.compact`).
+Objects not present at the season (fallen leaves) have no joints and no triangles.
 
 A clip of n frames holds n + 1 keys, at 0, 1/fps, …, n/fps: it lasts n/fps in a client, which
 plays from the first key to the last (a loop's last key repeats its first: :mod:`treeanim.loop`).
@@ -218,7 +219,7 @@ def vertex_colours(tree: Tree, mesh: TreeMesh, season: float) -> np.ndarray:
 
 
 # ---------------------------------------------------------------------------- container
-_WIDTH = {gl.SCALAR: 1, gl.VEC3: 3, gl.VEC4: 4, gl.MAT4: 16}
+_WIDTH = {gl.SCALAR: 1, gl.VEC2: 2, gl.VEC3: 3, gl.VEC4: 4, gl.MAT4: 16}
 
 
 class _Blob:
@@ -239,11 +240,11 @@ class _Blob:
         return len(self.doc.bufferViews) - 1
 
     def accessor(self, array: np.ndarray, kind: str, component: int, target=None, normalized=None,
-                 minmax=False, view=None, offset=0, count=None, stride=None) -> int:
+                 minmax=False, view=None, offset=0, count=None) -> int:
         """An accessor of ``array``'s rows (in a view of their own unless ``view`` is given); a
-        ``stride`` of more bytes than a row's ``kind`` uses pads each row (the row is wider)."""
+        row may be wider than ``kind`` (padding in a strided view): min and max skip the rest."""
         if view is None:
-            view = self.view(np.ascontiguousarray(array).tobytes(), target, stride)
+            view = self.view(np.ascontiguousarray(array).tobytes(), target)
         acc = gl.Accessor(bufferView=view, byteOffset=offset or None, componentType=component,
                           count=int(count if count is not None else len(array)), type=kind, normalized=normalized)
         if minmax:
@@ -350,7 +351,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     nrm = (nrm / np.linalg.norm(nrm, axis=1, keepdims=True)).astype(np.float32)
     col = np.round(vertex_colours(tree, mesh, season)[used] * 255).astype(np.uint8)
     compact = precision == "compact"
-    small = compact and skel.count <= 256  # 8-bit joint indices
+    byte_joints = compact and skel.count <= 256
     index = remap[mesh.indices[keep_tris]]
     if compact:  # KHR_mesh_quantization: positions scaled by 1/scale (undone in the inverse bind matrices)
         qpos, scale = cp.positions(pos)
@@ -360,7 +361,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
         scale = 1.0
         columns = {"POSITION": (pos, gl.VEC3, gl.FLOAT, None), "NORMAL": (nrm, gl.VEC3, gl.FLOAT, None)}
     columns.update(COLOR_0=(col, gl.VEC4, gl.UNSIGNED_BYTE, True),
-                   JOINTS_0=(joints.astype(np.uint8), gl.VEC4, gl.UNSIGNED_BYTE, None) if small else
+                   JOINTS_0=(joints.astype(np.uint8), gl.VEC4, gl.UNSIGNED_BYTE, None) if byte_joints else
                    (joints, gl.VEC4, gl.UNSIGNED_SHORT, None),
                    WEIGHTS_0=(weights, gl.VEC4, gl.UNSIGNED_BYTE, True))
     views = {name: blob.view(a.tobytes(), gl.ARRAY_BUFFER, a.strides[0]) for name, (a, *_) in columns.items()}

@@ -239,7 +239,6 @@ def motion_error(tree, full: Skeleton, reduced: Skeleton, full_keys: np.ndarray,
     wf, pf = wf[pick], pf[pick]
     _, _, pos, jf, ww = skin(tree, mesh, full, present)
     _, _, _, jr, wr8 = skin(tree, mesh, reduced, present)
-    pos = pos.astype(np.float64)
     return displacement(tree, (full, (wf, pf), pos, jf, ww), (reduced, world_pose(tree, reduced, rekey(full, reduced, wf)),
                                                              pos, jr, wr8))
 

@@ -176,7 +176,8 @@ def add_precision_option(p: argparse.ArgumentParser) -> None:
     p.add_argument("--precision", choices=PRECISIONS, default=PRECISIONS[0],
                    help="compact (default): positions, normals and rotation keys quantised to 16 and 8 bits, and "
                    f"each joint's keys thinned where its motion allows (no joint's keys move a vertex more than "
-                   f"{TOLERANCE * 1000:g} mm; the command prints the measured error); full: float32 and every key")
+                   f"{TOLERANCE * 1000:g} mm; the command prints the measured error); full: float32 and every key (glTF "
+                   "files)")
 
 
 def add_wind_speed_options(p: argparse.ArgumentParser, wind: float = 5.0) -> None:
