@@ -405,7 +405,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
 
     # --- animation: a joint's every s-th key (s = 1 at full precision), one time accessor per
     # stride, the rotation accessors in one view
-    stride = cp.thin(tree, skel, keys, pos, joints) if compact else np.ones(J, np.int64)
+    keys, stride = cp.encode(tree, skel, keys, pos, joints) if compact else (keys, np.ones(J, np.int64))
     times = (np.arange(len(keys)) / fps).astype(np.float32)
     t_acc = {s: blob.accessor(times[::s], gl.SCALAR, gl.FLOAT, minmax=True) for s in np.unique(stride[1:]).tolist()}
     kept = [keys[::stride[j], j] for j in range(1, J)]
