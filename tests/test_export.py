@@ -77,7 +77,7 @@ def test_export_validates_and_plays_back(tmp_path, preset, name, seconds, fps, w
     skel = skeleton(tree)
     n = int(round(seconds * fps))
     assert len(doc.skins[0].joints) == skel.count
-    times = accessor(doc, blob, doc.animations[0].samplers[0].input)[:, 0]
+    times = clip(doc, blob)[0]  # the longest of the channels' inputs: thinned ones hold fewer keys
     assert len(times) == n + 1 == len(frames), "n frames: keys at 0, 1/fps, ..., seconds"
     assert times[-1] == np.float32(seconds), "the clip lasts exactly --seconds"
     assert np.allclose(np.diff(times), 1 / fps, rtol=1e-5)

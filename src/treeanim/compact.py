@@ -39,6 +39,7 @@ from __future__ import annotations
 import numpy as np
 
 from .loop import _conj, _exp, _log, _mul, angles
+from .pose import _levels, _rest, displacement, world_pose
 
 __all__ = ["PRECISIONS", "TOLERANCE", "decode", "encode", "error", "positions", "reach", "report", "runs", "shorts", "strides",
            "unit"]
@@ -104,8 +105,6 @@ def runs(tris: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int, int, int]]]
 def reach(tree, skel, pos: np.ndarray, joint: np.ndarray) -> np.ndarray:
     """(J,) for each joint, an upper bound of the distance from its pivot to the vertices it
     carries (its subtree's): the farthest corner of their bounding box (m)."""
-    from .joints import _levels, _rest
-
     J = skel.count
     lo = np.full((J, 3), np.inf)
     hi = np.full((J, 3), -np.inf)
@@ -184,8 +183,6 @@ def encode(tree, skel, keys: np.ndarray, pos: np.ndarray, joints: np.ndarray) ->
         The keys to store (every s-th of a joint's, quantised with :func:`shorts`).
     stride : (J,) int
     """
-    from .joints import _levels, world_pose
-
     keys = np.asarray(keys, np.float64)
     world, _ = world_pose(tree, skel, keys)
     limit = TOLERANCE / np.maximum(reach(tree, skel, pos, joints[:, 0]), 1e-9)
@@ -201,7 +198,8 @@ def encode(tree, skel, keys: np.ndarray, pos: np.ndarray, joints: np.ndarray) ->
     return local, stride
 
 
-def error(tree, skel, keys: np.ndarray, mesh=None, present=None, frames: int = 31) -> tuple[float, float, int]:
+def error(tree, skel, keys: np.ndarray, pos: np.ndarray, joints: np.ndarray, weights: np.ndarray,
+          frames: int = 31) -> tuple[float, float, int]:
     """The displacement of the mesh as the compact file skins it from the mesh skinned with the
     exact keys and positions: every vertex, at ``frames`` frames midway between evenly spread
     ones (so not all on kept keys).
@@ -212,10 +210,8 @@ def error(tree, skel, keys: np.ndarray, mesh=None, present=None, frames: int = 3
         The tree and the skeleton the keys are for.
     keys : (F, J, 4) float
         The exact keys.
-    mesh : TreeMesh, optional
-        The tree's mesh, built if not given.
-    present : (M,) bool, optional
-        Objects on the tree.
+    pos, joints, weights : (V, 3), (V, 4), (V, 4)
+        The skinned vertices (:func:`treeanim.export.skin`).
 
     Returns
     -------
@@ -224,11 +220,6 @@ def error(tree, skel, keys: np.ndarray, mesh=None, present=None, frames: int = 3
     measured : int
         Frames measured.
     """
-    from .export import skin
-    from .joints import displacement, world_pose
-    from .render.mesh import build_mesh
-
-    _, _, pos, joints, weights = skin(tree, mesh if mesh is not None else build_mesh(tree), skel, present)
     n = len(keys) - 1
     m = min(frames, n)
     pick = np.unique(((np.arange(m) + 0.5) * n / m).astype(np.int64))

@@ -24,6 +24,7 @@ def cmd_export(args) -> int:
     the last at exactly --seconds (a loop's repeats its first: :mod:`treeanim.loop`); or, with
     ``--motion shader``, write the static mesh with the shader-wind attributes."""
     from .. import compact, export, export_usd, joints, loop
+    from ..render.mesh import build_mesh
 
     if args.motion == "shader":
         return _shader_export(args)
@@ -56,7 +57,8 @@ def cmd_export(args) -> int:
           f"{n + 1} keys from 0 to {n / args.fps:.2f} s, {size / 1e6:.1f} MB")
     print(joints.report(full, skel, budget, error))
     if args.precision == "compact" and not usd:
-        print(compact.report(compact.error(tree, skel, keys, mesh, sim.present)))
+        skinned = export.skin(tree, mesh if mesh is not None else build_mesh(tree), skel, sim.present)[2:]
+        print(compact.report(compact.error(tree, skel, keys, *skinned)))
     if fade:
         print(loop.seam(keys, raw).line())
     return 0
