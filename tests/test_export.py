@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 import treeanim as ta
-from gltf_readback import accessor, attribute, clip, joint_world_positions, load, play, skinned_vertices, triangles
+from gltf_readback import attribute, clip, joint_world_positions, load, play, skinned_vertices, triangles
 from treeanim import scripted
 from treeanim.export import local_rotations, skeleton
 
