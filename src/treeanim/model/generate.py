@@ -62,6 +62,7 @@ class LeafSpec:
     winter_count: int = 0
     levels: tuple[int, ...] = ()
     attach: tuple[float, float] = (0.0, 1.0)  # where along a branch leaves sit (fraction)
+    leader: float = 0.0  # the top fraction of the trunk (the leader's shoot) is in leaf too
     tip_share: float = 0.0  # share of the leaves in tufts at free tips
     tip_angle: float = 30.0  # down angle of a tip tuft's most upright leaves, degrees
     petiole_length: float = 0.03
@@ -74,6 +75,7 @@ class LeafSpec:
     down_var: float = 10.0
     roll_var: float = 15.0  # scatter about the spiral's golden angle, degrees
     droop: float = 30.0
+    turn_var: float = 25.0  # scatter of the blade's turn about its petiole from facing up, degrees
 
 
 @dataclass(frozen=True)
@@ -292,11 +294,15 @@ def _leaf_slots(lf: LeafSpec, branches: list[ObjectSpec]) -> tuple[np.ndarray, .
     grown_on = {(s.parent, s.attach) for s in branches if s.parent >= 0}
     rows = []
     for b, s in enumerate(branches):
-        if s.level not in lf.levels:
+        if s.level in lf.levels:
+            lo, hi = lf.attach
+        elif s.level == 1 and lf.leader > 0:
+            lo, hi = 1 - lf.leader, 1.0
+        else:
             continue
         seg = np.linalg.norm(np.diff(s.points, axis=0), axis=1)
         frac = np.cumsum(seg) / seg.sum()  # of nodes 1..n along the branch
-        for j in np.flatnonzero((frac >= lf.attach[0] - 1e-9) & (frac <= lf.attach[1] + 1e-9)) + 1:
+        for j in np.flatnonzero((frac >= lo - 1e-9) & (frac <= hi + 1e-9)) + 1:
             rows.append((b, j, seg[j - 1], j == len(seg) and (b, j) not in grown_on))
     if not rows:
         raise ValueError(f"key 'leaves.levels': {list(lf.levels)} names no level that has branches "
@@ -361,7 +367,7 @@ def place_leaves(lf: LeafSpec, branches: list[ObjectSpec], slots: tuple[np.ndarr
     # Lamina normal: as close to "up" as the petiole allows, turned a little at random.
     w = UP - tip_dir * tip_dir[:, 1:2]
     w = np.where(np.linalg.norm(w, axis=1, keepdims=True) > 1e-3, w, perpendicular(tip_dir))
-    w = rotate(_unit(w), tip_dir, rng.normal(0, np.radians(25), n))
+    w = rotate(_unit(w), tip_dir, rng.normal(0, np.radians(lf.turn_var), n))
     # A petiole is never thicker than the twig it grows from.
     twig = np.array([branches[b].diameters[j] for b, j in zip(b_idx, j_idx)])
     base_d = np.minimum(lf.petiole_diameter * scale, twig)
