@@ -93,6 +93,12 @@ MATERIAL_BLADE = 3
 #: the materials each holds: leaves (petioles and laminas), bark, grass blades.
 PARTS = {"LEAVES": (MATERIAL_PETIOLE, MATERIAL_LAMINA), "BARK": (MATERIAL_BARK,), "BLADES": (MATERIAL_BLADE,)}
 
+#: Blades drawn per simulated grass blade: a clump riding its motion, so a meadow of the paper's
+#: 5,000 blades reads as grass (render side only: the simulation and Table 1 count one).
+BLADE_CLUMP = 5
+#: A clump's radius over its blade's height.
+BLADE_SPREAD = 0.3
+
 VERTEX_DTYPE = np.dtype(
     [("ids", "<i4", (4,)), ("offset", "<f4", (3,)), ("normal", "<f4", (3,)), ("extra", "<f4", (4,)),
      ("uv", "<f4", (2,)), ("curve", "<f4", (2,))]
@@ -441,7 +447,7 @@ def _laminas(parts: _Parts, tree: Tree, leaves: np.ndarray, jitter: np.ndarray, 
     parts.triangles(tris, leaves[:, None])
 
 
-def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray) -> None:
+def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray, rng: np.random.Generator) -> None:
     if len(blades) == 0:
         return
     P = tree.rest_positions
@@ -450,26 +456,50 @@ def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray) -
     w = tree.rest_w[obj]
     across = _unit(w - np.sum(w * t, axis=1, keepdims=True) * t, _perpendicular(t))
     normal = np.cross(across, t)
-    half = 0.5 * tree.node_diameter[nodes, None] * across
+    half = 0.5 * tree.node_diameter[nodes]
     frac = k / (tree.object_count[obj] - 1)
     inner = ~(base | tip)
-    prev = np.where(inner, nodes - 1, nodes)
-    weight = np.where(inner, 0.5, 0.0)
-    rep = lambda a: np.repeat(a, 2, axis=0)  # noqa: E731
-    offset = np.stack([-half, half], axis=1).reshape(-1, 3)
-    uv = np.stack([np.tile([-1.0, 1.0], len(nodes)), rep(frac)], -1)
-    v0 = parts.add(rep(nodes), rep(prev), rep(obj), MATERIAL_BLADE, offset, rep(normal),
-                   rep(weight), rep(jitter[obj]), rep(frac), uv)
-    pair = v0 + 2 * np.arange(len(nodes))
-    seg = np.flatnonzero(~tip)
-    a0, a1, b0, b1 = pair[seg], pair[seg] + 1, pair[seg] + 2, pair[seg] + 3
-    parts.triangles(np.stack([np.stack([a0, a1, b1], -1), np.stack([a0, b1, b0], -1)], axis=1),
-                    obj[seg, None])
+    rise = P[nodes] - P[tree.object_start[obj]]  # from the blade's root
+    m, slot = len(blades), np.searchsorted(blades, obj)
+    height = np.linalg.norm(rise[tip], axis=1)
     it = np.flatnonzero(tip)
     seg_len = np.linalg.norm(P[nodes[it]] - P[prv[it]], axis=1)
-    ap = parts.add(nodes[it], nodes[it], obj[it], MATERIAL_BLADE, 0.5 * seg_len[:, None] * t[it],
-                   normal[it], 0.0, jitter[obj[it]], 1.0, np.array([0.0, 1.0]))
-    parts.triangles(np.stack([pair[it], pair[it] + 1, ap + np.arange(len(it))], -1), obj[it])
+    rep = lambda a: np.repeat(a, 2, axis=0)  # noqa: E731
+    for c in range(BLADE_CLUMP):
+        # The first blade of a clump is the simulated one; the others stand around its root,
+        # shorter, leaning their own way, each its own colour, their roots in the ground's frame.
+        axis, scale, own = np.zeros((len(nodes), 3)), np.ones(m), jitter[blades]
+        prev, weight = np.where(inner, nodes - 1, nodes), np.where(inner, 0.5, 0.0)
+        if c:
+            r, az = BLADE_SPREAD * height * np.sqrt(rng.random(m)), rng.uniform(0, 2 * np.pi, m)
+            scale, own = rng.uniform(0.55, 1.0, m), rng.random(m)
+            lean = np.insert(rng.normal(0.0, 0.25, (m, 2)), 1, 0.0, axis=1) * height[:, None]
+            shift = np.column_stack([r * np.cos(az), np.zeros(m), r * np.sin(az)])
+            axis = shift[slot] + (scale[slot, None] - 1) * rise + frac[:, None] * lean[slot]
+            prev, weight = np.where(base, -1, prev), np.where(base, 1.0, weight)
+        offset = rep(axis) + np.stack([-half, half], axis=1).reshape(-1, 1) * rep(across)
+        uv = np.stack([np.tile([-1.0, 1.0], len(nodes)), rep(frac)], -1)
+        curve = np.stack([np.zeros(2 * len(nodes)), rep(half)], -1)  # t = 0; the half width
+        v0 = parts.add(rep(nodes), rep(prev), rep(obj), MATERIAL_BLADE, offset, rep(normal),
+                       rep(weight), rep(own[slot]), rep(frac), uv, curve)
+        pair = v0 + 2 * np.arange(len(nodes))
+        seg = np.flatnonzero(~tip)
+        a0, a1, b0, b1 = pair[seg], pair[seg] + 1, pair[seg] + 2, pair[seg] + 3
+        parts.triangles(np.stack([np.stack([a0, a1, b1], -1), np.stack([a0, b1, b0], -1)], axis=1),
+                        obj[seg, None])
+        ap = parts.add(nodes[it], nodes[it], obj[it], MATERIAL_BLADE,
+                       axis[it] + 0.5 * (seg_len * scale)[:, None] * t[it], normal[it], 0.0, own, 1.0,
+                       np.array([0.0, 1.0]))
+        parts.triangles(np.stack([pair[it], pair[it] + 1, ap + np.arange(len(it))], -1), obj[it])
+
+
+def drawn_triangles(tree: Tree) -> np.ndarray:
+    """(M,) int: the triangles :func:`build_mesh` draws for each object.
+
+    :meth:`Tree.triangles_per_object` (the paper's count, Table 1's), a blade's times
+    :data:`BLADE_CLUMP`.
+    """
+    return tree.triangles_per_object() * np.where(tree.kind == "blade", BLADE_CLUMP, 1)
 
 
 def _ambient_occlusion(tree: Tree, verts: np.ndarray) -> np.ndarray:
@@ -515,7 +545,7 @@ def build_mesh(tree: Tree, seed: int | None = None) -> TreeMesh:
     _tubes(parts, tree, np.flatnonzero(kind == "branch"), BRANCH_SIDES, True, MATERIAL_BARK, jitter, key)
     _tubes(parts, tree, leaves, int(tree.petiole_sides), False, MATERIAL_PETIOLE, jitter, key)
     _laminas(parts, tree, leaves, jitter, key)
-    _blades(parts, tree, np.flatnonzero(kind == "blade"), jitter)
+    _blades(parts, tree, np.flatnonzero(kind == "blade"), jitter, rng)
 
     verts = np.concatenate(parts.verts) if parts.verts else np.zeros(0, VERTEX_DTYPE)
     tris = np.concatenate(parts.tris).astype(np.uint32) if parts.tris else np.zeros((0, 3), np.uint32)
