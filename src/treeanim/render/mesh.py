@@ -51,7 +51,9 @@ Geometry per object kind (triangle counts equal :meth:`Tree.triangles_per_object
   point (x, y) sits at ``L·(x·u + y·v + curl·x²·w)`` from the tip, L = ``lamina_length``.
 - blade: a strip with 2 vertices per node across the blade's w axis (width =
   ``node_diameter``; the strip's face contains the blade's tangent and faces along the bending
-  plane), plus one tip triangle to an apex half a segment beyond the tip: 2·(n−1) + 1.
+  plane), plus one tip triangle to an apex half a segment beyond the tip: 2·(n−1) + 1, drawn
+  :data:`BLADE_CLUMP` times (:func:`drawn_triangles`): the simulated blade and copies around
+  its root, shorter and leaning, offset from its nodes (their roots in the ground's frame).
 
 Vertex layout (:data:`VERTEX_DTYPE`, 72 bytes, interleaved, attribute format
 :data:`VERTEX_FORMAT`)::
@@ -64,7 +66,8 @@ Vertex layout (:data:`VERTEX_DTYPE`, 72 bytes, interleaved, attribute format
     in_uv     vec2   surface coordinates: bark and petioles (turn around the tube in [0, 1),
                      metres along the object); laminas (x, y) in leaf units; blades
                      (−1 / +1 across, fraction along)
-    in_curve  vec2   (t along the segment, 1 where the segment ends at the object's tip)
+    in_curve  vec2   (t along the segment, 1 where the segment ends at the object's tip); blades
+                     (0, half width): tree.vert finds a clump blade's axis by it
 
 ``key`` depends on the material: for lamina and petiole vertices the leaf's drop order
 normalised to [0, 1] (0 falls first, and turns colour first); for blades the fraction along
@@ -93,11 +96,9 @@ MATERIAL_BLADE = 3
 #: the materials each holds: leaves (petioles and laminas), bark, grass blades.
 PARTS = {"LEAVES": (MATERIAL_PETIOLE, MATERIAL_LAMINA), "BARK": (MATERIAL_BARK,), "BLADES": (MATERIAL_BLADE,)}
 
-#: Blades drawn per simulated grass blade: a clump riding its motion, so a meadow of the paper's
-#: 5,000 blades reads as grass (render side only: the simulation and Table 1 count one).
-BLADE_CLUMP = 5
-#: A clump's radius over its blade's height.
-BLADE_SPREAD = 0.3
+#: Blades drawn per simulated blade (a clump riding its motion, so the paper's 5,000 read as a
+#: meadow; Table 1 counts one), and a clump's radius over its blade's height.
+BLADE_CLUMP, BLADE_SPREAD = 5, 0.3
 
 VERTEX_DTYPE = np.dtype(
     [("ids", "<i4", (4,)), ("offset", "<f4", (3,)), ("normal", "<f4", (3,)), ("extra", "<f4", (4,)),
@@ -462,12 +463,13 @@ def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray, r
     rise = P[nodes] - P[tree.object_start[obj]]  # from the blade's root
     m, slot = len(blades), np.searchsorted(blades, obj)
     height = np.linalg.norm(rise[tip], axis=1)
-    it = np.flatnonzero(tip)
+    it, seg = np.flatnonzero(tip), np.flatnonzero(~tip)
     seg_len = np.linalg.norm(P[nodes[it]] - P[prv[it]], axis=1)
     rep = lambda a: np.repeat(a, 2, axis=0)  # noqa: E731
-    for c in range(BLADE_CLUMP):
-        # The first blade of a clump is the simulated one; the others stand around its root,
-        # shorter, leaning their own way, each its own colour, their roots in the ground's frame.
+    uv = np.stack([np.tile([-1.0, 1.0], len(nodes)), rep(frac)], -1)
+    curve = np.stack([np.zeros(2 * len(nodes)), rep(half)], -1)  # t = 0; the half width
+    quad = 2 * seg[:, None, None] + np.array([[[0, 1, 3], [0, 3, 2]]])
+    for c in range(BLADE_CLUMP):  # the simulated blade, then copies round its root, each its own colour
         axis, scale, own = np.zeros((len(nodes), 3)), np.ones(m), jitter[blades]
         prev, weight = np.where(inner, nodes - 1, nodes), np.where(inner, 0.5, 0.0)
         if c:
@@ -478,27 +480,17 @@ def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray, r
             axis = shift[slot] + (scale[slot, None] - 1) * rise + frac[:, None] * lean[slot]
             prev, weight = np.where(base, -1, prev), np.where(base, 1.0, weight)
         offset = rep(axis) + np.stack([-half, half], axis=1).reshape(-1, 1) * rep(across)
-        uv = np.stack([np.tile([-1.0, 1.0], len(nodes)), rep(frac)], -1)
-        curve = np.stack([np.zeros(2 * len(nodes)), rep(half)], -1)  # t = 0; the half width
         v0 = parts.add(rep(nodes), rep(prev), rep(obj), MATERIAL_BLADE, offset, rep(normal),
                        rep(weight), rep(own[slot]), rep(frac), uv, curve)
-        pair = v0 + 2 * np.arange(len(nodes))
-        seg = np.flatnonzero(~tip)
-        a0, a1, b0, b1 = pair[seg], pair[seg] + 1, pair[seg] + 2, pair[seg] + 3
-        parts.triangles(np.stack([np.stack([a0, a1, b1], -1), np.stack([a0, b1, b0], -1)], axis=1),
-                        obj[seg, None])
-        ap = parts.add(nodes[it], nodes[it], obj[it], MATERIAL_BLADE,
-                       axis[it] + 0.5 * (seg_len * scale)[:, None] * t[it], normal[it], 0.0, own, 1.0,
-                       np.array([0.0, 1.0]))
-        parts.triangles(np.stack([pair[it], pair[it] + 1, ap + np.arange(len(it))], -1), obj[it])
+        parts.triangles(v0 + quad, obj[seg, None])
+        ap = parts.add(nodes[it], nodes[it], obj[it], MATERIAL_BLADE, axis[it] + 0.5 * (seg_len * scale)[:, None]
+                       * t[it], normal[it], 0.0, own, 1.0, np.array([0.0, 1.0]))
+        parts.triangles(np.stack([v0 + 2 * it, v0 + 2 * it + 1, ap + np.arange(len(it))], -1), obj[it])
 
 
 def drawn_triangles(tree: Tree) -> np.ndarray:
-    """(M,) int: the triangles :func:`build_mesh` draws for each object.
-
-    :meth:`Tree.triangles_per_object` (the paper's count, Table 1's), a blade's times
-    :data:`BLADE_CLUMP`.
-    """
+    """(M,) int: the triangles :func:`build_mesh` draws for each object: the paper's
+    (:meth:`Tree.triangles_per_object`), a blade's times :data:`BLADE_CLUMP`."""
     return tree.triangles_per_object() * np.where(tree.kind == "blade", BLADE_CLUMP, 1)
 
 
