@@ -38,10 +38,10 @@ def crown_cover(off, tree) -> float:
     return float(leaf[rows].sum() / np.sum(right - left + 1))
 
 
-@pytest.mark.parametrize("name,least", [("small_cherry", 0.62), ("tulip_poplar", 0.75)])
+@pytest.mark.parametrize("name,least", [("small_cherry", 0.66), ("tulip_poplar", 0.75)])
 def test_a_crown_is_leaf_inside_its_outline(offscreen, name, least):
     """Before: 0.56 of the small cherry's outline was leaf (sparse bunches at its twig tips, blades
-    facing up, seen edge on), 0.70 of the poplar's; now 0.67 and 0.79."""
+    facing up, seen edge on), 0.70 of the poplar's; now 0.73 and 0.79."""
     assert crown_cover(offscreen, ta.load_preset(name)) > least
 
 

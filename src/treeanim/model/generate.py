@@ -4,9 +4,9 @@ A preset gives the trunk and, per hierarchy level, how many children each branch
 where along it, at what branching and roll angles, with what length and radius ratios, taper,
 curvature and gravity bend. Children on a parent's tip node share its cross-section (da Vinci's
 rule), so the wood tapers through a fork without a step. Leaves spiral along the outer levels'
-branches, so many per metre of twig, with a share in tufts at the free tips; grass blades are
-scattered roots in a patch that may fade out at its edge. The same spec and seed give
-bit-identical arrays.
+branches (and the leader's top), so many per metre of twig, with a share in tufts at the free
+tips, their blades turned at random off facing up; grass blades are scattered roots in a patch
+that may fade out at its edge. The same spec and seed give bit-identical arrays.
 """
 
 from __future__ import annotations
@@ -53,16 +53,17 @@ class LevelSpec:
 class LeafSpec:
     """Leaves: petiole beams with a lamina, spiralling along the branches of ``levels``.
 
-    Each node of those branches within ``attach`` (fraction of the branch's length) bears the
-    leaves of the segment below it, so leaves are spread evenly per metre of twig; a further
-    ``tip_share`` of all leaves sits in tufts at the free tips (tips no branch grows on from).
+    Each node of those branches within ``attach`` (fraction of the branch's length), and of the
+    trunk's top ``leader`` fraction, bears the leaves of the segment below it, so leaves are
+    spread evenly per metre of twig; a further ``tip_share`` of all leaves sits in tufts at the
+    free tips (tips no branch grows on from).
     """
 
     count: int = 0
     winter_count: int = 0
     levels: tuple[int, ...] = ()
     attach: tuple[float, float] = (0.0, 1.0)  # where along a branch leaves sit (fraction)
-    leader: float = 0.0  # the top fraction of the trunk (the leader's shoot) is in leaf too
+    leader: float = 0.0  # the trunk's top fraction (the leader's shoot) bears leaves too
     tip_share: float = 0.0  # share of the leaves in tufts at free tips
     tip_angle: float = 30.0  # down angle of a tip tuft's most upright leaves, degrees
     petiole_length: float = 0.03
