@@ -46,6 +46,19 @@ def test_triangle_counts_equal_tree_counts(any_tree):
     assert np.array_equal(mesh.object_triangle_start[1:], np.cumsum(mesh.object_triangles)[:-1])
 
 
+def test_a_blade_clump_casts_only_its_simulated_blades_shadow():
+    """The copies of a clump are drawn, not shadowed: the shadow pass holds the simulated blades'
+    strips and tips, whose vertices come first (a pair a node, then the apexes)."""
+    from treeanim.render.shadow import shadow_indices
+
+    grass = grass_patch()
+    mesh = build_mesh(grass)
+    tris = shadow_indices(mesh, grass)
+    assert BLADE_CLUMP > 1 and mesh.triangle_count == BLADE_CLUMP * len(tris)
+    assert len(tris) == grass.triangles_per_object().sum()
+    assert tris.max() < 2 * grass.n_nodes + grass.n_objects
+
+
 def test_per_kind_triangles_follow_the_papers_rule():
     tree = small_tree()
     mesh = build_mesh(tree)

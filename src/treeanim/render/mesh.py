@@ -97,8 +97,9 @@ MATERIAL_BLADE = 3
 PARTS = {"LEAVES": (MATERIAL_PETIOLE, MATERIAL_LAMINA), "BARK": (MATERIAL_BARK,), "BLADES": (MATERIAL_BLADE,)}
 
 #: Blades drawn per simulated blade (a clump riding its motion, so the paper's 5,000 read as a
-#: meadow; Table 1 counts one), and a clump's radius over its blade's height.
-BLADE_CLUMP, BLADE_SPREAD = 5, 0.3
+#: meadow; Table 1 counts one; each costs about as much as the simulated one to draw), and a
+#: clump's radius over its blade's height.
+BLADE_CLUMP, BLADE_SPREAD = 3, 0.5
 
 VERTEX_DTYPE = np.dtype(
     [("ids", "<i4", (4,)), ("offset", "<f4", (3,)), ("normal", "<f4", (3,)), ("extra", "<f4", (4,)),
