@@ -24,7 +24,7 @@ carries c onto the curve's tangent::
 so a one-segment twig pulled by its tip bends as a rod, t²(3 − t)/2 of its tip deflection
 at t, welded to its parent's (or the ground's) direction at its base.
 
-Geometry per object kind (triangle counts equal :meth:`Tree.triangles_per_object`):
+Geometry per object kind (triangle counts: :func:`drawn_triangles`):
 
 - branch: a ``BRANCH_SIDES`` (16)-sided tapered tube whose segments are split in
   :func:`~treeanim.model.tree.curve_bands` bands each (four along a one-segment twig), a ring
@@ -470,9 +470,9 @@ def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray, r
     uv = np.stack([np.tile([-1.0, 1.0], len(nodes)), rep(frac)], -1)
     curve = np.stack([np.zeros(2 * len(nodes)), rep(half)], -1)  # t = 0; the half width
     quad = 2 * seg[:, None, None] + np.array([[[0, 1, 3], [0, 3, 2]]])
+    joint_prev, joint_weight = np.where(inner, nodes - 1, nodes), np.where(inner, 0.5, 0.0)
     for c in range(BLADE_CLUMP):  # the simulated blade, then copies round its root, each its own colour
-        axis, scale, own = np.zeros((len(nodes), 3)), np.ones(m), jitter[blades]
-        prev, weight = np.where(inner, nodes - 1, nodes), np.where(inner, 0.5, 0.0)
+        axis, scale, own, prev, weight = np.zeros((len(nodes), 3)), np.ones(m), jitter[blades], joint_prev, joint_weight
         if c:
             r, az = BLADE_SPREAD * height * np.sqrt(rng.random(m)), rng.uniform(0, 2 * np.pi, m)
             scale, own = rng.uniform(0.55, 1.0, m), rng.random(m)
@@ -484,8 +484,8 @@ def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray, r
         v0 = parts.add(rep(nodes), rep(prev), rep(obj), MATERIAL_BLADE, offset, rep(normal),
                        rep(weight), rep(own[slot]), rep(frac), uv, curve)
         parts.triangles(v0 + quad, obj[seg, None])
-        ap = parts.add(nodes[it], nodes[it], obj[it], MATERIAL_BLADE, axis[it] + 0.5 * (seg_len * scale)[:, None]
-                       * t[it], normal[it], 0.0, own, 1.0, np.array([0.0, 1.0]))
+        apex = axis[it] + 0.5 * (seg_len * scale)[:, None] * t[it]
+        ap = parts.add(nodes[it], nodes[it], obj[it], MATERIAL_BLADE, apex, normal[it], 0.0, own, 1.0, np.array([0.0, 1.0]))
         parts.triangles(np.stack([v0 + 2 * it, v0 + 2 * it + 1, ap + np.arange(len(it))], -1), obj[it])
 
 
