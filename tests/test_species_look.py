@@ -47,7 +47,7 @@ def test_a_crown_is_leaf_inside_its_outline(offscreen, name, least):
 
 def test_the_meadow_covers_its_ground_from_ten_metres(offscreen):
     """The patch's middle (roots within 2.5 m of its centre) seen from 10 m, 30° above: before,
-    one blade drawn a simulated one, 0.64 of it showed blades (dark hair on the ground); drawn
+    one blade drawn for each simulated one, 0.64 of it showed blades (dark hair on the ground); drawn
     in clumps of three (render/mesh.py, BLADE_CLUMP) 0.82."""
     cam = OrbitCamera(target=(0.0, 0.0, 0.0), distance=10.0, azimuth=0.0, elevation=30.0)
     blades = covered(offscreen, ta.load_preset("grassland"), cam)
