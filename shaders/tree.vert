@@ -77,11 +77,16 @@ void main() {
         // wider each side, and tree.frag gives each pixel the share of it the true width
         // covers (from its distance to the axis, v_edge, and the true half width, v_half): a
         // soft line whose weight per pixel column stays the same wherever it falls.
+        vec3 axis = PART == PART_BLADES && in_uv.y >= 1.0                   // the segment's
+                  ? node_position(in_ids.x) - node_position(in_ids.x - 1)
+                  : node_position(in_ids.x + 1) - node_position(in_ids.x);
+        // A blade of a clump stands off its node: its axis is its half width (in_curve.y) in
+        // from the vertex, across it (render/mesh.py).
+        if (PART == PART_BLADES) centre = v_world - in_uv.x * in_curve.y * normalize(cross(axis, v_normal));
         vec3 across = v_world - centre;
         float metres = length(across);
         float px = metres * u_pixels_per_metre / max((u_view_proj * vec4(centre, 1.0)).w, 1e-6);
         if (px < u_thin_pixels) {
-            vec3 axis = node_position(in_ids.x + 1) - node_position(in_ids.x);   // the segment's
             vec3 side = cross(axis, u_camera_pos - centre);
             float k = dot(across, side) / max(metres * length(side), 1e-30);  // -1 .. 1 across the axis
             float half_px = PART == PART_BARK ? px : abs(k) * px;            // a blade: as seen

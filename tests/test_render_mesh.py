@@ -11,6 +11,7 @@ from conftest import beam_tree, grass_patch, identity, rot, small_tree, twig_tre
 from treeanim.model.geometry import unit as _unit
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.mesh import (
+    BLADE_CLUMP,
     MATERIAL_BARK,
     MATERIAL_LAMINA,
     MATERIAL_PETIOLE,
@@ -18,6 +19,7 @@ from treeanim.render.mesh import (
     VERTEX_DTYPE,
     VERTEX_FORMAT,
     build_mesh,
+    drawn_triangles,
     lamina_frames,
 )
 from treeanim.render.picking import Picker, pick
@@ -33,8 +35,8 @@ def any_tree(request):
 # ------------------------------------------------------------------------------ mesh
 def test_triangle_counts_equal_tree_counts(any_tree):
     mesh = build_mesh(any_tree)
-    assert np.array_equal(mesh.object_triangles, any_tree.triangles_per_object())
-    assert mesh.triangle_count == int(any_tree.triangles_per_object().sum()) == len(mesh.indices)
+    assert np.array_equal(mesh.object_triangles, drawn_triangles(any_tree))
+    assert mesh.triangle_count == int(drawn_triangles(any_tree).sum()) == len(mesh.indices)
     assert mesh.indices.dtype == np.uint32 and mesh.indices.max() < mesh.vertex_count
     # Every triangle belongs to one object (its three vertices share the object index), and
     # triangles come grouped by object, in object order.
@@ -43,6 +45,19 @@ def test_triangle_counts_equal_tree_counts(any_tree):
     expect = np.repeat(np.arange(any_tree.n_objects), mesh.object_triangles)
     assert np.array_equal(obj[:, 0], expect)
     assert np.array_equal(mesh.object_triangle_start[1:], np.cumsum(mesh.object_triangles)[:-1])
+
+
+def test_a_blade_clump_casts_only_its_simulated_blades_shadow():
+    """The copies of a clump are drawn, not shadowed: the shadow pass holds the simulated blades'
+    strips and tips, whose vertices come first (a pair a node, then the apexes)."""
+    from treeanim.render.shadow import shadow_indices
+
+    grass = grass_patch()
+    mesh = build_mesh(grass)
+    tris = shadow_indices(mesh, grass)
+    assert BLADE_CLUMP > 1 and mesh.triangle_count == BLADE_CLUMP * len(tris)
+    assert len(tris) == grass.triangles_per_object().sum()
+    assert tris.max() < 2 * grass.n_nodes + grass.n_objects
 
 
 def test_per_kind_triangles_follow_the_papers_rule():
@@ -60,7 +75,9 @@ def test_per_kind_triangles_follow_the_papers_rule():
     assert np.all(mesh.object_triangles[leaf] == 2 * tree.petiole_sides * (n[leaf] - 1) + lam)
     grass = grass_patch()
     gm = build_mesh(grass)
-    assert np.all(gm.object_triangles == 2 * (grass.object_count - 1) + 1)
+    # A blade: a strip with a tip triangle, drawn as a clump of BLADE_CLUMP (the paper counts one).
+    assert np.all(gm.object_triangles == BLADE_CLUMP * (2 * (grass.object_count - 1) + 1))
+    assert np.all(grass.triangles_per_object() == 2 * (grass.object_count - 1) + 1)
 
 
 def test_vertex_layout():

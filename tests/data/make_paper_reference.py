@@ -2,8 +2,9 @@
 
 Run once, with the release whose behaviour the paper model must keep (commit 4ed910f, before the
 load path): ``python tests/data/make_paper_reference.py``. When the presets change (issue #13
-reshaped the trees), record again with 4ed910f's ``physics`` package and today's presets and
-model. Each scenario is stepped and every
+reshaped the trees, issue 30 again), record again with 4ed910f's ``physics`` package and today's
+presets and model (4ed910f's ``WindField`` takes no ``model``: its field is the paper's; the
+scenarios whose presets did not change must come out bit for bit). Each scenario is stepped and every
 fifth node's position (and, for the small cherry, rotation) is stored after the last step.
 """
 

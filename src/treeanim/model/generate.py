@@ -4,9 +4,9 @@ A preset gives the trunk and, per hierarchy level, how many children each branch
 where along it, at what branching and roll angles, with what length and radius ratios, taper,
 curvature and gravity bend. Children on a parent's tip node share its cross-section (da Vinci's
 rule), so the wood tapers through a fork without a step. Leaves spiral along the outer levels'
-branches, so many per metre of twig, with a share in tufts at the free tips; grass blades are
-scattered roots in a patch that may fade out at its edge. The same spec and seed give
-bit-identical arrays.
+branches (and the leader's top), so many per metre of twig, with a share in tufts at the free
+tips, their blades turned at random off facing up; grass blades are scattered roots in a patch
+that may fade out at its edge. The same spec and seed give bit-identical arrays.
 """
 
 from __future__ import annotations
@@ -53,15 +53,17 @@ class LevelSpec:
 class LeafSpec:
     """Leaves: petiole beams with a lamina, spiralling along the branches of ``levels``.
 
-    Each node of those branches within ``attach`` (fraction of the branch's length) bears the
-    leaves of the segment below it, so leaves are spread evenly per metre of twig; a further
-    ``tip_share`` of all leaves sits in tufts at the free tips (tips no branch grows on from).
+    Each node of those branches within ``attach`` (fraction of the branch's length), and of the
+    trunk's top ``leader`` fraction, bears the leaves of the segment below it, so leaves are
+    spread evenly per metre of twig; a further ``tip_share`` of all leaves sits in tufts at the
+    free tips (tips no branch grows on from).
     """
 
     count: int = 0
     winter_count: int = 0
     levels: tuple[int, ...] = ()
     attach: tuple[float, float] = (0.0, 1.0)  # where along a branch leaves sit (fraction)
+    leader: float = 0.0  # the trunk's top fraction (the leader's shoot) bears leaves too
     tip_share: float = 0.0  # share of the leaves in tufts at free tips
     tip_angle: float = 30.0  # down angle of a tip tuft's most upright leaves, degrees
     petiole_length: float = 0.03
@@ -74,6 +76,7 @@ class LeafSpec:
     down_var: float = 10.0
     roll_var: float = 15.0  # scatter about the spiral's golden angle, degrees
     droop: float = 30.0
+    turn_var: float = 25.0  # scatter of the blade's turn about its petiole from facing up, degrees
 
 
 @dataclass(frozen=True)
@@ -292,11 +295,15 @@ def _leaf_slots(lf: LeafSpec, branches: list[ObjectSpec]) -> tuple[np.ndarray, .
     grown_on = {(s.parent, s.attach) for s in branches if s.parent >= 0}
     rows = []
     for b, s in enumerate(branches):
-        if s.level not in lf.levels:
+        if s.level in lf.levels:
+            lo, hi = lf.attach
+        elif s.level == 1 and lf.leader > 0:
+            lo, hi = 1 - lf.leader, 1.0
+        else:
             continue
         seg = np.linalg.norm(np.diff(s.points, axis=0), axis=1)
         frac = np.cumsum(seg) / seg.sum()  # of nodes 1..n along the branch
-        for j in np.flatnonzero((frac >= lf.attach[0] - 1e-9) & (frac <= lf.attach[1] + 1e-9)) + 1:
+        for j in np.flatnonzero((frac >= lo - 1e-9) & (frac <= hi + 1e-9)) + 1:
             rows.append((b, j, seg[j - 1], j == len(seg) and (b, j) not in grown_on))
     if not rows:
         raise ValueError(f"key 'leaves.levels': {list(lf.levels)} names no level that has branches "
@@ -361,7 +368,7 @@ def place_leaves(lf: LeafSpec, branches: list[ObjectSpec], slots: tuple[np.ndarr
     # Lamina normal: as close to "up" as the petiole allows, turned a little at random.
     w = UP - tip_dir * tip_dir[:, 1:2]
     w = np.where(np.linalg.norm(w, axis=1, keepdims=True) > 1e-3, w, perpendicular(tip_dir))
-    w = rotate(_unit(w), tip_dir, rng.normal(0, np.radians(25), n))
+    w = rotate(_unit(w), tip_dir, rng.normal(0, np.radians(lf.turn_var), n))
     # A petiole is never thicker than the twig it grows from.
     twig = np.array([branches[b].diameters[j] for b, j in zip(b_idx, j_idx)])
     base_d = np.minimum(lf.petiole_diameter * scale, twig)

@@ -72,6 +72,8 @@ BOUNDS: dict[str, tuple[float, float]] = {
     "interlace": (0.0, 1.0),
     "lenticels": (0.0, 1.0),
     "tip_angle": (0.0, 180.0),
+    "turn_var": (0.0, 90.0),
+    "leader": (0.0, 1.0),
     "seed": (0, 2**63 - 1),
 }
 

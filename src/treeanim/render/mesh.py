@@ -24,7 +24,7 @@ object's nodes one smooth curve at rest and bent. So a one-segment twig pulled b
 bends as a rod, t²(3 − t)/2 of its tip deflection at t, welded to its parent's (or the
 ground's) direction at its base; and a chain of segments has no corner at its inner nodes.
 
-Geometry per object kind (triangle counts equal :meth:`Tree.triangles_per_object`):
+Geometry per object kind (triangle counts: :func:`drawn_triangles`):
 
 - branch: a ``BRANCH_SIDES`` (16)-sided tapered tube whose segments are split in
   :func:`~treeanim.model.tree.curve_bands` bands each (four along a one-segment twig), a ring
@@ -51,7 +51,9 @@ Geometry per object kind (triangle counts equal :meth:`Tree.triangles_per_object
   point (x, y) sits at ``L·(x·u + y·v + curl·x²·w)`` from the tip, L = ``lamina_length``.
 - blade: a strip with 2 vertices per node across the blade's w axis (width =
   ``node_diameter``; the strip's face contains the blade's tangent and faces along the bending
-  plane), plus one tip triangle to an apex half a segment beyond the tip: 2·(n−1) + 1.
+  plane), plus one tip triangle to an apex half a segment beyond the tip: 2·(n−1) + 1, drawn
+  :data:`BLADE_CLUMP` times (:func:`drawn_triangles`): the simulated blade and copies around
+  its root, shorter and leaning, offset from its nodes (their roots in the ground's frame).
 
 Vertex layout (:data:`VERTEX_DTYPE`, 96 bytes, interleaved, attribute format
 :data:`VERTEX_FORMAT`)::
@@ -64,7 +66,8 @@ Vertex layout (:data:`VERTEX_DTYPE`, 96 bytes, interleaved, attribute format
     in_uv     vec2   surface coordinates: bark and petioles (turn around the tube in [0, 1),
                      metres along the object); laminas (x, y) in leaf units; blades
                      (−1 / +1 across, fraction along)
-    in_curve  vec2   (t along the segment, 1 where the segment ends at the object's tip)
+    in_curve  vec2   (t along the segment, 1 where the segment ends at the object's tip); blades
+                     (0, half width): tree.vert finds a clump blade's axis by it
     in_tangent0, in_tangent1 vec3   the segment's rest curve's tangents at its ends, metres
                      (branches; 0 elsewhere)
 
@@ -95,6 +98,11 @@ MATERIAL_BLADE = 3
 #: The mesh's parts, each drawn by its own shader program (``PART`` in ``shaders/tree.*``), and
 #: the materials each holds: leaves (petioles and laminas), bark, grass blades.
 PARTS = {"LEAVES": (MATERIAL_PETIOLE, MATERIAL_LAMINA), "BARK": (MATERIAL_BARK,), "BLADES": (MATERIAL_BLADE,)}
+
+#: Blades drawn per simulated blade (a clump riding its motion, so the paper's 5,000 read as a
+#: meadow; Table 1 counts one; each costs about as much as the simulated one to draw), and a
+#: clump's radius over its blade's height.
+BLADE_CLUMP, BLADE_SPREAD = 3, 0.5
 
 VERTEX_DTYPE = np.dtype(
     [("ids", "<i4", (4,)), ("offset", "<f4", (3,)), ("normal", "<f4", (3,)), ("extra", "<f4", (4,)),
@@ -400,7 +408,7 @@ def _laminas(parts: _Parts, tree: Tree, leaves: np.ndarray, jitter: np.ndarray, 
     parts.triangles(tris, leaves[:, None])
 
 
-def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray) -> None:
+def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray, rng: np.random.Generator) -> None:
     if len(blades) == 0:
         return
     P = tree.rest_positions
@@ -409,26 +417,41 @@ def _blades(parts: _Parts, tree: Tree, blades: np.ndarray, jitter: np.ndarray) -
     w = tree.rest_w[obj]
     across = _unit(w - np.sum(w * t, axis=1, keepdims=True) * t, _perpendicular(t))
     normal = np.cross(across, t)
-    half = 0.5 * tree.node_diameter[nodes, None] * across
+    half = 0.5 * tree.node_diameter[nodes]
     frac = k / (tree.object_count[obj] - 1)
     inner = ~(base | tip)
-    prev = np.where(inner, nodes - 1, nodes)
-    weight = np.where(inner, 0.5, 0.0)
-    rep = lambda a: np.repeat(a, 2, axis=0)  # noqa: E731
-    offset = np.stack([-half, half], axis=1).reshape(-1, 3)
-    uv = np.stack([np.tile([-1.0, 1.0], len(nodes)), rep(frac)], -1)
-    v0 = parts.add(rep(nodes), rep(prev), rep(obj), MATERIAL_BLADE, offset, rep(normal),
-                   rep(weight), rep(jitter[obj]), rep(frac), uv)
-    pair = v0 + 2 * np.arange(len(nodes))
-    seg = np.flatnonzero(~tip)
-    a0, a1, b0, b1 = pair[seg], pair[seg] + 1, pair[seg] + 2, pair[seg] + 3
-    parts.triangles(np.stack([np.stack([a0, a1, b1], -1), np.stack([a0, b1, b0], -1)], axis=1),
-                    obj[seg, None])
-    it = np.flatnonzero(tip)
+    rise = P[nodes] - P[tree.object_start[obj]]  # from the blade's root
+    m, slot = len(blades), np.searchsorted(blades, obj)
+    height = np.linalg.norm(rise[tip], axis=1)
+    it, seg = np.flatnonzero(tip), np.flatnonzero(~tip)
     seg_len = np.linalg.norm(P[nodes[it]] - P[prv[it]], axis=1)
-    ap = parts.add(nodes[it], nodes[it], obj[it], MATERIAL_BLADE, 0.5 * seg_len[:, None] * t[it],
-                   normal[it], 0.0, jitter[obj[it]], 1.0, np.array([0.0, 1.0]))
-    parts.triangles(np.stack([pair[it], pair[it] + 1, ap + np.arange(len(it))], -1), obj[it])
+    rep = lambda a: np.repeat(a, 2, axis=0)  # noqa: E731
+    uv = np.stack([np.tile([-1.0, 1.0], len(nodes)), rep(frac)], -1)
+    curve = np.stack([np.zeros(2 * len(nodes)), rep(half)], -1)  # t = 0; the half width
+    quad = 2 * seg[:, None, None] + np.array([[[0, 1, 3], [0, 3, 2]]])
+    joint_prev, joint_weight = np.where(inner, nodes - 1, nodes), np.where(inner, 0.5, 0.0)
+    for c in range(BLADE_CLUMP):  # the simulated blade, then copies round its root, each its own colour
+        axis, scale, own, prev, weight = np.zeros((len(nodes), 3)), np.ones(m), jitter[blades], joint_prev, joint_weight
+        if c:
+            r, az = BLADE_SPREAD * height * np.sqrt(rng.random(m)), rng.uniform(0, 2 * np.pi, m)
+            scale, own = rng.uniform(0.55, 1.0, m), rng.random(m)
+            lean = np.insert(rng.normal(0.0, 0.25, (m, 2)), 1, 0.0, axis=1) * height[:, None]
+            shift = np.column_stack([r * np.cos(az), np.zeros(m), r * np.sin(az)])
+            axis = shift[slot] + (scale[slot, None] - 1) * rise + frac[:, None] * lean[slot]
+            prev, weight = np.where(base, -1, prev), np.where(base, 1.0, weight)
+        offset = rep(axis) + np.stack([-half, half], axis=1).reshape(-1, 1) * rep(across)
+        v0 = parts.add(rep(nodes), rep(prev), rep(obj), MATERIAL_BLADE, offset, rep(normal),
+                       rep(weight), rep(own[slot]), rep(frac), uv, curve)
+        parts.triangles(v0 + quad, obj[seg, None])
+        apex = axis[it] + 0.5 * (seg_len * scale)[:, None] * t[it]
+        ap = parts.add(nodes[it], nodes[it], obj[it], MATERIAL_BLADE, apex, normal[it], 0.0, own, 1.0, np.array([0.0, 1.0]))
+        parts.triangles(np.stack([v0 + 2 * it, v0 + 2 * it + 1, ap + np.arange(len(it))], -1), obj[it])
+
+
+def drawn_triangles(tree: Tree) -> np.ndarray:
+    """(M,) int: the triangles :func:`build_mesh` draws for each object: the paper's
+    (:meth:`Tree.triangles_per_object`), a blade's times :data:`BLADE_CLUMP`."""
+    return tree.triangles_per_object() * np.where(tree.kind == "blade", BLADE_CLUMP, 1)
 
 
 def _ambient_occlusion(tree: Tree, verts: np.ndarray) -> np.ndarray:
@@ -474,7 +497,7 @@ def build_mesh(tree: Tree, seed: int | None = None) -> TreeMesh:
     _tubes(parts, tree, np.flatnonzero(kind == "branch"), BRANCH_SIDES, True, MATERIAL_BARK, jitter, key)
     _tubes(parts, tree, leaves, int(tree.petiole_sides), False, MATERIAL_PETIOLE, jitter, key)
     _laminas(parts, tree, leaves, jitter, key)
-    _blades(parts, tree, np.flatnonzero(kind == "blade"), jitter)
+    _blades(parts, tree, np.flatnonzero(kind == "blade"), jitter, rng)
 
     verts = np.concatenate(parts.verts) if parts.verts else np.zeros(0, VERTEX_DTYPE)
     tris = np.concatenate(parts.tris).astype(np.uint32) if parts.tris else np.zeros((0, 3), np.uint32)

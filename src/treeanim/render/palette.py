@@ -10,9 +10,9 @@ LEAF_ORANGE = (0.92, 0.40, 0.06)
 LEAF_RED = (0.70, 0.10, 0.06)
 LEAF_BROWN = (0.40, 0.17, 0.06)
 PETIOLE = (0.55, 0.28, 0.14)  # mixed 40 % into the leaf's colour
-BLADE_BASE = (0.10, 0.24, 0.05)
-BLADE_TIP = (0.42, 0.58, 0.16)
-BLADE_TIP_DRY = (0.55, 0.60, 0.22)
+BLADE_BASE = (0.17, 0.33, 0.07)  # a blade from its base to its tip, the tip between a fresh ...
+BLADE_TIP = (0.46, 0.66, 0.18)
+BLADE_TIP_DRY = (0.66, 0.68, 0.30)  # ... and a sun-dried green by the blade's jitter
 BLADE_WINTER = (0.62, 0.55, 0.32)
 HIGHLIGHT = (0.85, 0.15, 1.0)  # the grabbed object's tint: a violet no leaf, blade or bark takes
 

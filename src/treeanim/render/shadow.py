@@ -16,7 +16,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from ..model.lamina import ear_clip
 from ..model.tree import Tree
-from .mesh import MATERIAL_LAMINA, MATERIAL_PETIOLE, VERTEX_ATTRIBUTES, VERTEX_DTYPE, VERTEX_FORMAT, TreeMesh
+from .mesh import BLADE_CLUMP, MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, VERTEX_ATTRIBUTES, VERTEX_DTYPE, VERTEX_FORMAT, TreeMesh
 from .shaders import load_program
 from .uniforms import UniformBlock
 
@@ -49,8 +49,9 @@ def _skipping_format() -> str:
 
 def shadow_indices(mesh: TreeMesh, tree: Tree) -> np.ndarray:
     """The triangles the shadow pass draws: the mesh's, without petioles (a few millimetres
-    across, far below a texel) and with each lamina outlined by :data:`SHADOW_LAMINA_CORNERS`
-    of its corners (a lamina's vertices are its outline's, in order, per leaf).
+    across, far below a texel), with each lamina outlined by :data:`SHADOW_LAMINA_CORNERS`
+    of its corners (a lamina's vertices are its outline's, in order, per leaf), and each blade
+    clump casting its simulated blade's shadow (an object's first triangles: mesh notes).
 
     Returns
     -------
@@ -59,7 +60,10 @@ def shadow_indices(mesh: TreeMesh, tree: Tree) -> np.ndarray:
     """
     material = mesh.material
     first = material[mesh.indices[:, 0]]
-    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA)]]
+    obj = np.repeat(np.arange(len(mesh.object_triangles)), mesh.object_triangles)
+    copy = (first == MATERIAL_BLADE) & (np.arange(len(first)) - mesh.object_triangle_start[obj]
+                                        >= mesh.object_triangles[obj] // BLADE_CLUMP)
+    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA) & ~copy]]
     lamina = np.flatnonzero(material == MATERIAL_LAMINA)
     if len(lamina):
         outline = tree.lamina.outline
