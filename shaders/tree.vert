@@ -124,7 +124,7 @@ void main() {
         vec3 V = normalize(u_camera_pos - v_world);
         vec3 n = normalize(v_normal);
         if (dot(n, V) < 0.0) n = -n;             // double-sided: the face the eye sees
-        v_light = tree_light(v_albedo, n, V, v_ao, sun_visibility(v_world, n), true, v_highlight);
+        v_light = tree_light(v_albedo, n, V, v_ao, sun_visibility(v_world, n), 1.0, v_highlight);
         v_haze = haze(v_world);
     }
 }
