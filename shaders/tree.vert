@@ -45,7 +45,8 @@ vec3 leaf_color(float jitter, float key) {
     vec3 c = mix(summer, yellow, smoothstep(0.0, 0.35, prog));
     c = mix(c, mix(orange, red, j2), smoothstep(0.3, 0.7, prog) * (0.55 + 0.45 * jitter));
     c = mix(c, brown, 0.75 * smoothstep(0.8, 1.0, prog));
-    return c;
+    // Winter: the leaves still on the tree are dead, dry and tan (no autumn red left).
+    return mix(c, lin(C_LEAF_DRY) * (0.85 + 0.3 * j2), smoothstep(0.75, 1.0, u_season));
 }
 
 void main() {

@@ -116,7 +116,7 @@ def make_leaf_maps(lamina: Lamina, size: int = SIZE) -> np.ndarray:
     albedo = (0.9 + 0.1 * y / length) * (0.96 + 0.08 * mottle) * (1.0 + 0.45 * veins)
     translucency = 0.95 - 0.45 * veins - 0.1 * midrib
     # Relief: veins sunk into the upper face, the areoles between them puffed up a little.
-    height = -0.004 * (midrib + 0.7 * side + 0.25 * fine) + 0.0015 * np.clip(mottle, 0, 1)
+    height = -0.003 * (midrib + 0.7 * side + 0.25 * fine) + 0.0015 * np.clip(mottle, 0, 1)
     dy, dx = np.gradient(height, length / size, 2.0 * half / size)
     n = np.stack([-dx, -dy, np.ones_like(dx)], -1)
     n /= np.linalg.norm(n, axis=-1, keepdims=True)
