@@ -60,20 +60,20 @@ def crown_occlusion(points: np.ndarray, leaves: np.ndarray, area: np.ndarray) ->
     density = np.zeros(shape)
     np.add.at(density, tuple(idx.T), area / cell**3)
 
-    centres = np.stack(np.meshgrid(*[np.arange(n) + 0.5 for n in shape], indexing="ij"), -1).reshape(-1, 3)
+    steps = int(np.ceil(np.linalg.norm(shape)))
+    # Empty cells round the grid, as deep as the longest ray: a ray beyond the crown reads 0.
+    padded = np.pad(density, steps + 1)
+    strides = np.array(padded.strides) // padded.itemsize
+    cells = np.stack(np.meshgrid(*[np.arange(n) + steps + 1 for n in shape], indexing="ij"), -1).reshape(-1, 3)
+    base, flat = cells @ strides, padded.ravel()
     dirs = _sphere(DIRECTIONS)
     weight = np.where(dirs[:, 1] > 0.0, 1.0, GROUND_WEIGHT) * (0.5 + 0.5 * np.abs(dirs[:, 1]))
-    light = np.zeros(len(centres))
-    steps = int(np.ceil(np.linalg.norm(shape)))
+    light = np.zeros(len(cells))
     for d, w in zip(dirs, weight):
-        depth = np.zeros(len(centres))
-        for s in range(1, steps + 1):  # whole cells along the ray (half a cell's own, first)
-            at = np.floor(centres + (s - 0.5) * d).astype(int)
-            ok = np.all((at >= 0) & (at < shape), axis=1)
-            if not ok.any():
-                break
-            depth[ok] += density[tuple(at[ok].T)] * cell
-        light += w * np.exp(-EXTINCTION * depth)
+        # Whole cells along the ray from each cell's centre (half its own first).
+        offsets = np.floor(0.5 + (np.arange(1, steps + 1)[:, None] - 0.5) * d).astype(int) @ strides
+        depth = sum(flat[base + k] for k in offsets)
+        light += w * np.exp(-EXTINCTION * cell * depth)
     grid = (light / weight.sum()).reshape(shape)
     # Cell centres sit at (i + ½) cells from lo: a point's coordinate in the grid's index space.
     return np.clip(map_coordinates(grid, ((points - lo) / cell - 0.5).T, order=1, mode="nearest"), 0.0, 1.0)
