@@ -18,6 +18,7 @@ image every time (a fixed seed), and kept per outline (:func:`leaf_maps`).
 
 from __future__ import annotations
 
+import moderngl
 import numpy as np
 
 from ..model.tree import Lamina
@@ -138,3 +139,13 @@ def leaf_maps(lamina: Lamina, size: int = SIZE) -> np.ndarray:
         maps.flags.writeable = False
         _cache[key] = maps
     return _cache[key]
+
+
+def leaf_texture(ctx: moderngl.Context, lamina: Lamina) -> moderngl.Texture:
+    """The maps of ``lamina`` (:func:`leaf_maps`) as a texture: mipmapped, clamped at its edges."""
+    maps = leaf_maps(lamina)
+    texture = ctx.texture(maps.shape[1::-1], 4, maps.tobytes())
+    texture.build_mipmaps()
+    texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    texture.repeat_x = texture.repeat_y = False
+    return texture

@@ -25,7 +25,7 @@ import numpy as np
 
 from ..model.scene import Scene as TreeScene
 from ..model.tree import Tree
-from .leaf_maps import lamina_box, leaf_maps
+from .leaf_maps import lamina_box, leaf_texture
 from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
 from .scene import Scene, clip_ground
@@ -73,15 +73,10 @@ class TreePass:
         try:
             self.block = UniformBlock(ctx, "Tree")
             bark = tree.bark
-            self.block.set(bark_color=bark.color, bark=(bark.furrows, bark.depth, bark.interlace, bark.lenticels),
-                           lamina_box=(1.0, 1.0))
             if tree.lamina is not None and len(tree.lamina.outline):
-                maps = leaf_maps(tree.lamina)
-                self.leaf_maps = ctx.texture(maps.shape[1::-1], 4, np.ascontiguousarray(maps).tobytes())
-                self.leaf_maps.build_mipmaps()
-                self.leaf_maps.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
-                self.leaf_maps.repeat_x = self.leaf_maps.repeat_y = False
-                self.block.set(lamina_box=lamina_box(tree.lamina))
+                self.leaf_maps = leaf_texture(ctx, tree.lamina)
+            self.block.set(bark_color=bark.color, bark=(bark.furrows, bark.depth, bark.interlace, bark.lenticels),
+                           lamina_box=lamina_box(tree.lamina) if self.leaf_maps is not None else (1.0, 1.0))
             tris = [mesh.part_indices(name) for name in PARTS]
             if mesh.triangle_count:
                 self.vbo = ctx.buffer(mesh.vertices.tobytes())
