@@ -10,7 +10,7 @@ One RGBA8 image over the outline's box (x across the blade from −``half_width`
 - B, A, relief: the normal's x and y in the blade's (u, v) frame, 0.5 + 0.5 n (veins sunk
   into the upper face: the lower face, seen from its side, has them raised).
 
-Veins: a midrib tapering to the tip; pinnate side veins (alternate, leaving it at about 45°
+Veins: a midrib tapering to the tip; pinnate side veins (alternate, leaving it at about 55°
 and arching towards the tip), fading before the margin; a vein along the margin; and a net of
 fine veins round small areoles (cellular noise). Made with numpy at first use, the same
 image every time (a fixed seed), and kept per outline (:func:`leaf_maps`).
@@ -100,12 +100,12 @@ def make_leaf_maps(lamina: Lamina, size: int = SIZE) -> np.ndarray:
     rng = np.random.default_rng(0x1EAF)
 
     midrib = _line(r, 0.016 * (1.0 - 0.7 * y / length) + 0.003)
-    # Side veins: the lines y − g(r) = constant, g(r) = r·(1 + 1.1 r / width) (about 45° at the
+    # Side veins: the lines y − g(r) = constant, g(r) = r·(0.75 + 0.6 r / width) (about 55° at the
     # midrib, arching towards the tip); the left side's between the right's (alternate).
     spacing = length / SIDE_VEINS
     shift = np.where(x < 0.0, 0.45 * spacing, 0.0)
-    phase = (y - r * (1.0 + 1.1 * r / width) - shift) / spacing
-    across = np.abs(phase - np.round(phase)) * spacing / np.sqrt(1.0 + (1.0 + 2.2 * r / width) ** 2)
+    phase = (y - r * (0.75 + 0.6 * r / width) - shift) / spacing
+    across = np.abs(phase - np.round(phase)) * spacing / np.sqrt(1.0 + (0.75 + 1.2 * r / width) ** 2)
     reach = np.clip(1.0 - r / (0.92 * width), 0.0, 1.0)  # fading before the margin
     first = (np.round(phase) >= 0.35) & (np.round(phase) * spacing < 0.96 * length)
     side = _line(across, 0.0022 + 0.006 * reach) * np.sqrt(reach) * first
