@@ -73,7 +73,7 @@ void main() {
         // lower face is paler and greyer than the upper.
         vec4 m = texture(u_leaf_maps, vec2(0.5 + 0.5 * v_uv.x / u_lamina_box.x, v_uv.y / u_lamina_box.y));
         albedo *= m.r * LEAF_ALBEDO_SCALE;
-        if (!gl_FrontFacing) albedo = 1.6 * mix(albedo, vec3(dot(albedo, vec3(0.2126, 0.7152, 0.0722))), 0.4);
+        if (!gl_FrontFacing) albedo = 1.6 * mix(albedo, vec3(dot(albedo, vec3(0.2126, 0.7152, 0.0722))), 0.25);
         through = m.g;
         n = relief(n, 2.0 * m.ba - 1.0);
     }
