@@ -146,6 +146,6 @@ def leaf_texture(ctx: moderngl.Context, lamina: Lamina) -> moderngl.Texture:
     maps = leaf_maps(lamina)
     texture = ctx.texture(maps.shape[1::-1], 4, maps.tobytes())
     texture.build_mipmaps()
-    texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+    texture.filter = (moderngl.LINEAR_MIPMAP_NEAREST, moderngl.LINEAR)
     texture.repeat_x = texture.repeat_y = False
     return texture
