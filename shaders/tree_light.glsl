@@ -13,9 +13,8 @@ vec3 tree_light(vec3 albedo, vec3 n, vec3 V, float ao, float sun, float through,
     vec3 c = albedo * hemisphere(n) * ao;
     c += albedo * u_sun_color * max(ndl, 0.0) * mix(0.55, 1.0, ao) * sun;
     if (through > 0.0) {
-        float back = max(-ndl, 0.0) * (0.55 + 0.45 * pow(max(dot(-V, u_sun_dir), 0.0), 2.0));
-        vec3 filtered = pow(albedo, vec3(0.8)) * vec3(1.2, 1.0, 0.4);
-        c += filtered * u_sun_color * through * back * mix(0.5, 1.0, ao) * sun * u_translucency;
+        float back = max(-ndl, 0.0) * (0.55 + 0.45 * pow(max(dot(-V, u_sun_dir), 0.0), 2.0)) * sun * u_translucency;
+        if (back > 0.0) c += pow(albedo, vec3(0.8)) * vec3(1.2, 1.0, 0.4) * u_sun_color * through * back * mix(0.5, 1.0, ao);
         c += albedo * hemisphere(n) * ao * 0.25;
         vec3 H = normalize(V + u_sun_dir);
         c += u_sun_color * 0.06 * pow(max(dot(n, H), 0.0), 40.0) * step(0.0, ndl) * sun;
