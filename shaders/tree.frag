@@ -42,6 +42,18 @@ float bark(vec2 uv) {
     return shade * (0.9 + 0.2 * wander) * (1.0 + 0.45 * lenticel);
 }
 
+// The normal `n` tilted by a normal map's (x, y) in the surface's uv frame, the frame found from
+// the screen derivatives of the position and the uv (no tangents in the mesh).
+vec3 relief(vec3 n, vec2 tilt) {
+    vec3 dpx = dFdx(v_world), dpy = dFdy(v_world);
+    vec2 dux = dFdx(v_uv), duy = dFdy(v_uv);
+    vec3 px = cross(n, dpx), py = cross(dpy, n);
+    vec3 T = py * dux.x + px * duy.x;
+    vec3 B = py * dux.y + px * duy.y;
+    float scale = inversesqrt(max(max(dot(T, T), dot(B, B)), 1e-30));
+    return normalize(n + scale * (tilt.x * T + tilt.y * B));
+}
+
 // The integral of max(1 - |t|, 0) from -infinity to x.
 float tent_integral(float x) {
     return x < 0.0 ? 0.5 * max(1.0 + x, 0.0) * max(1.0 + x, 0.0) : 1.0 - 0.5 * max(1.0 - x, 0.0) * max(1.0 - x, 0.0);
@@ -52,20 +64,22 @@ void main() {
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;                 // double-sided: laminas, blades
     vec3 V = normalize(u_camera_pos - v_world);
-    bool foliage = PART != PART_BARK;
+    float through = PART == PART_BARK ? 0.0 : 1.0;  // the share of the sun the surface lets through
     vec3 albedo = v_albedo;
     if (PART == PART_BARK) {
         albedo *= bark(v_uv);
     } else if (PART == PART_LEAVES && v_material == LAMINA) {
-        // Lamina: a lighter midrib and faint side veins; darker towards the base.
-        float ax = abs(v_uv.x);
-        float rib = (1.0 - smoothstep(0.008, 0.022, ax)) * step(0.02, v_uv.y) * (1.0 - smoothstep(0.85, 1.0, v_uv.y));
-        float side = 1.0 - smoothstep(0.0, 0.07, abs(fract((v_uv.y - 0.9 * ax) * 7.0) - 0.5) - 0.43);
-        albedo *= (0.88 + 0.16 * v_uv.y) * (1.0 + 0.45 * rib + 0.12 * side * (1.0 - rib));
+        // The species' leaf maps (render/leaf_maps.py): veins, translucency, relief. The
+        // lower face is paler and greyer than the upper.
+        vec4 m = texture(u_leaf_maps, vec2(0.5 + 0.5 * v_uv.x / u_lamina_box.x, v_uv.y / u_lamina_box.y));
+        albedo *= m.r * LEAF_ALBEDO_SCALE;
+        if (!gl_FrontFacing) albedo = 1.6 * mix(albedo, vec3(dot(albedo, vec3(0.2126, 0.7152, 0.0722))), 0.25);
+        through = m.g;
+        n = relief(n, 2.0 * m.ba - 1.0);
     }
     // A blade is lit at its vertices (tree.vert), and only shaded across here.
     vec3 c = PART == PART_BLADES ? v_light * (0.85 + 0.3 * (1.0 - abs(v_uv.x)))
-                                 : tree_light(albedo, n, V, v_ao, sun_visibility(v_world, n), foliage, v_highlight);
+                                 : tree_light(albedo, n, V, v_ao, sun_visibility(v_world, n), through, v_highlight);
     // A thin twig or blade: its true width filtered by a tent one pixel either side (pixels
     // a column apart then sum to its width, wherever it falls between them).
     float cover = PART == PART_LEAVES || v_half < 0.0 ? 1.0 : tent_integral(v_edge + v_half) - tent_integral(v_edge - v_half);

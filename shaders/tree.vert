@@ -47,7 +47,8 @@ vec3 leaf_color(float jitter, float key) {
     vec3 c = mix(summer, yellow, smoothstep(0.0, 0.35, prog));
     c = mix(c, mix(orange, red, j2), smoothstep(0.3, 0.7, prog) * (0.55 + 0.45 * jitter));
     c = mix(c, brown, 0.75 * smoothstep(0.8, 1.0, prog));
-    return c;
+    // Winter: the leaves still on the tree are dead, dry and tan (no autumn red left).
+    return mix(c, lin(C_LEAF_DRY) * (0.85 + 0.3 * j2), smoothstep(0.75, 1.0, u_season));
 }
 
 void main() {
@@ -137,7 +138,7 @@ void main() {
         vec3 V = normalize(u_camera_pos - v_world);
         vec3 n = normalize(v_normal);
         if (dot(n, V) < 0.0) n = -n;             // double-sided: the face the eye sees
-        v_light = tree_light(v_albedo, n, V, v_ao, sun_visibility(v_world, n), true, v_highlight);
+        v_light = tree_light(v_albedo, n, V, v_ao, sun_visibility(v_world, n), 1.0, v_highlight);
         v_haze = haze(v_world);
     }
 }

@@ -208,6 +208,7 @@ def vertex_colours(tree: Tree, mesh: TreeMesh, season: float) -> np.ndarray:
     leaf = _mix(summer, c["LEAF_YELLOW"], _smoothstep(0.0, 0.35, prog))
     leaf = _mix(leaf, _mix(c["LEAF_ORANGE"], c["LEAF_RED"], j2), _smoothstep(0.3, 0.7, prog) * (0.55 + 0.45 * jitter))
     leaf = _mix(leaf, c["LEAF_BROWN"], 0.75 * _smoothstep(0.8, 1.0, prog))
+    leaf = _mix(leaf, c["LEAF_DRY"] * (0.85 + 0.3 * j2)[:, None], _smoothstep(0.75, 1.0, season))  # winter's withered
     blade = _mix(c["BLADE_BASE"], _mix(c["BLADE_TIP"], c["BLADE_TIP_DRY"], jitter), key)
     blade = _mix(blade, c["BLADE_WINTER"] * (0.6 + 0.4 * key)[:, None], 0.6 * season)
     col = np.select(

@@ -88,6 +88,7 @@ from ..model.geometry import perpendicular as _perpendicular
 from ..model.geometry import unit as _unit
 from ..model.tree import BRANCH_SIDES, Tree, curve_bands
 from .collars import collars, outward
+from .occlusion import crown_occlusion
 from .skinning import hermite, skin_points
 
 MATERIAL_BARK = 0
@@ -455,19 +456,14 @@ def drawn_triangles(tree: Tree) -> np.ndarray:
 
 
 def _ambient_occlusion(tree: Tree, verts: np.ndarray) -> np.ndarray:
-    """A cheap, static occlusion term from where a vertex sits in the crown (1 = open)."""
+    """A static occlusion term (1 = open): the crown's leaves' (:mod:`~.occlusion`, the laminas'
+    vertices sampling their area) and contact with the ground; a blade darker at its base."""
     ids = verts["ids"]
     rest = tree.rest_positions[ids[:, 0]] + verts["offset"]
     mat = ids[:, 3]
-    ao = np.ones(len(verts))
-    leafy = (mat == MATERIAL_LAMINA) | (mat == MATERIAL_PETIOLE)
-    foliage = rest[leafy]
-    if len(foliage):
-        centre = foliage.mean(axis=0)
-        radius = max(float(np.percentile(np.linalg.norm(foliage - centre, axis=1), 95)), 1e-6)
-        d = np.linalg.norm(rest - centre, axis=1) / radius
-        up = np.clip(0.5 + 0.5 * (rest[:, 1] - centre[1]) / radius, 0.0, 1.0)
-        ao = (0.42 + 0.58 * np.clip(d, 0.0, 1.0) ** 1.3) * (0.82 + 0.18 * up)
+    lam = np.flatnonzero(mat == MATERIAL_LAMINA)
+    area = tree.lamina.area * tree.lamina_length[ids[lam, 2]] ** 2 / len(tree.lamina.outline) if len(lam) else []
+    ao = crown_occlusion(rest, rest[lam], area)
     height = max(float(np.ptp(tree.rest_positions[:, 1])), 1e-6)
     ao *= 0.7 + 0.3 * np.clip(rest[:, 1] / (0.04 * height), 0.0, 1.0)  # contact with the ground
     blade = mat == MATERIAL_BLADE

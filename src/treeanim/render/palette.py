@@ -9,6 +9,7 @@ LEAF_YELLOW = (0.88, 0.70, 0.12)  # autumn, in this order
 LEAF_ORANGE = (0.92, 0.40, 0.06)
 LEAF_RED = (0.70, 0.10, 0.06)
 LEAF_BROWN = (0.40, 0.17, 0.06)
+LEAF_DRY = (0.50, 0.40, 0.27)  # winter: the few leaves a cherry keeps, withered (docs/design.md §3)
 PETIOLE = (0.55, 0.28, 0.14)  # mixed 40 % into the leaf's colour
 BLADE_BASE = (0.17, 0.33, 0.07)  # a blade from its base to its tip, the tip between a fresh ...
 BLADE_TIP = (0.46, 0.66, 0.18)

@@ -25,6 +25,7 @@ import numpy as np
 
 from ..model.scene import Scene as TreeScene
 from ..model.tree import Tree
+from .leaf_maps import lamina_box, leaf_texture
 from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
 from .scene import Scene, clip_ground
@@ -67,12 +68,15 @@ class TreePass:
     """
 
     def __init__(self, ctx: moderngl.Context, mesh: TreeMesh, tree: Tree) -> None:
-        self.vbo = self.ibo = self.block = None
+        self.vbo = self.ibo = self.block = self.leaf_maps = None
         self.parts: dict[str, _Part] = {}
         try:
             self.block = UniformBlock(ctx, "Tree")
             bark = tree.bark
-            self.block.set(bark_color=bark.color, bark=(bark.furrows, bark.depth, bark.interlace, bark.lenticels))
+            if tree.lamina is not None and len(tree.lamina.outline):
+                self.leaf_maps = leaf_texture(ctx, tree.lamina)
+            self.block.set(bark_color=bark.color, bark=(bark.furrows, bark.depth, bark.interlace, bark.lenticels),
+                           lamina_box=lamina_box(tree.lamina) if self.leaf_maps is not None else (1.0, 1.0))
             tris = [mesh.part_indices(name) for name in PARTS]
             if mesh.triangle_count:
                 self.vbo = ctx.buffer(mesh.vertices.tobytes())
@@ -98,6 +102,8 @@ class TreePass:
         (0 summer .. 1 winter); the shadow map bound to its unit."""
         self.block.set(season=season)
         self.block.use()
+        if self.leaf_maps is not None:
+            self.leaf_maps.use(SAMPLERS["leaf_maps"].unit)
         for name in parts:
             self.parts[name].render()
 
@@ -106,8 +112,8 @@ class TreePass:
         for part in self.parts.values():
             release_all(part.vao, part.prog)
         self.parts = {}
-        release_all(self.vbo, self.ibo, self.block)
-        self.vbo = self.ibo = self.block = None
+        release_all(self.vbo, self.ibo, self.block, self.leaf_maps)
+        self.vbo = self.ibo = self.block = self.leaf_maps = None
 
 
 class GroundPass:

@@ -57,6 +57,7 @@ BLOCKS: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("float", "translucency", "0: leaves pass no sunlight through"),
         ("vec3", "bark_color", "sRGB"),
         ("vec4", "bark", "furrows around a branch, furrow depth, interlacing, lenticels"),
+        ("vec2", "lamina_box", "the lamina's half width and length: its uv over the leaf maps"),
     ),
     # GroundPass's (ground.frag).
     "Ground": (
@@ -93,6 +94,7 @@ SAMPLERS: dict[str, Sampler] = {
     "objects": Sampler("sampler2D", 1, "per object: r = visible, g = highlight"),
     "shadow_map": Sampler("sampler2DShadow", 2, "depth seen from the sun (shadow.py)"),
     "background": Sampler("sampler2D", 3, "the background cache (background.frag)"),
+    "leaf_maps": Sampler("sampler2D", 4, "the lamina's albedo, translucency and relief (leaf_maps.py)"),
 }
 
 #: std140 base alignment and size (bytes) of each member type.
