@@ -44,10 +44,13 @@ def test_a_vertex_carries_its_trunk_and_its_three_innermost_branches():
     their bends added up."""
     tree = ta.load_preset("small_cherry")
     levels, pivots = shader_wind.level_chains(tree)
-    leaf = int(np.flatnonzero(tree.kind == "leaf")[0])
-    chain = [leaf]
-    while tree.parent[chain[-1]] >= 0:
-        chain.append(int(tree.parent[chain[-1]]))
+    def chain_of(o):
+        chain = [int(o)]
+        while tree.parent[chain[-1]] >= 0:
+            chain.append(int(tree.parent[chain[-1]]))
+        return chain
+
+    leaf, chain = max(((o, chain_of(o)) for o in np.flatnonzero(tree.kind == "leaf")), key=lambda c: len(c[1]))
     assert len(chain) > shader_wind.LEVELS
     assert levels[leaf].tolist() == [chain[-1], chain[2], chain[1], chain[0]]
     assert pivots[leaf].tolist() == [chain[-1], chain[-2], chain[1], chain[0]]
