@@ -41,11 +41,16 @@ def built(request):
 
 
 # ------------------------------------------------------------------------------ measures
+def collared(tree):
+    """The child branches with a collar: all but the forks' leaders (tests/test_wood.py)."""
+    return np.setdiff1d(np.flatnonzero((tree.kind == "branch") & (tree.parent >= 0)), tree.fork_leaders()[0])
+
+
 def collar(tree, mesh):
     """(V,) masks of the collars' rims and sunk apexes: the bark vertices of a child branch at
     t = 0 on its base node; an apex vertex is used by one triangle of the base fan."""
     obj = mesh.object
-    group = ((tree.kind[obj] == "branch") & (tree.parent[obj] >= 0) & (mesh.material == MATERIAL_BARK)
+    group = (np.isin(obj, collared(tree)) & (mesh.material == MATERIAL_BARK)
              & (mesh.node == tree.object_start[obj]) & (mesh.vertices["curve"][:, 0] == 0))
     uses = np.bincount(mesh.indices.ravel(), minlength=mesh.vertex_count)
     return group & (uses > 1), group & (uses == 1)
@@ -122,7 +127,7 @@ def surface_offset(tree, mesh, pts, where, reference=None):
 def test_every_child_has_a_collar_at_no_cost_in_triangles(built):
     tree, mesh = built
     rim, apex = collar(tree, mesh)
-    children = np.flatnonzero((tree.kind == "branch") & (tree.parent >= 0))
+    children = collared(tree)
     assert len(children)
     for part in (rim, apex):
         assert np.all(np.bincount(mesh.object[part], minlength=tree.n_objects)[children] == 16)
@@ -137,9 +142,9 @@ def test_collar_sinks_into_its_parent_and_no_cap_shows(built):
     rest, _ = mesh.skin(tree.rest_positions, identity(tree))
     rim, apex = collar(tree, mesh)
     at_base = rim | apex | ((mesh.node == tree.object_start[mesh.object]) & (mesh.vertices["curve"][:, 0] == 0)
-                            & (tree.parent[mesh.object] >= 0) & (mesh.material == MATERIAL_BARK))
+                            & np.isin(mesh.object, collared(tree)) & (mesh.material == MATERIAL_BARK))
     cap = at_base[mesh.indices].all(axis=1)
-    children = np.flatnonzero((tree.kind == "branch") & (tree.parent >= 0))
+    children = collared(tree)
     assert np.array_equal(np.bincount(mesh.object[mesh.indices[cap, 0]], minlength=tree.n_objects)[children],
                           np.full(len(children), 16))
     centres, radii = rest_tubes(tree)

@@ -9,6 +9,7 @@ import pytest
 
 from conftest import beam_tree, grass_patch, identity, rot, small_tree, twig_tree
 from treeanim.model.geometry import unit as _unit
+from treeanim.model.tree import curve_bands
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.mesh import (
     BLADE_CLUMP,
@@ -67,10 +68,14 @@ def test_per_kind_triangles_follow_the_papers_rule():
     branch = tree.kind == "branch"
     leaf = tree.kind == "leaf"
     # Branch tubes: 2 x 16 triangles a band, at least four bands (a twig of one or two
-    # segments is split along its curve), plus two 16-triangle end fans.
+    # segments is split along its curve; a crooked one in more, tests/test_model.py), plus two
+    # 16-triangle end fans, but none where a fork's leader runs on from its parent.
     segments = n[branch] - 1
-    bands = segments * np.ceil(4 / segments)
-    assert np.all(mesh.object_triangles[branch] == 32 * bands + 32)
+    bands = segments * curve_bands(n[branch], tree.joint_turn()[branch])
+    assert np.all(bands >= np.minimum(4, segments * np.ceil(4 / segments)))
+    lead = tree.fork_leaders()[0]
+    fans = 2 - np.isin(np.arange(tree.n_objects), lead) - np.isin(np.arange(tree.n_objects), tree.parent[lead])
+    assert len(lead) and np.all(mesh.object_triangles[branch] == 32 * bands + 16 * fans[branch])
     lam = len(tree.lamina.triangles)
     assert np.all(mesh.object_triangles[leaf] == 2 * tree.petiole_sides * (n[leaf] - 1) + lam)
     grass = grass_patch()
@@ -131,11 +136,13 @@ def test_rest_geometry():
     node = mesh.node
     # Tube rings lie on the segments' rest curves at the tapering radius (the end fans' centres,
     # on the axis, are left out): one ring at every band's ends, but where a child's base ring
-    # is its collar (tests/test_junctions.py).
+    # is its collar (tests/test_junctions.py; a fork's leader has none, tests/test_wood.py).
     P, r = tree.rest_positions, 0.5 * tree.node_diameter
     t = mesh.vertices["curve"][:, 0]
     obj = mesh.object
-    collar = (tree.parent[obj] >= 0) & (node == tree.object_start[obj]) & (t == 0)
+    lead = tree.fork_leaders()[0]
+    assert len(lead)
+    collar = (tree.parent[obj] >= 0) & ~np.isin(obj, lead) & (node == tree.object_start[obj]) & (t == 0)
     bark = np.flatnonzero((mesh.material == MATERIAL_BARK) & ~collar)
     j = node[bark]
     axis = P[np.minimum(j + 1, len(P) - 1)] - P[j]
@@ -146,8 +153,8 @@ def test_rest_geometry():
     ring = np.linalg.norm(np.cross(pts[bark] - centre, _unit(axis)), axis=1) > 1e-6
     branch = tree.kind == "branch"
     n = tree.object_count[branch]
-    children = np.sum(branch & (tree.parent >= 0))
-    assert ring.sum() == 16 * (np.sum((n - 1) * np.ceil(4 / (n - 1)) + 1) - children)
+    children = np.sum(branch & (tree.parent >= 0)) - len(lead)
+    assert ring.sum() == 16 * (np.sum((n - 1) * curve_bands(n, tree.joint_turn()[branch]) + 1) - children)
     assert np.sum(collar & (mesh.material == MATERIAL_BARK)) == 2 * 16 * children  # rim and sunk apex
     radius = (1 - t[bark]) * r[j] + t[bark] * r[np.minimum(j + 1, len(P) - 1)]
     assert np.allclose(dist[ring], radius[ring], rtol=1e-5)

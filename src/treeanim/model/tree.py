@@ -34,6 +34,11 @@ CURVE_BANDS = 4
 CURVE_TURN = 4.0
 #: ... but at most this many.
 CURVE_MOST = 6
+#: A fork's leader, which continues its parent's tube, turns at most this many degrees from it
+#: (see :meth:`Tree.fork_leaders`).
+FORK_LEAD = 45.0
+#: ... and at most this fraction of the turn of the next straightest branch on the same tip.
+FORK_CLEAR = 0.5
 
 
 def curve_bands(object_count: np.ndarray, turn: np.ndarray | float = 0.0) -> np.ndarray:
@@ -163,17 +168,50 @@ class Tree:
         """(N,) int: the object each node belongs to."""
         return np.repeat(np.arange(self.n_objects), self.object_count)
 
+    def _chords(self) -> np.ndarray:
+        """(N - 1, 3): unit vectors from each node to the next."""
+        chord = np.diff(self.rest_positions, axis=0)
+        return chord / np.maximum(np.linalg.norm(chord, axis=1, keepdims=True), 1e-12)
+
+    def fork_leaders(self) -> tuple[np.ndarray, np.ndarray]:
+        """The forks' leaders: of the branches on a branch's tip, the one that turns least from
+        its last segment, if by at most ``FORK_LEAD``° and at most ``FORK_CLEAR`` times as much
+        as the next (the renderer draws it as the parent's tube running on; an even fork keeps
+        its collars).
+
+        Returns
+        -------
+        leader : (L,) int
+            The leaders (their parents: ``parent[leader]``).
+        turn : (L,) float
+            The angle between the parent's last chord and the leader's first, radians.
+        """
+        child = np.flatnonzero((np.asarray(self.kind) == "branch") & (self.parent >= 0))
+        tip = self.object_start[self.parent[child]] + self.object_count[self.parent[child]] - 1
+        on_tip = self.attach_node[child] == tip
+        child, tip = child[on_tip], tip[on_tip]
+        chord = self._chords()
+        cos = np.clip(np.sum(chord[tip - 1] * chord[self.object_start[child]], axis=1), -1.0, 1.0)
+        turn = np.arccos(cos)
+        order = np.lexsort((turn, tip))
+        first = np.unique(tip[order], return_index=True)[1]
+        best = order[first]  # the straightest on each tip, and the next straightest
+        second = np.where(np.diff(np.r_[first, len(order)]) > 1, turn[order[np.minimum(first + 1, len(order) - 1)]], np.pi)
+        best = best[(turn[best] <= np.radians(FORK_LEAD)) & (turn[best] <= FORK_CLEAR * second)]
+        return child[best], turn[best]
+
     def joint_turn(self) -> np.ndarray:
-        """(M,) float: the largest angle between consecutive chords of each object at rest,
-        radians (0 for one segment)."""
-        P = self.rest_positions
-        chord = np.diff(P, axis=0)
-        chord /= np.maximum(np.linalg.norm(chord, axis=1, keepdims=True), 1e-12)
+        """(M,) float: the largest angle between consecutive chords of each object at rest, and
+        for a fork's leader (:meth:`fork_leaders`) between its parent's last chord and its first,
+        radians."""
+        chord = self._chords()
         k, n = self.node_index, self.object_count[self.node_object]
         inner = np.flatnonzero((k > 0) & (k < n - 1))
         turn = np.zeros(self.n_objects)
         cos = np.clip(np.sum(chord[inner - 1] * chord[inner], axis=1), -1.0, 1.0)
         np.maximum.at(turn, self.node_object[inner], np.arccos(cos))
+        leader, fork = self.fork_leaders()
+        np.maximum.at(turn, leader, fork)
         return turn
 
     @property
@@ -244,15 +282,20 @@ class Tree:
         """(M,) int: triangles the renderer draws for each object.
 
         Branch: a 16-sided tube in :func:`curve_bands` bands per segment, closed by a fan at
-        each end (32 per node for branches of four or more segments, as the paper's tubes).
+        each end (32 per node for branches of four or more segments, as the paper's tubes), but
+        none where a fork's leader runs on from its parent (:meth:`fork_leaders`).
         Leaf: a petiole tube (``petiole_sides``) plus the lamina triangulation.
         Blade: a two-sided strip over its segments plus a tip triangle.
         """
         n = self.object_count
         lamina_tris = 0 if self.lamina is None else len(self.lamina.triangles)
+        fans = np.full(self.n_objects, 2)
+        leader = self.fork_leaders()[0]
+        fans[leader] -= 1
+        fans[self.parent[leader]] -= 1
         return np.select(
             [self.kind == "branch", self.kind == "leaf"],
-            [2 * BRANCH_SIDES * ((n - 1) * curve_bands(n, self.joint_turn()) + 1),
+            [BRANCH_SIDES * (2 * (n - 1) * curve_bands(n, self.joint_turn()) + fans),
              2 * self.petiole_sides * (n - 1) + lamina_tris],
             2 * (n - 1) + 1,
         )

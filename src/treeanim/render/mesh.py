@@ -87,7 +87,7 @@ from ..model.geometry import arc_length, lamina_frames
 from ..model.geometry import perpendicular as _perpendicular
 from ..model.geometry import unit as _unit
 from ..model.tree import BRANCH_SIDES, Tree, curve_bands
-from .collars import collars, outward
+from .collars import collars, leaders, outward
 from .occlusion import crown_occlusion
 from .skinning import hermite, skin_points
 
@@ -285,7 +285,14 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     P = tree.rest_positions
     nodes, k, obj = _object_nodes(tree, objs)
     tangent, base, tip, nxt, prv = _node_tangents(tree, nodes, k, obj, curved)
+    # A fork's leader continues its parent's tube: from the parent's end ring (its radius, and
+    # the rings square to the same w, and the bark running on), without a collar.
+    lead = leaders(tree, nodes, tangent) if curved else np.zeros(tree.n_objects, bool)
     r = 0.5 * tree.node_diameter
+    r[tree.object_start[lead]] = r[tree.attach_node[lead]]
+    frame, along0, arc = np.arange(tree.n_objects), np.zeros(tree.n_objects), arc_length(tree)
+    for c in np.flatnonzero(lead):  # parents come first (objects are sorted by level)
+        frame[c], along0[c] = frame[tree.parent[c]], along0[tree.parent[c]] + arc[tree.attach_node[c]]
     inner = ~(base | tip)
     # T₀ of the segment leaving each node (module notes).
     prev = np.where(inner, nodes - 1, nodes)
@@ -308,7 +315,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     t = (np.arange(len(src)) - np.repeat(np.cumsum(reps) - reps, reps)) / bands[src]
     last = tip[src]  # each object's end ring
     first = base[src] & (t == 0)
-    ic = np.flatnonzero(first & child[src])  # a child's base ring: its collar's rim
+    ic = np.flatnonzero(first & child[src] & ~lead[obj[src]])  # a child's base ring: its collar's rim
     if curved:
         src = np.where(last, src - 1, src)
         t = np.where(last, 1.0, t)
@@ -329,19 +336,21 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
 
     # Ring frame: the object's w axis projected off the tangent (continuous along a planar
     # object, no twist); a fixed perpendicular where w runs along the tangent.
-    w = tree.rest_w[ring_obj]
+    w = tree.rest_w[frame[ring_obj]]
     a = _unit(w - np.sum(w * tan, axis=1, keepdims=True) * tan, _perpendicular(tan))
     b = np.cross(tan, a)
     ang = 2.0 * np.pi * np.arange(sides) / sides
     radial = np.cos(ang)[None, :, None] * a[:, None, :] + np.sin(ang)[None, :, None] * b[:, None, :]
     offset = centre[:, None, :] + radius[:, None, None] * radial
     normal = _unit(radial - slope[:, None, None] * tan[:, None, :])
-    along = arc_length(tree)[n0] + t * seg_len
+    along = along0[ring_obj] + arc[n0] + t * seg_len
     # A child's base ring is its collar's rim, on the parent's surface with its normals.
     child = ring_obj[ic]
     att, par = tree.attach_node[child], tree.parent[child]
+    drawn = np.zeros_like(P)
+    drawn[nodes] = tangent
     offset[ic], normal[ic], axis, apex = collars(tree, child, tan[ic], radial[ic], seg_len[ic] / bands[src[ic]],
-                                                 _node_tangents(tree, att, att - tree.object_start[par], par))
+                                                 _node_tangents(tree, att, att - tree.object_start[par], par), drawn)
     along[ic] = np.mean(np.sum(offset[ic] * tan[ic, None], axis=2), axis=1)
     ring_prev, ring_weight = prev[src], weight[src]
 
@@ -366,8 +375,8 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
 
     if curved:
         # Base fans, one apex vertex per side: a flat disc facing the ground under a root; a
-        # collar's cone from its sunk apex, with the parent's surface normals.
-        ib = np.flatnonzero(first)
+        # collar's cone from its sunk apex, with the parent's surface normals; none for a leader.
+        ib = np.flatnonzero(first & ~lead[obj[src]])
         kb = np.searchsorted(ib, ic)  # the collars among the base fans
         peak = np.zeros((len(ib), 3))
         peak[kb] = apex
@@ -379,8 +388,11 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
                        (rep(d0[ib]), rep(d1[ib])))
         parts.triangles(np.stack([cb + sides * np.arange(len(ib))[:, None] + s0, ring[ib, None] + s1,
                                   ring[ib, None] + s0], -1), ring_obj[ib, None])
-        # Tip fans: a low cone; flat under the collars of branches on the tip.
-        it = np.flatnonzero(last)
+        # Tip fans: a low cone; flat under the collars of branches on the tip; none where a
+        # leader runs on.
+        led = np.zeros(tree.n_objects, bool)
+        led[tree.parent[lead]] = True
+        it = np.flatnonzero(last & ~led[obj[src]])
         rise = np.where(carries[ring_obj[it]], 0.0, 0.5 * radius[it])
         ct = parts.add(n0[it], ring_prev[it], ring_obj[it], material, chord[it] + rise[:, None] * tan[it],
                        tan[it], ring_weight[it], jitter[ring_obj[it]], key[ring_obj[it]],

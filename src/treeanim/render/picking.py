@@ -23,6 +23,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..model.tree import Tree, curve_bands
+from .collars import leaders
 from .mesh import _node_tangents, _object_nodes, lamina_frames, segment_tangents
 from .skinning import hermite, skin_points
 
@@ -83,8 +84,10 @@ class Picker:
         j = nodes[src]
         j1 = np.minimum(j + 1, N - 1)
         # A branch's rest axis: each segment's Hermite curve (render/skinning.py).
+        tangent = _node_tangents(tree, nodes, k, obj, True)[0]
+        leaders(tree, nodes, tangent)
         length = np.where(curved[src], np.linalg.norm(P[j1] - P[j], axis=1), 0.0)
-        d0, d1 = segment_tangents(_node_tangents(tree, nodes, k, obj, True)[0], src, length)
+        d0, d1 = segment_tangents(tangent, src, length)
         offset = hermite(t, P[j1] - P[j], d0, d1)[0]
         radius = (1.0 - t) * r[j] + t * r[j1]
         first_cap = np.flatnonzero(~end)  # a piece from each ring to the next, within an object
