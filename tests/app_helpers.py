@@ -139,3 +139,15 @@ def open_viewer(win, tree, ready=lambda v: None):
     finally:
         v.release()
         win.close()
+
+
+def drag_and_let_go(v, dx, dy, steps):
+    """Press on a branch on screen, move the cursor by (dx, dy), hold ``steps`` steps, let go;
+    the branch's object."""
+    obj, x, y = branch_on_screen(v)
+    press(v, x, y)
+    v.on_cursor_pos(x + dx, y + dy)
+    for _ in range(steps):
+        v.advance(DT)
+    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    return obj

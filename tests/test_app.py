@@ -20,7 +20,20 @@ import numpy as np
 import pytest
 
 import treeanim as ta
-from app_helpers import DT, H, W, branch_on_screen, centre, check_tree_and_panel, click, press, reveal, tree_pixels, unsimulable
+from app_helpers import (
+    DT,
+    H,
+    W,
+    branch_on_screen,
+    centre,
+    check_tree_and_panel,
+    click,
+    drag_and_let_go,
+    press,
+    reveal,
+    tree_pixels,
+    unsimulable,
+)
 from treeanim.app.gui import Gui
 from treeanim.app.headless import HeadlessWindow
 from treeanim.app.save import physics_toml, preset_text, save_preset
@@ -966,12 +979,7 @@ def test_the_trace_of_a_released_branch_shrinks_away_as_the_swing_dies(viewer):
     """Issue 31: the last pull's trace stayed on screen until R. It keeps the swing's last
     seconds: once the branch is still again it is a point."""
     v = viewer
-    obj, x, y = branch_on_screen(v)
-    press(v, x, y)
-    v.on_cursor_pos(x + 40, y + 25)
-    for _ in range(60):
-        v.advance(DT)
-    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    drag_and_let_go(v, 40, 25, 60)
     for _ in range(60):
         v.advance(DT)
     swing = np.ptp(v.trace.points, axis=0).max()

@@ -9,7 +9,7 @@ import glfw
 import numpy as np
 import pytest
 
-from app_helpers import DT, branch_on_screen, centre, click, press, reveal
+from app_helpers import DT, branch_on_screen, centre, click, drag_and_let_go, press, reveal
 from treeanim.app.plots import spectrum
 from treeanim.app.timeline import Timeline
 
@@ -18,12 +18,7 @@ pytestmark = pytest.mark.usefixtures("no_display")  # the app fixtures: tests/co
 
 def swing(v, steps):
     """Drag a branch across and let go; then ``steps`` steps: the poses after each, by time."""
-    obj, x, y = branch_on_screen(v)
-    press(v, x, y)
-    v.on_cursor_pos(x + 30, y + 10)
-    for _ in range(30):
-        v.advance(DT)
-    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    drag_and_let_go(v, 30, 10, 30)
     poses = {}
     for _ in range(steps):
         v.advance(DT)
