@@ -134,11 +134,17 @@ def test_sway_grows_at_least_as_the_speed_to_the_power_1_3():
     assert sway[20.0] / sway[5.0] >= 4.0**1.3, sway
 
 
-def test_the_state_is_copied_and_restored_exactly():
+@pytest.mark.parametrize("falling", [False, True], ids=["summer", "leaves falling"])
+def test_the_state_is_copied_and_restored_exactly(falling):
     tree = ta.load_preset("small_cherry")
     sim = ta.Simulation(tree, wind=ta.WindField(speed=8.0))
     for _ in range(20):
         sim.step(1 / 60)
+    if falling:  # the falling leaves are state too, their random draws included
+        sim.season = 0.8
+        for _ in range(20):
+            sim.step(1 / 60)
+        assert len(sim.state.fallen) > 100
     st = sim.state
     for _ in range(10):
         sim.step(1 / 60)

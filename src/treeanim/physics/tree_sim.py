@@ -6,7 +6,6 @@ state (:class:`~.treestep.TreeState` and the fallen leaves) and steps it with
 
 from __future__ import annotations
 
-import copy
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,7 +42,7 @@ class SimState:
 
     def copy(self) -> "SimState":
         """A deep copy."""
-        return SimState(self.tree.copy(), copy.deepcopy(self.fallen))
+        return SimState(self.tree.copy(), self.fallen.copy())
 
 
 class TreeSim:
