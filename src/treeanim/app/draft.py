@@ -6,22 +6,10 @@ from __future__ import annotations
 
 import moderngl
 
-__all__ = ["DraftTarget"]
+from ..render.shaders import load_program
+from ..render.uniforms import SAMPLERS
 
-_VERTEX = """#version 330 core
-out vec2 uv;
-void main() {
-    vec2 p = vec2((gl_VertexID << 1) & 2, gl_VertexID & 2);  // one triangle over the viewport
-    uv = p;
-    gl_Position = vec4(2.0 * p - 1.0, 0.0, 1.0);
-}
-"""
-_FRAGMENT = """#version 330 core
-uniform sampler2D picture;
-in vec2 uv;
-out vec4 color;
-void main() { color = texture(picture, uv); }
-"""
+__all__ = ["DraftTarget"]
 
 
 class DraftTarget:
@@ -34,7 +22,7 @@ class DraftTarget:
 
     def __init__(self, ctx: moderngl.Context) -> None:
         self.ctx = ctx
-        self.program = ctx.program(vertex_shader=_VERTEX, fragment_shader=_FRAGMENT)
+        self.program = load_program(ctx, "draft.vert", "draft.frag")
         self.vao = ctx.vertex_array(self.program, [])
         self.size: tuple[int, int] | None = None
         self._fbo = self._color = self._depth = None
@@ -60,8 +48,7 @@ class DraftTarget:
         target.use()
         self.ctx.viewport = (0, 0, int(width), int(height))
         self.ctx.disable(moderngl.DEPTH_TEST | moderngl.BLEND | moderngl.CULL_FACE)
-        self._color.use(0)
-        self.program["picture"] = 0
+        self._color.use(SAMPLERS["draft"].unit)
         self.vao.render(moderngl.TRIANGLES, vertices=3)
         self.ctx.enable(moderngl.DEPTH_TEST)
 

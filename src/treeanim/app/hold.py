@@ -2,10 +2,12 @@
 
 The mouse's grab (:mod:`treeanim.physics.pull`) is a spring; :attr:`~ViewerHold.grab_strength`
 scales it (1, the default: on the tree model :data:`~treeanim.physics.tree_sim.GRAB_STIFFNESS`
-times the tree's own stiffness at the grabbed point, so a small drag is covered to 98 %; on the
-paper's model a loop gain of :data:`~treeanim.physics.pull.GAIN`). A weaker grab leaves the
-branch short of the cursor: the point covers s/(1 + s) of a small drag, s the spring in units of
-the tree's stiffness there.
+times the tree's own stiffness at the grabbed point, so a small drag is covered up to 98 %; on
+the paper's model a loop gain of :data:`~treeanim.physics.pull.GAIN`). A weaker grab leaves the
+branch short of the cursor: the point covers at most s/(1 + s) of a small drag, s the spring in
+units of the tree's stiffness there, taken with every joint's lever across the pull (the most
+compliant way: a pull along some levers meets a stiffer tree), and less of a drag whose force
+would pass what the wood bears (the spring's force is held there).
 
 A **pin** keeps a drag of the tree model after the mouse lets go: P (or letting go with Shift
 held) pins the drag in progress where its target is; the branch stays bent, held by the
@@ -59,7 +61,7 @@ class ViewerHold:
             self.grab.sent = None  # handed to the simulation before the next step
 
     def held_share(self) -> float:
-        """The share of a small drag a grab covers, s/(1 + s): s the spring over the tree's
+        """The most of a small drag a grab covers, s/(1 + s): s the spring over the tree's
         stiffness at the point (the tree model), or the spring pull's loop gain (the paper's)."""
         s = (GRAB_STIFFNESS if self.sim.model == "tree" else GAIN) * self.grab_strength
         return s / (1.0 + s)

@@ -247,7 +247,7 @@ class Panel:
         v = self.viewer
         self.widget("grab_strength")
         spring = f", now {v.grab.spring(v.sim):.3g} N/m" if v.grab is not None else ""
-        imgui.text_disabled(f"covers {100 * v.held_share():.1f} % of a drag{spring}")
+        imgui.text_disabled(f"covers up to {100 * v.held_share():.1f} % of a small drag{spring}")
         for j, p in enumerate(v.pins):
             if imgui.small_button(f"x##pin{j}"):
                 v.unpin(j)

@@ -95,6 +95,7 @@ SAMPLERS: dict[str, Sampler] = {
     "shadow_map": Sampler("sampler2DShadow", 2, "depth seen from the sun (shadow.py)"),
     "background": Sampler("sampler2D", 3, "the background cache (background.frag)"),
     "leaf_maps": Sampler("sampler2D", 4, "the lamina's albedo, translucency and relief (leaf_maps.py)"),
+    "draft": Sampler("sampler2D", 5, "draft mode's smaller picture, scaled up (app/draft.py)"),
 }
 
 #: std140 base alignment and size (bytes) of each member type.
