@@ -23,13 +23,13 @@ def press(v, x, y, button=glfw.MOUSE_BUTTON_LEFT):
     v.on_mouse_button(button, glfw.PRESS, 0)
 
 
-def click(v, x, y):
+def click(v, x, y, button=glfw.MOUSE_BUTTON_LEFT):
     """A click on the panel: imgui sees the move, the press and the release in separate frames."""
     v.on_cursor_pos(x, y)
     v.frame(DT)
-    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.PRESS, 0)
+    v.on_mouse_button(button, glfw.PRESS, 0)
     v.frame(DT)
-    v.on_mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    v.on_mouse_button(button, glfw.RELEASE, 0)
     v.frame(DT)
 
 

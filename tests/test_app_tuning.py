@@ -65,13 +65,7 @@ def test_right_click_on_a_slider_resets_it(viewer):
     v.panel.apply("wind_speed", 12.0)
     v.frame(DT)
     v.frame(DT)
-    x, y = centre(v.panel.item_rects["speed"])
-    v.on_cursor_pos(x, y)
-    v.frame(DT)
-    v.on_mouse_button(glfw.MOUSE_BUTTON_RIGHT, glfw.PRESS, 0)
-    v.frame(DT)
-    v.on_mouse_button(glfw.MOUSE_BUTTON_RIGHT, glfw.RELEASE, 0)
-    v.frame(DT)
+    click(v, *centre(v.panel.item_rects["speed"]), glfw.MOUSE_BUTTON_RIGHT)
     assert v.sim.wind.speed == 0.0
     assert v._mode is None
 
