@@ -23,6 +23,7 @@ import numpy as np
 
 import treeanim as ta
 from treeanim.model.build import ObjectSpec, assemble
+from treeanim.offline.trace import PLOTS_HINT, pyplot, save_figure
 from treeanim.physics.bending import rest_frames
 from treeanim.physics.simulation import Simulation
 from treeanim.physics.trace import trace_tips
@@ -127,14 +128,8 @@ def main(argv=None) -> int:
     ap.add_argument("--angle", type=float, default=35.0, help="pull direction, degrees from u towards w")
     ap.add_argument("--seconds", type=float, default=25.0, help="seconds recorded after the release")
     args = ap.parse_args(argv)
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        from treeanim.offline.trace import PLOTS_HINT
-
+    plt = pyplot()
+    if plt is None:
         print(f"lissajous.py {PLOTS_HINT}", file=sys.stderr)
         return 1
 
@@ -147,17 +142,13 @@ def main(argv=None) -> int:
         fig, ax = plt.subplots(figsize=(5.2, 5.2), dpi=120)
         lc = plot(ax, times, xz, title)
         fig.colorbar(lc, ax=ax, shrink=0.8, label="time after release (s)")
-        fig.tight_layout()
-        fig.savefig(args.out / f"{name}.png")
-        plt.close(fig)
+        save_figure(fig, args.out / f"{name}.png")
         print(f"{name}: {title}; wrote {args.out / (name + '.png')}")
     fig, axes = plt.subplots(1, 2, figsize=(10, 5), dpi=120)
     for ax, (name, (times, xz, p)) in zip(axes, results.items()):
         plot(ax, times, xz, f"({name[-1]}) f_u={p['f_u']}, f_w={p['f_w']}, ζ_u={p['zeta_u']}, ζ_w={p['zeta_w']}")
     fig.suptitle("Tip trace of a curved beam after pull and release (cf. Hu et al. 2012, Fig. 4)")
-    fig.tight_layout()
-    fig.savefig(args.out / "fig4.png")
-    plt.close(fig)
+    save_figure(fig, args.out / "fig4.png")
     print(f"wrote {args.out / 'fig4.png'}")
     return 0
 

@@ -36,6 +36,7 @@ except ImportError:  # running from a checkout without installing
 
 import numpy as np
 
+from treeanim.offline.trace import PLOTS_HINT, pyplot, save_figure
 from treeanim.physics.wind import WindField
 
 
@@ -48,17 +49,13 @@ def axis_spectrum(field: np.ndarray) -> np.ndarray:
     return np.mean(out, axis=0)
 
 
-def save_profile(plt, fig, bx, title: str, out: Path) -> Path:
+def save_profile(fig, bx, title: str, out: Path) -> Path:
     """Label the profile's axes ``bx``, title it, and write ``fig`` as out/wind_slice.png."""
     bx.set_xlabel("speed (m/s)")
     bx.set_ylabel("height y (m)")
     bx.set_title(title)
     bx.legend(fontsize=7, loc="lower right")
-    fig.tight_layout()
-    path = out / "wind_slice.png"
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return save_figure(fig, out / "wind_slice.png")
 
 
 def physical_plots(args, plt) -> tuple[Path, Path]:
@@ -100,10 +97,7 @@ def physical_plots(args, plt) -> tuple[Path, Path]:
     ax.set_ylabel("power spectral density (m²/s² per Hz; offset by decades)")
     ax.set_title(f"Physical wind at the canopy top: U = {U:g} m/s, L = {L:g} m, {n / rate:g} s")
     ax.legend(fontsize=6.5, loc="lower left")
-    fig.tight_layout()
-    spectrum_png = args.out / "wind_spectrum.png"
-    fig.savefig(spectrum_png)
-    plt.close(fig)
+    spectrum_png = save_figure(fig, args.out / "wind_spectrum.png")
 
     # -- a vertical slice along the wind, and the mean profile ---------------------------------
     xs = np.linspace(-2 * L, 2 * L, 200)
@@ -136,7 +130,7 @@ def physical_plots(args, plt) -> tuple[Path, Path]:
     bx.plot(U * wind.profile(heights), heights, "-", color="tab:red", label="U · canopy profile")
     bx.plot(along.std(axis=0), heights, "s", ms=3, color="tab:green", label="measured σ_u")
     bx.axhline(H, color="0.5", lw=0.8, ls=":")
-    return spectrum_png, save_profile(plt, fig, bx, "Mean profile", args.out)
+    return spectrum_png, save_profile(fig, bx, "Mean profile", args.out)
 
 
 def paper_plots(args, plt) -> tuple[Path, Path]:
@@ -163,10 +157,7 @@ def paper_plots(args, plt) -> tuple[Path, Path]:
     ax.set_ylabel("1-D power (curves offset by decades)")
     ax.set_title(f"Wind noise spectra, N = {n}")
     ax.legend(fontsize=7, loc="lower left")
-    fig.tight_layout()
-    spectrum_png = args.out / "wind_spectrum.png"
-    fig.savefig(spectrum_png)
-    plt.close(fig)
+    spectrum_png = save_figure(fig, args.out / "wind_spectrum.png")
 
     # -- vertical slice (Fig. 7b) ----------------------------------------------------------
     (x0, y0, z0), (x1, y1, z1) = wind.bounds
@@ -214,7 +205,7 @@ def paper_plots(args, plt) -> tuple[Path, Path]:
             label=f"speed·c1·ln(c2·h), c1 = {wind.c1:.3f}, c2 = {wind.c2:g}/m")
     bx.plot(fit * law, heights, "-", color="tab:red",
             label=f"c1·ln(c2·h) × {fit:.2f} m/s (least squares)")
-    return spectrum_png, save_profile(plt, fig, bx, "Mean profile (Eq. 16)", args.out)
+    return spectrum_png, save_profile(fig, bx, "Mean profile (Eq. 16)", args.out)
 
 
 
@@ -233,14 +224,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--grid", type=int, default=64, help="paper: noise grid edge N (default 64)")
     args = parser.parse_args(argv)
 
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        from treeanim.offline.trace import PLOTS_HINT
-
+    plt = pyplot()
+    if plt is None:
         print(f"wind_spectrum.py {PLOTS_HINT}", file=sys.stderr)
         return 1
 

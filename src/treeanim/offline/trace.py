@@ -92,11 +92,9 @@ def write_trace_csv(path: Path, trace: TraceResult) -> None:
 def plot_trace(path: Path, trace: TraceResult, title: str = "") -> None:
     """The horizontal trace of the tip (x–z displacement from rest, equal aspect), coloured by
     time after release, in the manner of the paper's Figs. 1 and 4."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.collections import LineCollection
+
+    plt = pyplot()
 
     d = trace.tips - trace.rest
     x, z = d[:, 0] * 100, d[:, 2] * 100  # cm
@@ -129,13 +127,35 @@ def plot_trace(path: Path, trace: TraceResult, title: str = "") -> None:
         f, z_ = trace.f, trace.zeta
         sub += f": f u,v,w = {f[0]:.3f}, {f[1]:.3f}, {f[2]:.3f} Hz; ζ = {z_[0]:.3f}, {z_[1]:.3f}, {z_[2]:.3f}"
     ax.set_title((title + "\n" if title else "") + sub, fontsize=9)
+    save_figure(fig, path)
+
+
+def pyplot():
+    """matplotlib's pyplot on the Agg backend (files, no window), or None where matplotlib is
+    not installed (:data:`PLOTS_HINT` says how to install it)."""
+    try:
+        import matplotlib
+    except ImportError:
+        return None
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def save_figure(fig, path: str | Path) -> Path:
+    """Lay out ``fig``, write it to ``path`` atomically (the format from its suffix) and close it."""
+    import matplotlib.pyplot as plt
+
+    path = Path(path)
     fig.tight_layout()
-    suffix = Path(path).suffix.lower()
+    suffix = path.suffix.lower()
     try:
         with atomic_path(path, suffix) as tmp:
             fig.savefig(tmp, format=suffix[1:])
     finally:
         plt.close(fig)
+    return path
 
 
 def zero_crossing_frequency(t: np.ndarray, x: np.ndarray) -> float:
