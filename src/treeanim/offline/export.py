@@ -45,6 +45,7 @@ def cmd_export(args) -> int:
         raise UsageError(str(e)) from None
     full = skel
     skel, raw, mesh, error = joints.fit(tree, full, raw, n, budget, sim.present)
+    mesh = mesh if mesh is not None else build_mesh(tree)  # once, for the file and the compact error
     keys = loop.close_loop(raw, n) if fade else raw
     if usd:
         files = export_usd.write_usd(out, tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel)
@@ -57,7 +58,7 @@ def cmd_export(args) -> int:
           f"{n + 1} keys from 0 to {n / args.fps:.2f} s, {size / 1e6:.1f} MB")
     print(joints.report(full, skel, budget, error))
     if args.precision == "compact" and not usd:
-        skinned = export.skin(tree, mesh if mesh is not None else build_mesh(tree), skel, sim.present)[2:]
+        skinned = export.skin(tree, mesh, skel, sim.present)[2:]
         print(compact.report(compact.error(tree, skel, keys, *skinned)))
     if fade:
         print(loop.seam(keys, raw).line())
