@@ -304,6 +304,19 @@ def skin(tree: Tree, mesh: TreeMesh, skel: Skeleton, present: np.ndarray | None 
     return keep_tris, used, pos, joints, weights
 
 
+def surface(tree: Tree, mesh: TreeMesh, used: np.ndarray, season: float) -> tuple[np.ndarray, np.ndarray]:
+    """The ``used`` vertices' unit normals (V, 3) float32 and colours at ``season`` (V, 4) uint8."""
+    nrm = mesh.vertices["normal"][used].astype(np.float64)
+    nrm = (nrm / np.linalg.norm(nrm, axis=1, keepdims=True)).astype(np.float32)
+    return nrm, np.round(vertex_colours(tree, mesh, season)[used] * 255).astype(np.uint8)
+
+
+def material() -> gl.Material:
+    """The one material of an exported tree: its colours are the vertices', both sides drawn."""
+    return gl.Material(name="tree", doubleSided=True, pbrMetallicRoughness=gl.PbrMetallicRoughness(
+        baseColorFactor=[1, 1, 1, 1], metallicFactor=0.0, roughnessFactor=0.8))
+
+
 def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, mesh: TreeMesh | None = None,
                present: np.ndarray | None = None, skel: Skeleton | None = None,
                precision: str = "full") -> tuple[gl.GLTF2, bytes]:
@@ -347,10 +360,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     # --- mesh: rest positions, normals, colours, joints and weights
     keep_tris, used, pos, joints, weights = skin(tree, mesh, skel, present)
     remap = np.cumsum(used) - 1
-    v = mesh.vertices[used]
-    nrm = v["normal"].astype(np.float64)
-    nrm = (nrm / np.linalg.norm(nrm, axis=1, keepdims=True)).astype(np.float32)
-    col = np.round(vertex_colours(tree, mesh, season)[used] * 255).astype(np.uint8)
+    nrm, col = surface(tree, mesh, used, season)
     compact = precision == "compact"
     byte_joints = compact and skel.count <= 256
     index = remap[mesh.indices[keep_tris]]
@@ -366,10 +376,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
                    (joints, gl.VEC4, gl.UNSIGNED_SHORT, None),
                    WEIGHTS_0=(weights, gl.VEC4, gl.UNSIGNED_BYTE, True))
     views = {name: blob.view(a.tobytes(), gl.ARRAY_BUFFER, a.strides[0]) for name, (a, *_) in columns.items()}
-    doc.materials.append(gl.Material(
-        name="tree", doubleSided=True,
-        pbrMetallicRoughness=gl.PbrMetallicRoughness(baseColorFactor=[1, 1, 1, 1], metallicFactor=0.0, roughnessFactor=0.8),
-    ))
+    doc.materials.append(material())
     # A compact file has one primitive per run of at most 65,535 vertices: 16-bit indices
     order, runs = cp.runs(index) if compact else (slice(None), [(0, len(index), 0, len(pos))])
     index = index[order]

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import scripted
-from .export import skeleton, skin, vertex_colours
+from .export import material, skeleton, skin, surface
 from .model.tree import Tree
 from .physics.simulation import Simulation
 from .physics.wind.field import WindField
@@ -187,13 +187,10 @@ def build_shader_gltf(tree: Tree, table: BranchTable, season: float = 0.0, mesh:
     o = np.maximum(lv, 0)
     doc = gl.GLTF2(asset=gl.Asset(version="2.0", generator="treeanim (shader wind)"))
     blob = _Blob(doc)
-    v = mesh.vertices[used]
-    nrm = v["normal"].astype(np.float64)
-    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
-    col = np.round(vertex_colours(tree, mesh, season)[used] * 255).astype(np.uint8)
+    nrm, col = surface(tree, mesh, used, season)
     attrs = {
         "POSITION": blob.accessor(pos, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER, minmax=True),
-        "NORMAL": blob.accessor(nrm.astype(np.float32), gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
+        "NORMAL": blob.accessor(nrm, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
         "COLOR_0": blob.accessor(col, gl.VEC4, gl.UNSIGNED_BYTE, gl.ARRAY_BUFFER, normalized=True),
     }
     for level in range(LEVELS):
@@ -207,10 +204,7 @@ def build_shader_gltf(tree: Tree, table: BranchTable, season: float = 0.0, mesh:
     remap = np.cumsum(used) - 1
     index = remap[mesh.indices[keep_tris]].astype(np.uint32).ravel()
     indices = blob.accessor(index, gl.SCALAR, gl.UNSIGNED_INT, gl.ELEMENT_ARRAY_BUFFER, minmax=True)
-    doc.materials.append(gl.Material(
-        name="tree", doubleSided=True,
-        pbrMetallicRoughness=gl.PbrMetallicRoughness(baseColorFactor=[1, 1, 1, 1], metallicFactor=0.0, roughnessFactor=0.8),
-    ))
+    doc.materials.append(material())
     doc.meshes.append(gl.Mesh(name=tree.name, primitives=[gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices,
                                                                          material=0)],
                               extras={"treeanim_wind": {"levels": LEVELS, "exponent": round(table.exponent, 4),
