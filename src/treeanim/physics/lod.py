@@ -122,8 +122,9 @@ class Reduced:
     """The active part of a tree (or scene) at its detail levels, and the state it steps.
 
     Building it freezes the rest in ``st`` (no relative velocity; the frozen leaves pass no
-    force). :meth:`gather` copies the active part of a full state into :attr:`state`;
-    :meth:`scatter` writes it back and carries the frozen part along.
+    force); it steps in the first rows of the whole structure's ``work``. :meth:`gather`
+    copies the active part of a full state into :attr:`state`; :meth:`scatter` writes it back
+    and carries the frozen part along.
 
     Attributes
     ----------
@@ -135,7 +136,7 @@ class Reduced:
         A body's index in :attr:`s` (−1: frozen).
     """
 
-    def __init__(self, tree, s: Structure, st: TreeState, levels: np.ndarray):
+    def __init__(self, tree, s: Structure, st: TreeState, levels: np.ndarray, work: Work):
         on, leaf_on = active_parts(tree, s, levels)
         self.bodies, self.leaves = np.flatnonzero(on), np.flatnonzero(leaf_on)
         self.frozen = np.flatnonzero(~on)
@@ -147,7 +148,7 @@ class Reduced:
         st.w[self.frozen] = 0.0
         carry(self.frozen, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
         self.s = self._structure(s, st, _anchors(s.parent, on), still)
-        self.work = Work(len(self.bodies), len(self.leaves))
+        self.work = work.head(len(self.bodies))
         self.state = TreeState(time=st.time, **{f.name: getattr(st, f.name)[self._rows(f.name)]
                                                   for f in fields(TreeState) if f.name != "time"})
 

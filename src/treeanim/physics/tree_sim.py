@@ -69,7 +69,7 @@ class TreeSim:
         self._present = tree.leaves_present(self._season)
         self._present.setflags(write=False)
         self._s = Structure.build(tree, self._physics, self._present)
-        self._work = Work(len(self._s.parent), len(self._s.leaf_body))
+        self._work = Work(len(self._s.parent))
         self._st = TreeState.rest(self._s, self._seed)
         self._next = self._st.copy()
         self._fallen = FallingLeaves(tree.object_start, tree.object_count, tree.rest_w, self._seed)
@@ -198,7 +198,7 @@ class TreeSim:
         if not force and np.array_equal(detail, self._detail):
             return
         self._detail = detail
-        self._lod = Reduced(self._tree, self._s, self._st, detail) if detail.any() else None
+        self._lod = Reduced(self._tree, self._s, self._st, detail, self._work) if detail.any() else None
         self._pos = self._rot = None
 
     # ------------------------------------------------------------------ stepping

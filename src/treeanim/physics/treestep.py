@@ -262,7 +262,9 @@ def _add_turn(b, h, Ka, Om, F, kap):
 class Work:
     """Scratch arrays of one structure's step (allocated once)."""
 
-    def __init__(self, B: int, L: int):
+    _ARRAYS = ("F", "kap", "IA", "pA", "Dinv", "U", "Ur", "u", "acc")
+
+    def __init__(self, B: int):
         self.F = np.zeros((B, 6))
         self.kap = np.zeros((B, 6, 6))
         self.IA = np.empty((B, 6, 6))
@@ -274,6 +276,14 @@ class Work:
         self.acc = np.empty((B, 6))  # each body's change of spatial velocity over the step
         self.theta = None
         self.theta_h = None
+
+    def head(self, B: int) -> "Work":
+        """Scratch of a structure of B bodies (at most this one's) in this one's first rows
+        (never used at the same time as this one)."""
+        w = Work(0)
+        for name in self._ARRAYS:
+            setattr(w, name, getattr(self, name)[:B])
+        return w
 
 
 def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: float, work: Work,
