@@ -106,6 +106,8 @@ def test_a_state_taken_at_mixed_levels_replays_exactly(scene):
             sim.step(1 / 30)
         runs.append(sim.positions)
     assert np.array_equal(runs[0], runs[1])
+    sim.state = sim.state  # posed whole again: the still trees' nodes were where they are
+    assert np.array_equal(sim.positions, runs[1])
     sim.season = 0.9  # a new structure, the same levels
     sim.step(1 / 30)
     assert list(sim.detail) == [1, 2, 0] and np.all(np.isfinite(sim.positions))

@@ -134,6 +134,12 @@ class Reduced:
         Their indices in the full structure; ``frozen`` the other bodies.
     body_index : (B,) int
         A body's index in :attr:`s` (−1: frozen).
+    carried : (F,) int
+        The frozen bodies that ride on an active one (the others stand still).
+    moving : ((B″,) int, (L″,) int)
+        The bodies and leaves that move: their nodes are all a pose after the first rewrites.
+    last : (pos, rot) or None
+        The last whole pose, kept by the simulation.
     """
 
     def __init__(self, tree, s: Structure, st: TreeState, levels: np.ndarray, work: Work):
@@ -147,7 +153,12 @@ class Reduced:
             a[still] = 0.0
         st.w[self.frozen] = 0.0
         carry(self.frozen, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
-        self.s = self._structure(s, st, _anchors(s.parent, on), still)
+        anc = _anchors(s.parent, on)
+        self.carried = self.frozen[anc[self.frozen] >= 0]  # (the rest stands still from now on)
+        moving = anc >= 0
+        self.moving = np.flatnonzero(moving), np.flatnonzero(moving[s.leaf_body])
+        self.last = None  # the last pose of the whole tree (set by its simulation)
+        self.s = self._structure(s, st, anc, still)
         self.work = work.head(len(self.bodies))
         self.state = TreeState(time=st.time, **{f.name: getattr(st, f.name)[self._rows(f.name)]
                                                   for f in fields(TreeState) if f.name != "time"})
@@ -228,7 +239,7 @@ class Reduced:
             if f.name != "time":
                 getattr(st, f.name)[self._rows(f.name)] = getattr(sub, f.name)
         st.time = sub.time
-        carry(self.frozen, full.parent, full.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
+        carry(self.carried, full.parent, full.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
 
 
 def tree_extents(tree) -> tuple[np.ndarray, np.ndarray]:

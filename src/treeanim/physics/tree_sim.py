@@ -71,7 +71,6 @@ class TreeSim:
         self._s = Structure.build(tree, self._physics, self._present)
         self._work = Work(len(self._s.parent))
         self._st = TreeState.rest(self._s, self._seed)
-        self._next = self._st.copy()
         self._fallen = FallingLeaves(tree.object_start, tree.object_count, tree.rest_w, self._seed)
         self._pulls: dict[int, tuple[int, np.ndarray, np.ndarray, np.ndarray]] = {}  # body, offset, applied, asked
         self._grabs: dict[int, tuple[Grab, float, float]] = {}  # object -> grab, s, stiffness
@@ -160,7 +159,6 @@ class TreeSim:
     def reset(self) -> None:
         """Back to rest at time 0, nothing held, no leaf fallen."""
         self._st = TreeState.rest(self._s, self._seed)
-        self._next = self._st.copy()
         self._fallen.clear()
         self._pulls.clear()
         self._grabs.clear()
@@ -204,25 +202,22 @@ class TreeSim:
     # ------------------------------------------------------------------ stepping
     def step(self, dt: float) -> None:
         """Advance by ``dt`` seconds (already validated by the façade). Atomic: a wind that
-        fails leaves the state as it was."""
+        fails leaves the state as it was (the winds are sampled before anything moves)."""
         s, st, red = self._s, self._st, self._lod
         t = st.time
         pulls = [(b, ofs, f) for b, ofs, f, _ in self._pulls.values()]
         grabs = [g for g, _, _ in self._grabs.values()]
-        if red is None:
-            U = self._sample(treestep.sample_points(s, st), t)
-            treestep.step(s, st, self._next, U, dt, self._work, pulls, grabs, self._physics.leaf_flutter)
-        else:  # the active part, in place; the held trees are whole, so their bodies are active
-            sub, at = red.gather(st), red.body_index
-            U = self._sample(treestep.sample_points(red.s, sub), t)
-            treestep.step(red.s, sub, sub, U, dt, red.work, [(at[b], ofs, f) for b, ofs, f in pulls],
-                          [dataclasses.replace(g, body=at[g.body]) for g in grabs], self._physics.leaf_flutter)
+        work = self._work
+        if red is not None:  # the active part; the held trees are whole, so their bodies are in it
+            s, st, work, at = red.s, red.gather(st), red.work, red.body_index
+            pulls = [(at[b], ofs, f) for b, ofs, f in pulls]
+            grabs = [dataclasses.replace(g, body=at[g.body]) for g in grabs]
+        U = self._sample(treestep.sample_points(s, st), t)
         if len(self._fallen):
             self._fallen.step(None if self.wind is None else (lambda p: self._sample(p, t)), dt)
-        if red is None:
-            self._st, self._next = self._next, self._st
-        else:
-            red.scatter(st, s)
+        treestep.step(s, st, st, U, dt, work, pulls, grabs, self._physics.leaf_flutter)
+        if red is not None:
+            red.scatter(self._st, self._s)
         self._pos = self._rot = None
 
     def _sample(self, points: np.ndarray, t: float) -> np.ndarray:
@@ -251,14 +246,20 @@ class TreeSim:
         return self._rot
 
     def _pose(self) -> None:
-        N = self._tree.n_nodes
-        pos, rot = np.empty((N, 3)), np.empty((N, 3, 3))
-        treestep.pose(self._s, self._st, self._tree.rest_positions, pos, rot)
+        N, red = self._tree.n_nodes, self._lod
+        if red is not None and red.last is not None:  # the still trees' nodes are where they were
+            pos, rot = red.last[0].copy(), red.last[1].copy()
+            treestep.pose(self._s, self._st, self._tree.rest_positions, pos, rot, red.moving)
+        else:
+            pos, rot = np.empty((N, 3)), np.empty((N, 3, 3))
+            treestep.pose(self._s, self._st, self._tree.rest_positions, pos, rot)
         if len(self._fallen):
             self._fallen.pose(pos, rot)
         pos.setflags(write=False)
         rot.setflags(write=False)
         self._pos, self._rot = pos, rot
+        if red is not None:
+            red.last = pos, rot
 
     # ------------------------------------------------------------------ interaction
     def _point(self, i: int, s: float) -> tuple[int, np.ndarray]:

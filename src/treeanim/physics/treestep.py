@@ -379,10 +379,12 @@ def _point_force(b: int, r: np.ndarray, f: np.ndarray, h: float, st: TreeState, 
     _add_turn(b, h, Ka, st.Om, w.F, w.kap)
 
 
-def pose(s: Structure, st: TreeState, rest: np.ndarray, pos: np.ndarray, rot: np.ndarray) -> None:
-    """Write the posed nodes: ``pos`` (N, 3) and rest-relative rotations ``rot`` (N, 3, 3)."""
-    pose_nodes(s.node, s.tip, s.tip_node, rest, st.R, st.P, s.leaf_nodes, s.leaf_first, s.leaf_body, s.leaf_E,
-               st.th, s.leaf_on, pos, rot)
+def pose(s: Structure, st: TreeState, rest: np.ndarray, pos: np.ndarray, rot: np.ndarray, parts=None) -> None:
+    """Write the posed nodes: ``pos`` (N, 3) and rest-relative rotations ``rot`` (N, 3, 3), of
+    the ``parts`` (bodies, leaves) only where given (the other nodes left as they are)."""
+    bodies, leaves = (np.arange(len(s.parent)), np.arange(len(s.leaf_body))) if parts is None else parts
+    pose_nodes(bodies, leaves, s.node, s.tip, s.tip_node, rest, st.R, st.P, s.leaf_nodes, s.leaf_first, s.leaf_body,
+               s.leaf_E, st.th, s.leaf_on, pos, rot)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
