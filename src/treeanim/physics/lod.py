@@ -6,7 +6,8 @@ Each tree of a scene has a detail level (:data:`MAX_DETAIL` the coarsest):
 * 0 — everything: every segment's joint and every leaf's petiole;
 * 1 — the leaves and the twigs (branches that bear no branch) ride rigidly on their parents, a
   grass blade on its base joint;
-* 2 — only the trunk sways (and a blade on its base joint), the crown riding on it;
+* 2 — only the trunk and the limbs (the first two orders of branches) sway, the rest of the
+  crown riding on them; grass stands still (a tuft of a thousand blades has no limbs);
 * 3 — the tree stands still.
 
 :class:`Reduced` is the step's view of a scene with levels: the active bodies and leaves as a
@@ -40,7 +41,7 @@ __all__ = ["MAX_DETAIL", "DETAIL_PIXELS", "Reduced", "active_parts", "carry", "c
 #: The coarsest detail level.
 MAX_DETAIL = 3
 #: A tree's height on the screen (px) below which it takes detail level 1, 2 and 3.
-DETAIL_PIXELS = (240.0, 80.0, 20.0)
+DETAIL_PIXELS = (240.0, 80.0, 8.0)
 #: A tree goes coarser only when it is this much under a level's height (no flicker at the edge).
 HYSTERESIS = 0.15
 #: The mean drag along the flow of a segment at a random angle to it, per ½ρC_d·d·ℓ:
@@ -90,7 +91,7 @@ def active_parts(tree, s: Structure, levels: np.ndarray) -> tuple[np.ndarray, np
     keep = (lv == 0) | ((lv == 1) & (bears | (kind != "branch"))) | ((lv == 2) & (np.asarray(tree.level) <= 2))
     o = s.obj
     first = s.body_of_obj[o] == np.arange(len(o))
-    bodies = keep[o] & ((lv[o] == 0) | (kind[o] != "blade") | first)
+    bodies = keep[o] & ((lv[o] == 0) | (kind[o] != "blade") | (first & (lv[o] == 1)))
     return bodies, lv[s.leaf_obj] == 0
 
 
