@@ -149,9 +149,9 @@ class Reduced:
         self.frozen = np.flatnonzero(~on)
         self.body_index = np.full(len(on), -1, np.int64)
         self.body_index[self.bodies] = np.arange(len(self.bodies))
-        still = np.flatnonzero(~leaf_on)
+        resting = np.flatnonzero(~leaf_on)
         for a in (st.thd, st.leaf_F, st.leaf_kap, st.leaf_kap2):
-            a[still] = 0.0
+            a[resting] = 0.0
         st.w[self.frozen] = 0.0
         carry(self.frozen, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
         anc = _anchors(s.parent, on)
@@ -159,7 +159,7 @@ class Reduced:
         moving = anc >= 0
         self.moving = np.flatnonzero(moving), np.flatnonzero(moving[s.leaf_body])
         self.last = None  # the last pose of the whole tree (set by its simulation)
-        self.s = self._structure(s, st, anc, still)
+        self.s = self._structure(s, st, anc, resting)
         self.work = work.head(len(self.bodies))
         self.state = TreeState(time=st.time, **{f.name: getattr(st, f.name)[self._rows(f.name)]
                                                   for f in fields(TreeState) if f.name != "time"})
@@ -167,11 +167,12 @@ class Reduced:
     def _rows(self, name: str) -> np.ndarray:
         return self.bodies if name in _BODY_STATE else self.leaves
 
-    def _structure(self, s: Structure, st: TreeState, anc: np.ndarray, still: np.ndarray) -> Structure:
-        """The active part of ``s``, what rides on each body lumped into it."""
+    def _structure(self, s: Structure, st: TreeState, anc: np.ndarray, resting: np.ndarray) -> Structure:
+        """The active part of ``s``, what rides on each body (``anc``: its anchor) lumped into
+        it; ``resting``: the frozen leaves."""
         B = len(s.parent)
         m0, h0, J0 = s.m0.copy(), s.h0.copy(), s.J0.copy()
-        f = self.frozen[anc[self.frozen] >= 0]  # (frozen on the ground hold nothing up)
+        f = self.carried  # (what stands on the ground holds nothing up)
         a = anc[f]
         Ra = st.R[a]
         C = np.einsum("kji,kjl->kil", Ra, st.R[f])  # the frozen body in its anchor's rest axes
@@ -186,17 +187,17 @@ class Reduced:
         np.add.at(h0, a, hf + m[:, None] * d)
         np.add.at(J0, a, Jf)
         # the drag of what rides: segments at their middles, leaves at their laminas
-        t = s.leaf_body[still]
+        ride = resting[anc[s.leaf_body[resting]] >= 0]
+        t = s.leaf_body[ride]
         la = anc[t]
-        lv = still[la >= 0]
-        t, la = t[la >= 0], la[la >= 0]
-        lx = st.P[t] + np.einsum("kij,kj->ki", st.R[t], s.leaf_base0[lv] + s.leaf_rc0[lv]) - st.P[la]
+        lx = st.P[t] + np.einsum("kij,kj->ki", st.R[t], s.leaf_base0[ride] + s.leaf_rc0[ride]) - st.P[la]
+        xs = d + np.einsum("kij,kj->ki", C, s.mid0[f])  # (anchor's rest axes)
+        xl = np.einsum("kji,kj->ki", st.R[la], lx)
         cd = SEGMENT_DRAG * s.cda[f]
-        cl = LEAF_DRAG * s.leaf_cna[lv] * s.leaf_on[lv]
+        cl = LEAF_DRAG * s.leaf_cna[ride] * s.leaf_on[ride]
         lump = np.zeros((B, 6))  # cd, cl, cl·cauchy, (cd + cl)·x
-        np.add.at(lump, a, np.column_stack([cd, 0 * cd, 0 * cd, cd[:, None] * (d + np.einsum("kij,kj->ki", C, s.mid0[f]))]))
-        np.add.at(lump, la, np.column_stack([0 * cl, cl, cl * s.leaf_cauchy[lv],
-                                             cl[:, None] * np.einsum("kji,kj->ki", st.R[la], lx)]))
+        np.add.at(lump, a, np.column_stack([cd, 0 * cd, 0 * cd, cd[:, None] * xs]))
+        np.add.at(lump, la, np.column_stack([0 * cl, cl, cl * s.leaf_cauchy[ride], cl[:, None] * xl]))
         lump = lump[self.bodies]
         weight = np.maximum(lump[:, 0] + lump[:, 1], 1e-300)
         out = {}

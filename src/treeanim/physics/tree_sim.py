@@ -190,7 +190,7 @@ class TreeSim:
 
     def _relevel(self, force: bool = False) -> None:
         """Step at the levels asked, the held trees at full detail."""
-        held = [i for i in (*self._pulls, *self._grabs)]
+        held = [*self._pulls, *self._grabs]
         detail = self._levels.copy()
         detail[object_trees(self._tree)[held]] = 0
         if not force and np.array_equal(detail, self._detail):
