@@ -7,7 +7,7 @@ Each tree of a scene has a detail level (:data:`MAX_DETAIL` the coarsest):
 * 1 — the leaves and the twigs (branches that bear no branch) ride rigidly on their parents, a
   grass blade on its base joint;
 * 2 — only the trunk and the limbs (the first two orders of branches) sway, the rest of the
-  crown riding on them; grass stands still (a tuft of a thousand blades has no limbs);
+  crown riding on them; grass stands still (a blade has no limb to ride);
 * 3 — the tree stands still.
 
 :class:`Reduced` is the step's view of a scene with levels: the active bodies and leaves as a
@@ -88,10 +88,11 @@ def active_parts(tree, s: Structure, levels: np.ndarray) -> tuple[np.ndarray, np
     bears = np.zeros(tree.n_objects, bool)  # bears a branch
     grows = (par >= 0) & (kind != "leaf")
     bears[par[grows]] = True
-    keep = (lv == 0) | ((lv == 1) & (bears | (kind != "branch"))) | ((lv == 2) & (np.asarray(tree.level) <= 2))
+    limb = (kind == "branch") & (np.asarray(tree.level) <= 2)
+    keep = (lv == 0) | ((lv == 1) & (bears | (kind == "blade"))) | ((lv == 2) & limb)
     o = s.obj
-    first = s.body_of_obj[o] == np.arange(len(o))
-    bodies = keep[o] & ((lv[o] == 0) | (kind[o] != "blade") | (first & (lv[o] == 1)))
+    first = s.body_of_obj[o] == np.arange(len(o))  # (a blade's base joint)
+    bodies = keep[o] & ((lv[o] == 0) | (kind[o] != "blade") | first)
     return bodies, lv[s.leaf_obj] == 0
 
 
