@@ -7,7 +7,8 @@ Each tree of a scene has a detail level (:data:`MAX_DETAIL` the coarsest):
 * 1 — the leaves and the twigs (branches that bear no branch) ride rigidly on their parents, a
   grass blade on its base joint;
 * 2 — only the trunk and the limbs (the first two orders of branches) sway, the rest of the
-  crown riding on them; grass stands still (a blade has no limb to ride);
+  crown riding on them; a grass blade on its base joint, as at 1 (a blade has nothing to
+  ride on, and grass bends far more for its height than a tree);
 * 3 — the tree stands still.
 
 :class:`Reduced` is the step's view of a scene with levels: the active bodies and leaves as a
@@ -89,7 +90,7 @@ def active_parts(tree, s: Structure, levels: np.ndarray) -> tuple[np.ndarray, np
     grows = (par >= 0) & (kind != "leaf")
     bears[par[grows]] = True
     limb = (kind == "branch") & (np.asarray(tree.level) <= 2)
-    keep = (lv == 0) | ((lv == 1) & (bears | (kind == "blade"))) | ((lv == 2) & limb)
+    keep = (lv == 0) | ((lv == 1) & bears) | ((lv == 2) & limb) | ((lv < MAX_DETAIL) & (kind == "blade"))
     o = s.obj
     first = s.body_of_obj[o] == np.arange(len(o))  # (a blade's base joint)
     bodies = keep[o] & ((lv[o] == 0) | (kind[o] != "blade") | first)

@@ -283,7 +283,8 @@ class Simulation:
         ----------
         levels : int or sequence of int
             One per tree (or one for all): 0 everything; 1 the leaves and twigs ride rigidly;
-            2 only the trunk and limbs sway (grass stands still); 3 the tree stands still
+            2 only the trunk and limbs sway (a grass blade, as at 1, on its base joint); 3 the
+            tree stands still
             (:data:`~treeanim.physics.lod.MAX_DETAIL`). A tree holding a pull or a drag stays at
             0. A switch moves no node: what freezes keeps its shape on its parent, what thaws
             starts from its rigid ride. :func:`~treeanim.physics.lod.choose_detail` picks levels
