@@ -105,7 +105,8 @@ class Renderer:
             self.view = UniformBlock(ctx, "View")
             self.tree_pass = TreePass(ctx, self.mesh, tree, self.pad)
             bound = _bound_framebuffer(ctx)
-            casters, self._shadow_ranges = self.tree_pass.order.group(shadow_indices(self.mesh, tree))
+            casters, self._shadow_ranges = self.tree_pass.order.group(
+                shadow_indices(self.mesh, tree, coarse_bark=self.tree_pass.many))
             self.shadow = ShadowMap(ctx, self.tree_pass.vbo, casters, self.scene.shadow_size)
             bound.use()  # making the map's framebuffer bound it
 

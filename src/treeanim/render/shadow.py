@@ -15,8 +15,18 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from ..model.tree import Tree
-from .lod import coarse_laminas
-from .mesh import BLADE_CLUMP, MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, VERTEX_ATTRIBUTES, VERTEX_DTYPE, VERTEX_FORMAT, TreeMesh
+from .lod import coarse_laminas, coarse_tubes
+from .mesh import (
+    BLADE_CLUMP,
+    MATERIAL_BARK,
+    MATERIAL_BLADE,
+    MATERIAL_LAMINA,
+    MATERIAL_PETIOLE,
+    VERTEX_ATTRIBUTES,
+    VERTEX_DTYPE,
+    VERTEX_FORMAT,
+    TreeMesh,
+)
 from .shaders import load_program
 from .shadow_view import EDGE_FADE, clip_convex, view_window, window_on_ground
 from .uniforms import UniformBlock
@@ -48,11 +58,13 @@ def _skipping_format() -> str:
     return " ".join(parts)
 
 
-def shadow_indices(mesh: TreeMesh, tree: Tree) -> np.ndarray:
+def shadow_indices(mesh: TreeMesh, tree: Tree, coarse_bark: bool = False) -> np.ndarray:
     """The triangles the shadow pass draws: the mesh's, without petioles (a few millimetres
     across, far below a texel), with each lamina outlined by :data:`SHADOW_LAMINA_CORNERS`
     of its corners (a lamina's vertices are its outline's, in order, per leaf), and each blade
-    clump casting its simulated blade's shadow (an object's first triangles: mesh notes).
+    clump casting its simulated blade's shadow (an object's first triangles: mesh notes);
+    with ``coarse_bark`` (a scene's), the bark's tubes with half their sides
+    (:func:`~.lod.coarse_tubes`).
 
     Returns
     -------
@@ -64,8 +76,9 @@ def shadow_indices(mesh: TreeMesh, tree: Tree) -> np.ndarray:
     obj = np.repeat(np.arange(len(mesh.object_triangles)), mesh.object_triangles)
     copy = (first == MATERIAL_BLADE) & (np.arange(len(first)) - mesh.object_triangle_start[obj]
                                         >= mesh.object_triangles[obj] // BLADE_CLUMP)
-    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA) & ~copy],
-            coarse_laminas(mesh, tree, SHADOW_LAMINA_CORNERS)]
+    bark = coarse_bark & (first == MATERIAL_BARK)
+    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA) & ~copy & ~bark],
+            coarse_laminas(mesh, tree, SHADOW_LAMINA_CORNERS), coarse_tubes(mesh) if coarse_bark else np.zeros((0, 3), np.uint32)]
     return np.ascontiguousarray(np.concatenate(keep), dtype=np.uint32)
 
 
