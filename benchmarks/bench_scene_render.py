@@ -7,8 +7,8 @@ A script, not a test::
 
 Per scene: load, 5 steps in a 5 m/s wind, then for each camera ``frames`` frames of pose upload,
 draw and read back (one skipped); prints the median wall and CPU ms a frame (CPU counts a
-software rasteriser's worker threads), and, where the renderer counts them, the trees and
-triangles it drew (``Renderer.drawn``). It runs any version of treeanim on the import path.
+software rasteriser's worker threads), the shadow map's texel, and, where the renderer counts
+them, the trees and triangles it drew (``Renderer.drawn``). It runs any version of treeanim on the import path.
 """
 
 from __future__ import annotations
@@ -62,7 +62,8 @@ def main() -> None:
                         cpu.append(1e3 * (time.process_time() - c0))
                 drawn = getattr(off.renderer, "drawn", None)
                 print(f"{name:9s} {view:9s} wall {statistics.median(wall):7.0f} ms  cpu {statistics.median(cpu):7.0f} ms"
-                      + (f"  drawn {drawn}" if drawn is not None else ""), flush=True)
+                      f"  shadow texel {100 * off.renderer.shadow.texel:.1f} cm" + (f"  drawn {drawn}" if drawn is not None else ""),
+                      flush=True)
                 if a.save:
                     from PIL import Image
 

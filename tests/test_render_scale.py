@@ -9,7 +9,7 @@ import pytest
 
 from conftest import rest_pose, small_tree
 from treeanim.model.scene import make_scene
-from treeanim.render import renderer as renderer_module
+from treeanim.render import passes as passes_module
 from treeanim.render import shadow as shadow_module
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.culling import TreeOrder, frustum_planes
@@ -54,7 +54,7 @@ def all_visible(monkeypatch):
 
 
 def no_lod(monkeypatch):
-    monkeypatch.setattr(renderer_module, "lod_band", lambda tree, ppm: (1e30, 2e30))
+    monkeypatch.setattr(passes_module, "lod_band", lambda leaf, ppm: (1e30, 2e30))
 
 
 def test_trees_out_of_view_are_not_drawn(offscreen, near_grove):
@@ -116,11 +116,9 @@ def test_the_switch_to_coarse_trees_does_not_pop(offscreen, near_grove, monkeypa
     for k, cam in enumerate(cams):
         full.append(render(offscreen, cam))
         triangles[k] /= r.drawn["triangles"]
-    print(np.round(triangles, 3))
     assert triangles[-1] < triangles[0] - 0.03  # more of the trees turned coarse
     step = [np.abs(b - a).mean() for a, b in zip(frames, frames[1:])]
     normal = [np.abs(b - a).mean() for a, b in zip(full, full[1:])]
-    print(np.round(triangles, 3), np.round(step, 2), np.round(normal, 2))
     assert max(step) <= 1.1 * max(normal)
     assert max(s - n for s, n in zip(step, normal)) <= 0.5
 

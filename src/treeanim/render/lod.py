@@ -51,20 +51,24 @@ def coarse_laminas(mesh: TreeMesh, tree: Tree, corners: int) -> np.ndarray:
     return lamina.reshape(-1, K)[:, tris].reshape(-1, 3).astype(np.uint32)
 
 
-def lod_band(tree: Tree, pixels_per_metre: float) -> tuple[float, float]:
+def median_leaf(tree: Tree) -> float:
+    """The median length of the tree's leaves (metres; 0 without leaves)."""
+    lengths = np.asarray(tree.lamina_length)
+    lengths = lengths[lengths > 0]
+    return float(np.median(lengths)) if len(lengths) else 0.0
+
+
+def lod_band(leaf: float, pixels_per_metre: float) -> tuple[float, float]:
     """(near, far) metres from the eye over which a scene's leaves hand over from full to
-    coarse: where the median leaf is :data:`LOD_FULL_PIXELS` and :data:`LOD_COARSE_PIXELS`
-    long on screen.
+    coarse: where a leaf ``leaf`` metres long (:func:`median_leaf`) is :data:`LOD_FULL_PIXELS`
+    and :data:`LOD_COARSE_PIXELS` long on screen.
 
     Parameters
     ----------
-    tree : Tree
+    leaf : float
     pixels_per_metre : float
         A metre's size on screen at one metre from the eye.
     """
-    lengths = np.asarray(tree.lamina_length)
-    lengths = lengths[lengths > 0]
-    leaf = float(np.median(lengths)) if len(lengths) else 0.0
     return leaf * pixels_per_metre / LOD_FULL_PIXELS, leaf * pixels_per_metre / LOD_COARSE_PIXELS
 
 

@@ -27,7 +27,7 @@ from ..model.scene import Scene as TreeScene
 from ..model.tree import Tree
 from .culling import TreeOrder
 from .leaf_maps import lamina_box, leaf_texture
-from .lod import LOD_LAMINA_CORNERS, coarse_laminas, coarse_tubes
+from .lod import LOD_LAMINA_CORNERS, coarse_laminas, coarse_tubes, lod_band, median_leaf
 from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
 from .scene import Scene, clip_ground
@@ -75,6 +75,7 @@ class TreePass:
         self.programs: dict[tuple[str, int], tuple[moderngl.Program, moderngl.VertexArray | None]] = {}
         self.order = TreeOrder(tree, mesh, pad)
         self.many = self.order.n_trees > 1
+        self.leaf = median_leaf(tree)
         self.drawn = {"trees": 0, "triangles": 0, "draws": 0}
         try:
             self.block = UniformBlock(ctx, "Tree")
@@ -106,20 +107,21 @@ class TreePass:
         except BaseException:
             self.release()
             raise
-        self.view(None, None)
+        self.view()
 
     def apply(self, scene: Scene) -> None:
         """Take the scene's settings (leaves' translucency, thin lines' width)."""
         self.block.set(translucency=scene.translucency, thin_pixels=scene.thin_pixels)
 
-    def view(self, view_proj: np.ndarray | None, eye, band: tuple[float, float] | None = None) -> None:
-        """Which trees the next frame's draws hold: those whose sphere reaches into ``view_proj``'s
-        volume (None: all); of a scene's, leaves full nearer the eye than ``band[0]`` metres,
-        coarse beyond ``band[1]``, and both dithered by distance between (None: all full)."""
+    def view(self, view_proj: np.ndarray | None = None, eye=None, pixels_per_metre: float = 0.0) -> None:
+        """Which trees the next frame's draws hold: of a scene, those whose sphere reaches into
+        ``view_proj``'s volume, their leaves full or coarse by their distance from the ``eye``
+        and how long a leaf is on screen (:func:`~.lod.lod_band`); None: every tree, full."""
         n = self.order.n_trees
-        keep = np.ones(n, bool) if view_proj is None or not self.many else self.order.visible(view_proj)
-        full, coarse = np.ones(n, bool), np.zeros(n, bool)
-        if band is not None and self.many:
+        keep, full, coarse = np.ones(n, bool), np.ones(n, bool), np.zeros(n, bool)
+        if view_proj is not None and self.many:
+            keep = self.order.visible(view_proj)
+            band = lod_band(self.leaf, pixels_per_metre)
             self.block.set(lod_band=band)
             d = np.linalg.norm(self.order.centres - np.asarray(eye, float), axis=1)
             full, coarse = d + self.order.radii <= band[0], d - self.order.radii >= band[1]

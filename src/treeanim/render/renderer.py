@@ -35,7 +35,6 @@ import numpy as np
 
 from ..model.tree import Tree
 from .camera import OrbitCamera
-from .lod import lod_band
 from .mesh import TreeMesh, build_mesh
 from .passes import BackgroundCache, GroundPass, OverlayPass, SkyPass, TreePass, release_all
 from .scene import Scene
@@ -61,7 +60,8 @@ def _bound_framebuffer(ctx: moderngl.Context) -> moderngl.Framebuffer:
 
 
 class Renderer:
-    """Draws one tree (plus sky, ground and overlays) on any moderngl context of GL >= 3.3.
+    """Draws one tree or a scene of many (plus sky, ground and overlays) on any moderngl context
+    of GL >= 3.3; a scene tree by tree, those in view (docs/design.md §17, Drawing).
 
     Parameters
     ----------
@@ -299,9 +299,9 @@ class Renderer:
         drawn whole, its shadow map fitted to it."""
         self._shadow_runs = None
         if not self.tree_pass.many:
-            self.tree_pass.view(None, None)
+            self.tree_pass.view()  # the frame's counts start afresh
             return
-        self.tree_pass.view(vp, camera.eye, lod_band(self.tree, pixels_per_metre))
+        self.tree_pass.view(vp, camera.eye, pixels_per_metre)
         if self.scene.shadow:
             reach = max(VIEW_REACH * camera.distance, MIN_REACH)
             self.shadow.follow(view_slice(vp, camera.eye, camera.forward, reach))
