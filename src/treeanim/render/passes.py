@@ -142,7 +142,7 @@ class TreePass:
             self.leaf_maps.use(SAMPLERS["leaf_maps"].unit)
         for name in parts:
             for ranges, fade, keep in self._draws[name]:
-                vao = self.programs[name, fade][1]
+                vao = self.programs[name, fade][1] if keep.any() else None  # a lone tree: no coarse ranges
                 for first, count in self.ranges[ranges].runs(keep) if vao is not None else ():
                     vao.render(moderngl.TRIANGLES, vertices=count, first=first)
                     self.drawn["triangles"] += count // 3
