@@ -13,7 +13,8 @@ import numpy as np
 
 from ..model.tree import Tree
 
-#: A tree's sphere grows by this fraction of its height for sway (as the shadow's box does).
+#: A tree's sphere grows by this fraction of its height for sway, and the shadow map's box round
+#: a lone tree by this fraction of its size (:meth:`~.shadow.ShadowMap.fit`).
 SWAY_MARGIN = 0.15
 
 

@@ -68,7 +68,14 @@ def lod_band(leaf: float, pixels_per_metre: float) -> tuple[float, float]:
     leaf : float
     pixels_per_metre : float
         A metre's size on screen at one metre from the eye.
+
+    Returns
+    -------
+    (float, float)
+        Nothing is coarse (1e30 m) for a scene without leaves.
     """
+    if leaf <= 0.0:
+        return 1e30, 2e30
     return leaf * pixels_per_metre / LOD_FULL_PIXELS, leaf * pixels_per_metre / LOD_COARSE_PIXELS
 
 

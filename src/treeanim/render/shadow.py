@@ -15,6 +15,7 @@ import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
 from ..model.tree import Tree
+from .culling import SWAY_MARGIN
 from .lod import coarse_laminas, coarse_tubes
 from .mesh import (
     BLADE_CLUMP,
@@ -33,10 +34,6 @@ from .uniforms import UniformBlock
 
 #: Attributes the shadow pass reads; the rest of each vertex is skipped.
 SHADOW_ATTRIBUTES = ("in_ids", "in_offset", "in_extra", "in_curve", "in_tangent0", "in_tangent1")
-#: The box round the tree at rest grows by this fraction of its size each way (sway room), but
-#: by no more than its height (nothing sways further than it stands tall: a meadow's box grows
-#: by a blade's length, not by 15 % of the meadow's width).
-SWAY_MARGIN = 0.15
 #: The lowest sun elevation the map is fitted for (sin of it): lower suns cast the shadow of
 #: a sun at this height, not an endless one.
 MIN_SUN_HEIGHT = 0.15
@@ -249,7 +246,9 @@ class ShadowMap:
         self.clear()
 
     def fit(self, sun, lo, hi, points, pad: float) -> None:
-        """Fit the sun's view to the box ``lo`` .. ``hi`` grown by :data:`SWAY_MARGIN` (cached),
+        """Fit the sun's view to the box ``lo`` .. ``hi`` grown by :data:`~.culling.SWAY_MARGIN`
+        of its size each way for sway, but by no more than its height (nothing sways further than
+        it stands tall: a meadow's box grows by a blade's length, not by 15 % of its width) (cached),
         and the ground's :attr:`footprint` to the tree's ``points`` (its nodes at rest) grown by
         the same and by ``pad`` (how far its surface reaches beyond them)."""
         key = (tuple(np.round(sun, 9)), tuple(lo), tuple(hi))
