@@ -10,6 +10,7 @@ import pytest
 from conftest import rest_pose, small_tree
 from treeanim.model.scene import make_scene
 from treeanim.render import passes as passes_module
+from treeanim.render import renderer as renderer_module
 from treeanim.render import shadow as shadow_module
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.culling import TreeOrder, frustum_planes
@@ -182,3 +183,14 @@ def test_the_view_window_holds_what_the_view_sees_of_the_receivers():
     inside = frustum_planes(vp)
     assert np.all(inside[:, :3] @ cam.target + inside[:, 3] > 0)
     assert np.any(inside[:, :3] @ (cam.eye - cam.forward) + inside[:, 3] < 0)
+
+
+def test_twigs_far_thinner_than_a_shadow_texel_cast_no_shadow_and_are_not_missed(offscreen, wide_grove, monkeypatch):
+    r = load(offscreen, wide_grove)
+    cam = OrbitCamera(target=(0.0, 1.0, 0.0), distance=150.0, elevation=40.0)
+    img = render(offscreen, cam)
+    cast = r.drawn["shadow_triangles"]
+    monkeypatch.setattr(renderer_module, "THIN_CASTER_TEXELS", 0.0)
+    every = render(offscreen, cam)
+    assert cast < 0.7 * r.drawn["shadow_triangles"]
+    assert np.abs(img - every).mean() < 0.05 and np.percentile(np.abs(img - every).max(axis=2), 99.9) < 16

@@ -1,6 +1,7 @@
-"""Leaves with fewer triangles: a lamina outlined by a few of its corners and no petiole, for
-the sun's shadow map (always) and for the trees of a scene far from the camera (docs/design.md
-§17, Drawing).
+"""Fewer triangles: a lamina outlined by a few of its corners and no petiole, for the sun's
+shadow map (always) and for the trees of a scene far from the camera; tubes of half the sides,
+for a scene's far trees and shadow map; a scene's shadow casters by thickness, for a map to
+leave out twigs far thinner than its texel (docs/design.md §17, Drawing).
 
 A far tree's leaves hand over from the full mesh to the coarse one across a band of distance,
 leaf by leaf: each pixel of a leaf in the band is drawn by one of the two, chosen by a 4 × 4
@@ -14,7 +15,7 @@ import numpy as np
 
 from ..model.lamina import ear_clip
 from ..model.tree import BRANCH_SIDES, Tree
-from .mesh import MATERIAL_LAMINA, TreeMesh
+from .mesh import MATERIAL_BARK, MATERIAL_LAMINA, TreeMesh
 
 #: Corners of a lamina's outline kept for a far tree's leaves: six triangles, at a size where
 #: the leaf's teeth and curve are below a pixel.
@@ -22,6 +23,10 @@ LOD_LAMINA_CORNERS = 8
 #: Sides of the bark's tubes a far tree keeps one in (of ``BRANCH_SIDES``): eight, whose outline
 #: is within 8 % of the round one's, so a twig drawn as a soft line keeps its weight.
 LOD_TUBE_STEP = 2
+#: A scene's shadow map leaves out bark thinner than this share of its texel (a twig a fifth of
+#: a texel wide only speckles it), in classes of diameter split at these (metres).
+THIN_CASTER_TEXELS = 0.25
+CASTER_DIAMETERS = (0.04, 0.02, 0.01, 0.005)
 #: A scene's tree draws its coarse leaves where a leaf is shorter than this on screen (px) ...
 LOD_COARSE_PIXELS = 8.0
 #: ... its full ones where longer than this, and both, dithered, between.
@@ -112,3 +117,28 @@ def coarse_tubes(mesh: TreeMesh, step: int = LOD_TUBE_STEP) -> np.ndarray:
             np.stack([v0[base_fan], on(v2[base_fan], side[v0[base_fan]] + step), v2[base_fan]], -1),
             np.stack([v0[tip_fan], v1[tip_fan], on(v1[tip_fan], side[v1[tip_fan]] + step)], -1)]
     return np.concatenate(tris).astype(np.uint32)
+
+
+def caster_classes(mesh: TreeMesh, tree: Tree, casters: np.ndarray) -> list[tuple[float, np.ndarray]]:
+    """A scene's shadow casters by thickness, so the map can leave out those far thinner than
+    its texel (:data:`THIN_CASTER_TEXELS`): they would only speckle it.
+
+    Parameters
+    ----------
+    mesh : TreeMesh
+    tree : Tree
+    casters : (T, 3) int
+        The shadow pass's triangles (:func:`~.shadow.shadow_indices`).
+
+    Returns
+    -------
+    list of (float, (T_k, 3) int)
+        Each class's thickest diameter (metres; inf for the first, which holds bark of at least
+        the first of :data:`CASTER_DIAMETERS` and all but bark) and its triangles: bark by its
+        node's diameter, between one of :data:`CASTER_DIAMETERS` and the one before.
+    """
+    first = casters[:, 0]
+    d = np.where(mesh.material[first] == MATERIAL_BARK, np.asarray(tree.node_diameter)[mesh.node[first]], np.inf)
+    bounds = (np.inf, *CASTER_DIAMETERS, 0.0)
+    return [(hi, casters[(d >= lo) & (d < hi) | ((k == 0) & np.isinf(d))])
+            for k, (hi, lo) in enumerate(zip(bounds[:-1], bounds[1:]))]

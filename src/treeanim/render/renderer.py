@@ -35,6 +35,7 @@ import numpy as np
 
 from ..model.tree import Tree
 from .camera import OrbitCamera
+from .lod import THIN_CASTER_TEXELS, caster_classes
 from .mesh import TreeMesh, build_mesh
 from .passes import BackgroundCache, GroundPass, OverlayPass, SkyPass, TreePass, release_all
 from .scene import Scene
@@ -105,9 +106,15 @@ class Renderer:
             self.view = UniformBlock(ctx, "View")
             self.tree_pass = TreePass(ctx, self.mesh, tree, self.pad)
             bound = _bound_framebuffer(ctx)
-            casters, self._shadow_ranges = self.tree_pass.order.group(
-                shadow_indices(self.mesh, tree, coarse_bark=self.tree_pass.many))
-            self.shadow = ShadowMap(ctx, self.tree_pass.vbo, casters, self.scene.shadow_size)
+            casters = shadow_indices(self.mesh, tree, coarse_bark=self.tree_pass.many)
+            classes = caster_classes(self.mesh, tree, casters) if self.tree_pass.many else [(math.inf, casters)]
+            self._casters, tris, first = [], [], 0  # (thickest diameter, ranges) of each class
+            for thickest, t in classes:
+                t, ranges = self.tree_pass.order.group(t, first)
+                self._casters.append((thickest, ranges))
+                tris.append(t)
+                first += ranges.total
+            self.shadow = ShadowMap(ctx, self.tree_pass.vbo, np.concatenate(tris), self.scene.shadow_size)
             bound.use()  # making the map's framebuffer bound it
 
             # --- per-frame textures
@@ -295,8 +302,8 @@ class Renderer:
 
     def _cull(self, camera: OrbitCamera, vp: np.ndarray, pixels_per_metre: float) -> None:
         """A scene's draws for this view: the trees in it, far leaves coarse, and the shadow map
-        fitted to the view and drawn with the trees in the sun's view of it. A lone tree is
-        drawn whole, its shadow map fitted to it."""
+        fitted to the view and drawn with the trees in the sun's view of it, less twigs far
+        thinner than its texel. A lone tree is drawn whole, its shadow map fitted to it."""
         self._shadow_runs = None
         if not self.tree_pass.many:
             self.tree_pass.view()  # the frame's counts start afresh
@@ -305,13 +312,15 @@ class Renderer:
         if self.scene.shadow:
             reach = max(VIEW_REACH * camera.distance, MIN_REACH)
             self.shadow.follow(view_slice(vp, camera.eye, camera.forward, reach))
-            self._shadow_runs = self._shadow_ranges.runs(self.tree_pass.order.visible(self.shadow.matrix))
+            visible = self.tree_pass.order.visible(self.shadow.matrix)
+            thinnest = THIN_CASTER_TEXELS * self.shadow.texel
+            self._shadow_runs = [run for thickest, ranges in self._casters if thickest > thinnest for run in ranges.runs(visible)]
 
     @property
     def drawn(self) -> dict:
         """The last frame's draws of the tree: ``trees`` in view, ``triangles`` and ``draws``
         (calls) of the colour passes, ``shadow_triangles`` of the shadow map's."""
-        runs = [(0, self._shadow_ranges.total)] if self._shadow_runs is None else self._shadow_runs
+        runs = [(0, sum(r.total for _, r in self._casters))] if self._shadow_runs is None else self._shadow_runs
         return dict(self.tree_pass.drawn, shadow_triangles=sum(c for _, c in runs) // 3 if self.scene.shadow else 0)
 
     def _ground_shown(self, camera: OrbitCamera) -> bool:
