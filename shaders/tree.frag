@@ -69,8 +69,8 @@ float dither4(vec2 pixel) {
 
 void main() {
 #if LOD_FADE != 0
-    // A leaf in the hand-over band: its full mesh keeps the pixels whose threshold is at least
-    // its fade, its coarse mesh the others, so between them the leaf is whole.
+    // A leaf or branch in the hand-over band: its full mesh keeps the pixels whose threshold is
+    // at least its fade, its coarse mesh the others, so between them it is whole.
     if ((dither4(gl_FragCoord.xy) >= v_fade) != (LOD_FADE == 1)) discard;
 #endif
     if (PART == PART_BARK && !gl_FrontFacing) discard;  // a closed tube's far side; a thin twig's, flat

@@ -50,9 +50,9 @@ class TreePass:
     Each part's triangles lie tree by tree (:class:`~.culling.TreeOrder`), and after the parts
     a scene's far trees' leaves and bark (:func:`~.lod.coarse_laminas`,
     :func:`~.lod.coarse_tubes`), so :meth:`view` can keep a scene's draws to the trees in view,
-    and its far trees coarse: two more leaf programs (``LOD_FADE`` 1 and 2) draw the full and
-    coarse leaves of the trees in the hand-over band, dithered; their bark turns coarse once
-    their leaves all are. A lone tree is one range a part, always drawn whole.
+    and its far trees coarse: two more programs for leaves and two for bark (``LOD_FADE`` 1 and
+    2) draw the full and coarse meshes of the trees in the hand-over band, dithered. A lone
+    tree is one range a part, always drawn whole.
 
     Parameters
     ----------
@@ -96,7 +96,7 @@ class TreePass:
             if mesh.triangle_count:
                 self.vbo = ctx.buffer(mesh.vertices.tobytes())
                 self.ibo = ctx.buffer(np.concatenate(tris).astype(np.uint32).tobytes())
-            variants = [(name, 0) for name in PARTS] + ([("LEAVES", 1), ("LEAVES", 2)] if self.many else [])
+            variants = [(name, 0) for name in PARTS] + ([(n, f) for n in ("LEAVES", "BARK") for f in (1, 2)] if self.many else [])
             for name, fade in variants:
                 prog = load_program(ctx, "tree.vert", "tree.frag", defines={"PART": list(PARTS).index(name), "LOD_FADE": fade})
                 vao = None
@@ -129,7 +129,8 @@ class TreePass:
         # each part's draws: (ranges, program variant, trees)
         self._draws = {"LEAVES": [("LEAVES", 0, keep & full), ("COARSE_LEAVES", 0, keep & coarse),
                                   ("LEAVES", 1, both), ("COARSE_LEAVES", 2, both)],
-                       "BARK": [("BARK", 0, keep & ~coarse), ("COARSE_BARK", 0, keep & coarse)],
+                       "BARK": [("BARK", 0, keep & full), ("COARSE_BARK", 0, keep & coarse),
+                                ("BARK", 1, both), ("COARSE_BARK", 2, both)],
                        "BLADES": [("BLADES", 0, keep)]}
         self.drawn = {"trees": int(keep.sum()), "triangles": 0, "draws": 0}
 
