@@ -3,10 +3,10 @@ shadow map (always) and for the trees of a scene far from the camera; tubes of h
 for a scene's far trees and shadow map; a scene's shadow casters by thickness, for a map to
 leave out twigs far thinner than its texel (docs/design.md §17, Drawing).
 
-A far tree's leaves hand over from the full mesh to the coarse one across a band of distance,
-leaf by leaf: each pixel of a leaf in the band is drawn by one of the two, chosen by a 4 × 4
-ordered dither against the leaf's place in the band (``LOD_FADE`` in ``shaders/tree.*``), so
-the leaf is whole all the way and the switch does not pop.
+A far tree's leaves and bark hand over from the full mesh to the coarse one across a band of
+distance, node by node: each pixel of a leaf or branch in the band is drawn by one of the two,
+chosen by a 4 × 4 ordered dither against its node's place in the band (``LOD_FADE`` in
+``shaders/tree.*``), so it is whole all the way and the switch does not pop.
 """
 
 from __future__ import annotations
