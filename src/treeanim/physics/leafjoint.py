@@ -16,6 +16,9 @@ __all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP", "FLUTTER_STROU
 #: leaf from side to side. Capping the turn (and the speed with it: energy is only taken
 #: away) keeps each step where the linearisation holds.
 MAX_TURN = 0.4
+#: A bend whose Newton step τ/k_air would pass this (rad) takes the air's chord stiffness
+#: instead (:func:`_secant_stiffness`); below it the local slope is within a few per cent of it.
+SECANT_TURN = 0.3
 #: The most a petiole bends (rad): past a right angle, so a leaf whose petiole points upwind
 #: trails downwind of it in a gale instead of being held face-on to the flow.
 PETIOLE_STOP = 0.9 * np.pi
@@ -30,14 +33,58 @@ FLUTTER_SPEED = 4.0
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _leaf_theta(x2):
-    """A petiole joint's θ for x² = (ωh)²: ½ + ½·x⁴/(x⁴ + 10⁴), the trapezoidal rule up to a
-    few steps a period (a leaf's turns stay visible at 30 frames a second, at a turn per frame
-    proportional to the frame's length), toward backward Euler for swings ten times faster.
-    Defined here, not shared with the joints' (``articulated.theta_of``): numba's cache does
-    not see a change in another module's inlined function."""
-    x4 = x2 * x2
-    return 0.5 + 0.5 * x4 / (x4 + 1.0e4)
+def _axis_step(h, J, K, d, f0, f1, th, om):
+    """One step of J·θ̈ + d·θ̇ + K·θ = f0 + f1·t/h from (θ, θ̇) = (th, om): (θ, θ̇) after it.
+
+    The 2-stage Radau IIA method, in closed form. On this linear system it is the exact flow
+    with exp(Z) taken as its (1, 2) Padé approximant R(Z) = (1 − ⅔Z + Z²/6)⁻¹(1 + Z/3)
+    (Z = h·A, A the system's matrix): third order, exact for the forcing's ramp, A-stable (the
+    energy ½(Kθ² + Jθ̇²) never grows unforced, any h) and L-stable (a swing far faster than
+    the step settles in it, as backward Euler's, and never rings at the step rate, as the
+    trapezoidal rule's overdamped modes do). In scaled velocity v = hθ̇, with p = Kh²/J,
+    q = dh/J, φ = h²f/J: x⁺ = x + D⁻¹[(1 − Z/6)(Zx + φ₀e₂) + (½ − Z/6)φ₁e₂],
+    D = 1 − ⅔Z + Z²/6, Z = [[0, 1], [−p, −q]].
+    """
+    hJ = h / J
+    p, q = K * h * hJ, d * hJ
+    ph0, ph1 = h * hJ * f0, h * hJ * f1
+    v = om * h
+    w1 = ph0 - p * th - q * v
+    y0 = v - (w1 + ph1) / 6.0
+    y1 = w1 + (p * v + q * w1) / 6.0 + ph1 * (0.5 + q / 6.0)
+    d00, d01 = 1.0 - p / 6.0, -2.0 / 3.0 - q / 6.0
+    d10, d11 = p * (2.0 / 3.0 + q / 6.0), 1.0 + 2.0 * q / 3.0 + (q * q - p) / 6.0
+    r = 1.0 / (d00 * d11 - d01 * d10)
+    return th + (d11 * y0 - d01 * y1) * r, (v + (d00 * y1 - d10 * y0) * r) / h
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _secant_stiffness(tau, alpha, beta, gamma):
+    """The air's stiffness against a lamina's bend far from the flow: its moment τ(0)/δ* over
+    the turn δ* to where it lets go, or 0 where it never does.
+
+    Turning the lamina by δ about an axis e carries its normal and its lever alike, so the
+    moment about e is τ(δ) = c|U|(e·p)·(α + β cos δ + γ sin δ), α = (e·U)(e·n), β = U·n − α,
+    γ = e·(n × U): a sinusoid. δ* is its first zero in the direction τ(0) turns the lamina,
+    where it comes to rest edge-on (stable: the moment turns back beyond). The local slope
+    −τ′(0) (Newton's step) overshoots past δ* from 67° off the flow on and flips the lamina
+    from side to side; the chord τ(0)/δ* is exact at both ends and steeper than the sinusoid
+    on the way (never overshoots).
+    """
+    sg = 1.0 if tau > 0.0 else -1.0
+    rho = np.sqrt(beta * beta + gamma * gamma)
+    if rho <= abs(alpha):
+        return 0.0
+    # α + β cos t + σγ sin t = α + ρ cos(t − ψ) = 0 for the smallest t > 0
+    psi = np.arctan2(sg * gamma, beta)
+    a = np.arccos(-alpha / rho)
+    t = 4.0 * np.pi
+    for cand in (psi + a, psi - a):
+        cand = cand % (2.0 * np.pi)
+        if cand <= 1e-12:
+            cand += 2.0 * np.pi
+        t = min(t, cand)
+    return abs(tau) / t
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
@@ -186,12 +233,13 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
         # the flutter: its phase and amplitude in the wind at the twig
         u2 = U[b, 0] * U[b, 0] + U[b, 1] * U[b, 1] + U[b, 2] * U[b, 2]
         f = min(FLUTTER_STROUHAL * np.sqrt(u2) / max(size[l], 1e-3), f_max)
+        twist0 = flutter[l] * _sincos(phase[l])[0]
         phase[l] = (phase[l] + 2.0 * np.pi * f * h) % (2.0 * np.pi)
         if not on[l]:
             flutter[l] = 0.0
             continue
         flutter[l] = amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED)
-        twist = flutter[l] * _sincos(phase[l])[0]
+        twist1 = flutter[l] * _sincos(phase[l])[0]
         _leaf_rotation(E[l], th[l], G)
         for i in range(3):
             for j in range(3):
@@ -206,7 +254,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
         ny = RG[1, 0] * n0[l, 0] + RG[1, 1] * n0[l, 1] + RG[1, 2] * n0[l, 2]
         nz = RG[2, 0] * n0[l, 0] + RG[2, 1] * n0[l, 1] + RG[2, 2] * n0[l, 2]
         xx, xy, xz = bx + cx, by + cy, bz + cz  # the centroid from the twig's joint
-        # the twig's velocity and acceleration there
+        # the air relative to the lamina, its twig's motion taken away
         o = _cross(Om[b, 0], Om[b, 1], Om[b, 2], xx, xy, xz)
         ux, uy, uz = U[b, 0] - V[b, 0] - o[0], U[b, 1] - V[b, 1] - o[1], U[b, 2] - V[b, 2] - o[2]
         s = np.sqrt(ux * ux + uy * uy + uz * uz)
@@ -217,10 +265,10 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
         # on the twig: the force's Plücker line a = (x × n, n) through the centroid x, and,
         # the next step taking them implicitly, the point terms α·aaᵀ + β·bbᵀ (b = (x × Û, Û))
         # and the force's stiffness against the twig's turn (:func:`_turn_stiffness`)
-        px, py, pz = _cross(xx, xy, xz, nx, ny, nz)
-        LF[b, 0] += fn * px
-        LF[b, 1] += fn * py
-        LF[b, 2] += fn * pz
+        mx, my, mz = _cross(xx, xy, xz, nx, ny, nz)
+        LF[b, 0] += fn * mx
+        LF[b, 1] += fn * my
+        LF[b, 2] += fn * mz
         LF[b, 3] += fx
         LF[b, 4] += fy
         LF[b, 5] += fz
@@ -228,50 +276,49 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
             q = 1.0 / s
             ex, ey, ez = ux * q, uy * q, uz * q
             rx, ry, rz = _cross(xx, xy, xz, ex, ey, ez)
-            _add_outer(LC, b, c * s, px, py, pz, nx, ny, nz)
+            _add_outer(LC, b, c * s, mx, my, mz, nx, ny, nz)
             _add_outer(LC, b, c * abs(un), rx, ry, rz, ex, ey, ez)
-            _turn_stiffness(LK, b, c * s * s, px, py, pz, nx, ny, nz, ex, ey, ez)
-        # torque about the petiole's base: the bends take its part about the rest axes b₁, b₂
-        # (in the twig's axes, Rᵀτ), the twist its part about the lamina's axis now (Ga): nil
-        # for a force at the centroid, which lies on that axis; the flutter drives it instead
-        t = _cross(cx, cy, cz, fx, fy, fz)
-        tl0 = R[b, 0, 0] * t[0] + R[b, 1, 0] * t[1] + R[b, 2, 0] * t[2]
-        tl1 = R[b, 0, 1] * t[0] + R[b, 1, 1] * t[1] + R[b, 2, 1] * t[2]
-        tl2 = R[b, 0, 2] * t[0] + R[b, 1, 2] * t[1] + R[b, 2, 2] * t[2]
+            _turn_stiffness(LK, b, c * s * s, mx, my, mz, nx, ny, nz, ex, ey, ez)
+        # about the petiole's base the normal force's moment is fn·p (p = x_c × n, x_c the
+        # centroid from the base) and its stiffness against a turn about an axis e (δx_c = e × x_c,
+        # δn = e × n) is −c|U|(e·p)(e·w), w = n × U_rel; in the twig's axes, where E's are
+        px, py, pz = _cross(cx, cy, cz, nx, ny, nz)
+        pl0 = R[b, 0, 0] * px + R[b, 1, 0] * py + R[b, 2, 0] * pz
+        pl1 = R[b, 0, 1] * px + R[b, 1, 1] * py + R[b, 2, 1] * pz
+        pl2 = R[b, 0, 2] * px + R[b, 1, 2] * py + R[b, 2, 2] * pz
+        wx, wy, wz = _cross(nx, ny, nz, ux, uy, uz)
+        wl0 = R[b, 0, 0] * wx + R[b, 1, 0] * wy + R[b, 2, 0] * wz
+        wl1 = R[b, 0, 1] * wx + R[b, 1, 1] * wy + R[b, 2, 1] * wz
+        wl2 = R[b, 0, 2] * wx + R[b, 1, 2] * wy + R[b, 2, 2] * wz
         lever2 = rc0[l, 0] ** 2 + rc0[l, 1] ** 2 + rc0[l, 2] ** 2
         dair = max(cswing[l], c) * s * lever2  # the air against the lamina's own swing
         for i in range(3):
             kk = k[l, i]
-            ka = 0.0
-            if i == 0:  # the lamina rolling about its axis: its halves swing through the air
-                tau = kk * twist
+            if i == 0:
+                # the twist: nil for a force at the centroid, which lies on the lamina's axis;
+                # the flutter drives it (its torque a ramp over the step), the lamina's halves
+                # swinging through the air damp it
+                K, f0, f1 = kk, kk * twist0, kk * (twist1 - twist0)
                 d = dstr[l, i] + cswing[l] * s * roll2[l]
             else:
-                tau = E[l, 0, i] * tl0 + E[l, 1, i] * tl1 + E[l, 2, i] * tl2
+                # a bend: the air's moment linearised about the step's start, its stiffness
+                # taken implicitly where it restores (a lamina weathervaning into the flow)
+                ep = E[l, 0, i] * pl0 + E[l, 1, i] * pl1 + E[l, 2, i] * pl2
+                ew = E[l, 0, i] * wl0 + E[l, 1, i] * wl1 + E[l, 2, i] * wl2
+                tau = fn * ep
+                ka = max(0.0, -c * s * ep * ew)
+                if abs(tau) > SECANT_TURN * ka:  # far from the flow: the chord to where it lets go
+                    ex = R[b, 0, 0] * E[l, 0, i] + R[b, 0, 1] * E[l, 1, i] + R[b, 0, 2] * E[l, 2, i]
+                    ey = R[b, 1, 0] * E[l, 0, i] + R[b, 1, 1] * E[l, 1, i] + R[b, 1, 2] * E[l, 2, i]
+                    ez = R[b, 2, 0] * E[l, 0, i] + R[b, 2, 1] * E[l, 1, i] + R[b, 2, 2] * E[l, 2, i]
+                    eu = ex * ux + ey * uy + ez * uz
+                    en = ex * nx + ey * ny + ez * nz
+                    ka = max(ka, _secant_stiffness(tau, eu * en, un - eu * en, ew))
+                K, f0, f1 = kk + ka, tau + ka * th[l, i], 0.0
                 d = dstr[l, i] + dair
-                # the air's stiffness against a turn about this axis e (world), taken implicitly
-                # where it restores (a lamina weathervaning into the flow): −e·∂τ/∂θ with
-                # ∂r = e × r, ∂n = e × n
-                ex = R[b, 0, 0] * E[l, 0, i] + R[b, 0, 1] * E[l, 1, i] + R[b, 0, 2] * E[l, 2, i]
-                ey = R[b, 1, 0] * E[l, 0, i] + R[b, 1, 1] * E[l, 1, i] + R[b, 1, 2] * E[l, 2, i]
-                ez = R[b, 2, 0] * E[l, 0, i] + R[b, 2, 1] * E[l, 1, i] + R[b, 2, 2] * E[l, 2, i]
-                dr = _cross(ex, ey, ez, cx, cy, cz)
-                dn = _cross(ex, ey, ez, nx, ny, nz)
-                udn = ux * dn[0] + uy * dn[1] + uz * dn[2]
-                g0 = c * s * (udn * nx + un * dn[0])
-                g1 = c * s * (udn * ny + un * dn[1])
-                g2 = c * s * (udn * nz + un * dn[2])
-                t1 = _cross(dr[0], dr[1], dr[2], fx, fy, fz)
-                t2 = _cross(cx, cy, cz, g0, g1, g2)
-                ka = max(0.0, -(ex * (t1[0] + t2[0]) + ey * (t1[1] + t2[1]) + ez * (t1[2] + t2[2])))
-            kt = kk + ka
-            tl = _leaf_theta(h * h * kt / J[l, i])
-            hth = h * tl
-            num = h * (tau - kk * th[l, i] - (d + hth * kt) * thd[l, i])
-            dd = num / (J[l, i] + hth * d + hth * hth * kt)
-            turn = h * (thd[l, i] + tl * dd)
-            v = thd[l, i] + dd
-            if abs(turn) > MAX_TURN:
+            t1, v = _axis_step(h, J[l, i], K, d, f0, f1, th[l, i], thd[l, i])
+            turn = t1 - th[l, i]
+            if abs(turn) > MAX_TURN:  # a guard (see MAX_TURN)
                 v *= MAX_TURN / abs(turn)
                 turn = MAX_TURN if turn > 0.0 else -MAX_TURN
             th[l, i] += turn
