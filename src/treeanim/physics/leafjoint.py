@@ -16,8 +16,8 @@ __all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP", "FLUTTER_STROU
 #: leaf from side to side. Capping the turn (and the speed with it: energy is only taken
 #: away) keeps each step where the linearisation holds.
 MAX_TURN = 0.4
-#: A bend whose Newton step τ/k_air would pass this (rad) takes the air's chord stiffness
-#: instead (:func:`_secant_stiffness`); below it the local slope is within a few per cent of it.
+#: A bend whose Newton step (τ − kθ)/(k + k_air) would pass this (rad) takes the air's chord
+#: stiffness (:func:`_secant_stiffness`); below it the local slope is within a few per cent of it.
 SECANT_TURN = 0.3
 #: The most a petiole bends (rad): past a right angle, so a leaf whose petiole points upwind
 #: trails downwind of it in a gale instead of being held face-on to the flow.
@@ -307,7 +307,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
                 ew = E[l, 0, i] * wl0 + E[l, 1, i] * wl1 + E[l, 2, i] * wl2
                 tau = fn * ep
                 ka = max(0.0, -c * s * ep * ew)
-                if abs(tau) > SECANT_TURN * ka:  # far from the flow: the chord to where it lets go
+                if abs(tau - kk * th[l, i]) > SECANT_TURN * (kk + ka):  # far from rest: the air's chord
                     ex = R[b, 0, 0] * E[l, 0, i] + R[b, 0, 1] * E[l, 1, i] + R[b, 0, 2] * E[l, 2, i]
                     ey = R[b, 1, 0] * E[l, 0, i] + R[b, 1, 1] * E[l, 1, i] + R[b, 1, 2] * E[l, 2, i]
                     ez = R[b, 2, 0] * E[l, 0, i] + R[b, 2, 1] * E[l, 1, i] + R[b, 2, 2] * E[l, 2, i]
