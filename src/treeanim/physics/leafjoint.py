@@ -337,6 +337,24 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
             thd[l, 2] *= sc
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _matrix_quat(M):
+    """The unit quaternion (w, x, y, z) of the rotation matrix M (Shepperd: from its largest
+    diagonal term)."""
+    t = M[0, 0] + M[1, 1] + M[2, 2]
+    if t > 0.0:
+        s = 2.0 * np.sqrt(t + 1.0)
+        return 0.25 * s, (M[2, 1] - M[1, 2]) / s, (M[0, 2] - M[2, 0]) / s, (M[1, 0] - M[0, 1]) / s
+    if M[0, 0] > M[1, 1] and M[0, 0] > M[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + M[0, 0] - M[1, 1] - M[2, 2])
+        return (M[2, 1] - M[1, 2]) / s, 0.25 * s, (M[0, 1] + M[1, 0]) / s, (M[0, 2] + M[2, 0]) / s
+    if M[1, 1] > M[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + M[1, 1] - M[0, 0] - M[2, 2])
+        return (M[0, 2] - M[2, 0]) / s, (M[0, 1] + M[1, 0]) / s, 0.25 * s, (M[1, 2] + M[2, 1]) / s
+    s = 2.0 * np.sqrt(1.0 + M[2, 2] - M[0, 0] - M[1, 1])
+    return (M[1, 0] - M[0, 1]) / s, (M[0, 2] + M[2, 0]) / s, (M[1, 2] + M[2, 1]) / s, 0.25 * s
+
+
 @njit(cache=True, fastmath=True, error_model="numpy")
 def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf_first, leaf_body, leaf_E,
                leaf_th, leaf_on, pos, rot):
@@ -347,7 +365,8 @@ def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf
     segment i turning by (i + 1)/k of the leaf's bend and twist against its twig; its tip
     node (the lamina) the whole turn.
     """
-    G = np.empty((3, 3))
+    last = -1
+    Qw = Qx = Qy = Qz = 0.0
     for b in range(body_node.shape[0]):
         j = body_node[b]
         for i in range(3):
@@ -368,6 +387,9 @@ def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf
         e = leaf_first[l + 1]
         k = e - a - 1
         jb = body_node[b]
+        if b != last:  # the twig's rotation as a quaternion (leaves come twig by twig)
+            last = b
+            Qw, Qx, Qy, Qz = _matrix_quat(R[b])
         # the petiole's base on its twig
         for i in range(3):
             s = P[b, i]
@@ -375,7 +397,8 @@ def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf
                 s += R[b, i, c] * (Xrest[leaf_nodes[a], c] - Xrest[jb, c])
             pos[leaf_nodes[a], i] = s
         # segment q turns by G_q = B^((q+1)/k)·T^((q+1)/k), the bend B and twist T each about
-        # one axis: as quaternions whose half angles grow by one k-th a segment (angle addition)
+        # one axis: as quaternions whose half angles grow by one k-th a segment (angle addition),
+        # then the twig's turn on top (R·G_q, the quaternions' product)
         on = 1.0 if leaf_on[l] else 0.0
         ax, ay, az = leaf_E[l, 0, 0], leaf_E[l, 1, 0], leaf_E[l, 2, 0]
         vx = on * (leaf_E[l, 0, 1] * leaf_th[l, 1] + leaf_E[l, 0, 2] * leaf_th[l, 2])
@@ -399,12 +422,10 @@ def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf
             qx = cb * st * ax + ct * sb * bx + sb * st * cx_
             qy = cb * st * ay + ct * sb * by + sb * st * cy_
             qz = cb * st * az + ct * sb * bz + sb * st * cz_
-            _quat_matrix(qw, qx, qy, qz, G)
             n0 = leaf_nodes[a + q]
             n1 = leaf_nodes[a + q + 1]
-            for i in range(3):
-                for c in range(3):
-                    rot[n0, i, c] = R[b, i, 0] * G[0, c] + R[b, i, 1] * G[1, c] + R[b, i, 2] * G[2, c]
+            _quat_matrix(Qw * qw - Qx * qx - Qy * qy - Qz * qz, Qw * qx + Qx * qw + Qy * qz - Qz * qy,
+                         Qw * qy - Qx * qz + Qy * qw + Qz * qx, Qw * qz + Qx * qy - Qy * qx + Qz * qw, rot[n0])
             for i in range(3):
                 s = pos[n0, i]
                 for c in range(3):
