@@ -36,8 +36,9 @@ FLUTTER_SPEED = 4.0
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _axis_step(h, J, K, d, f0, f1, th, om):
-    """One step of J·θ̈ + d·θ̇ + K·θ = f0 + f1·t/h from (θ, θ̇) = (th, om): (θ, θ̇) after it.
+def _axis_step(h, ih, J, K, d, f0, f1, th, om):
+    """One step of J·θ̈ + d·θ̇ + K·θ = f0 + f1·t/h from (θ, θ̇) = (th, om): (θ, θ̇) after it
+    (ih = 1/h).
 
     The 2-stage Radau IIA method, in closed form. On this linear system it is the exact flow
     with exp(Z) taken as its (1, 2) Padé approximant R(Z) = (1 − ⅔Z + Z²/6)⁻¹(1 + Z/3)
@@ -58,7 +59,7 @@ def _axis_step(h, J, K, d, f0, f1, th, om):
     d00, d01 = 1.0 - p / 6.0, -2.0 / 3.0 - q / 6.0
     d10, d11 = p * (2.0 / 3.0 + q / 6.0), 1.0 + 2.0 * q / 3.0 + (q * q - p) / 6.0
     r = 1.0 / (d00 * d11 - d01 * d10)
-    return th + (d11 * y0 - d01 * y1) * r, (v + (d00 * y1 - d10 * y0) * r) / h
+    return th + (d11 * y0 - d01 * y1) * r, (v + (d00 * y1 - d10 * y0) * r) * ih
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -177,7 +178,7 @@ def _turn_stiffness(K, b, cs2, px, py, pz, nx, ny, nz, ex, ey, ez):
 
 @njit(cache=True, fastmath=True, error_model="numpy")
 def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, cauchy, size, R, P, Om, V, U,
-              amp, phase, flutter, th, thd, LF, LC, LK):
+              amp, phase, twist, th, thd, LF, LC, LK):
     """Advance every leaf's petiole joint (bend about two axes and twist) over one step, and
     give the force it passes to its twig for the next.
 
@@ -214,10 +215,11 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
     R, P, Om, V : the twigs' new kinematics.
     U : (B, 3) — the wind at each twig body (m/s); a leaf takes its twig's.
     amp : float — the largest flutter angle (rad), reached edge-on in a strong wind.
-    phase, flutter : (L,) — the flutter's phase (rad) and amplitude (rad), advanced in place:
-        a frequency St·|U|/ℓ (:data:`FLUTTER_STROUHAL`; at most :data:`MAX_FLUTTER_HZ` and a
-        quarter of the step rate), an amplitude ``amp``·U²/(U² + :data:`FLUTTER_SPEED`²). The
-        flutter's twist, flutter·sin(phase), drives the twist through its torque k_t·flutter.
+    phase, twist : (L,) — the flutter's phase and its twist φ (rad), advanced in place: a
+        frequency St·|U|/ℓ (:data:`FLUTTER_STROUHAL`; at most :data:`MAX_FLUTTER_HZ` and a
+        quarter of the step rate), an amplitude ``amp``·U²/(U² + :data:`FLUTTER_SPEED`²),
+        φ = amplitude·sin(phase). It drives the petiole's twist through its torque k_t·φ, a
+        ramp over the step from φ's value at its start to its value at its end.
     th, thd : (L, 3) — the state, advanced in place.
     LF, LC, LK : (B, 6), (B, 6, 6), (B, 3, 3) — written: summed over each twig's leaves, the
         laminas' spatial force (world, N, about the twig's joint), their air damping there as
@@ -232,18 +234,19 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
     LC[:] = 0.0
     LK[:] = 0.0
     f_max = min(MAX_FLUTTER_HZ, 0.25 / h)
+    ih = 1.0 / h
     for l in range(body.shape[0]):
         b = body[l]
         # the flutter: its phase and amplitude in the wind at the twig
         u2 = U[b, 0] * U[b, 0] + U[b, 1] * U[b, 1] + U[b, 2] * U[b, 2]
         f = min(FLUTTER_STROUHAL * np.sqrt(u2) / max(size[l], 1e-3), f_max)
-        twist0 = flutter[l] * _sincos(phase[l])[0]
-        phase[l] = (phase[l] + 2.0 * np.pi * f * h) % (2.0 * np.pi)
+        ph = phase[l] + 2.0 * np.pi * f * h  # less than 4π: f ≤ 1/(4h)
+        phase[l] = ph - 2.0 * np.pi if ph >= 2.0 * np.pi else ph  # exact (Sterbenz)
+        twist0 = twist[l]
         if not on[l]:
-            flutter[l] = 0.0
+            twist[l] = 0.0
             continue
-        flutter[l] = amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED)
-        twist1 = flutter[l] * _sincos(phase[l])[0]
+        twist[l] = amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED) * _sincos(phase[l])[0]
         _leaf_rotation(E[l], th[l], G)
         for i in range(3):
             for j in range(3):
@@ -302,7 +305,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
                 # the twist: nil for a force at the centroid, which lies on the lamina's axis;
                 # the flutter drives it (its torque a ramp over the step), the lamina's halves
                 # swinging through the air damp it
-                K, f0, f1 = kk, kk * twist0, kk * (twist1 - twist0)
+                K, f0, f1 = kk, kk * twist0, kk * (twist[l] - twist0)
                 d = dstr[l, i] + cswing[l] * s * roll2[l]
             else:
                 # a bend: the air's moment linearised about the step's start, its stiffness
@@ -320,7 +323,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
                     ka = max(ka, _secant_stiffness(tau, eu * en, un - eu * en, ew))
                 K, f0, f1 = kk + ka, tau + ka * th[l, i], 0.0
                 d = dstr[l, i] + dair
-            t1, v = _axis_step(h, J[l, i], K, d, f0, f1, th[l, i], thd[l, i])
+            t1, v = _axis_step(h, ih, J[l, i], K, d, f0, f1, th[l, i], thd[l, i])
             turn = t1 - th[l, i]
             if i > 0 and abs(turn) > MAX_TURN:  # the guard (see MAX_TURN): speed cut with it
                 v *= MAX_TURN / abs(turn)

@@ -6,12 +6,13 @@ and writes the next one. One step:
 
 1. the wind at every segment's middle (the pose at the start), a leaf taking its twig's;
 2. the air's force on every segment, ½ρC_d·d·ℓ|U⊥|U⊥ of the wind normal to it relative to the
-   segment's own motion, and the leaves' forces of the last step, with the damping of both
-   implicit; pulls (constant forces) and grabs (stiff springs to targets, implicit);
+   segment's own motion, and the leaves' forces of the last step (summed per twig), with the
+   damping and turn stiffness of both implicit; pulls (constant forces) and grabs (stiff
+   springs to targets, implicit);
 3. the articulated-body step (:func:`~treeanim.physics.articulated.articulated_step`);
 4. the new pose of every body, kept above the ground (:func:`~treeanim.physics.kinematics.ground_contact`);
 5. every leaf's flutter and petiole joint (:func:`~treeanim.physics.leafjoint.leaf_step`), its
-   force kept for the twig's next step.
+   force, air damping and turn stiffness summed per twig for the twig's next step.
 """
 
 from __future__ import annotations
@@ -47,7 +48,7 @@ class TreeState:
     leaf_C: np.ndarray  # (B, 6, 6) their air damping there, Σ PᵀCP (N·s/m; times h in the step)
     leaf_K: np.ndarray  # (B, 3, 3) their stiffness against the twig's turn (N·m; times h²)
     phase: np.ndarray   # (L,) flutter phase (rad)
-    flutter: np.ndarray  # (L,) flutter amplitude (rad)
+    twist: np.ndarray   # (L,) the flutter's twist (rad)
 
     @classmethod
     def rest(cls, s: Structure, seed: int = 0) -> "TreeState":
@@ -57,7 +58,7 @@ class TreeState:
                  P=np.empty((B, 3)), Om=np.empty((B, 3)), V=np.empty((B, 3)),
                  th=np.zeros((L, 3)), thd=np.zeros((L, 3)), leaf_F=np.zeros((B, 6)),
                  leaf_C=np.zeros((B, 6, 6)), leaf_K=np.zeros((B, 3, 3)),
-                 phase=np.random.default_rng([int(seed), 0x1EAF]).uniform(0, 2 * np.pi, L), flutter=np.zeros(L))
+                 phase=np.random.default_rng([int(seed), 0x1EAF]).uniform(0, 2 * np.pi, L), twist=np.zeros(L))
         forward_kinematics(s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
         return st
 
@@ -240,7 +241,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     ground_contact(s.parent, s.r0, s.seg0, s.floor, out.Q, out.w, out.R, out.P, out.Om, out.V)
     leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
               s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, s.leaf_cauchy, s.leaf_size,
-              out.R, out.P, out.Om, out.V, Ub, float(leaf_flutter), out.phase, out.flutter, out.th, out.thd,
+              out.R, out.P, out.Om, out.V, Ub, float(leaf_flutter), out.phase, out.twist, out.th, out.thd,
               out.leaf_F, out.leaf_C, out.leaf_K)
     out.time = st.time + dt
 
