@@ -99,7 +99,16 @@ def sample_points(s: Structure, st: TreeState) -> np.ndarray:
     """(B, 3) world points where the wind is sampled: the segments' middles. A leaf takes its
     twig segment's wind: the wind varies over metres (its integral scale is the canopy's
     height), a leaf sits centimetres from its twig."""
-    return st.P + np.einsum("bij,bj->bi", st.R, s.mid0)
+    out = np.empty_like(st.P)
+    _midpoints(st.P, st.R, s.mid0, out)
+    return out
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _midpoints(P, R, mid0, out):
+    for b in range(P.shape[0]):
+        for i in range(3):
+            out[b, i] = P[b, i] + R[b, i, 0] * mid0[b, 0] + R[b, i, 1] * mid0[b, 1] + R[b, i, 2] * mid0[b, 2]
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
