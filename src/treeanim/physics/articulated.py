@@ -38,7 +38,7 @@ import numpy as np
 
 from .compiled import njit
 
-__all__ = ["theta_of", "articulated_step", "rot_log", "rot_exp", "add_point", "positive_part", "JOINT_STOP"]
+__all__ = ["theta_of", "articulated_step", "rot_log", "rot_exp", "add_point", "JOINT_STOP"]
 
 #: The most a joint turns against its parent (rad): beyond it a segment stops, its outward
 #: speed taken away (a soft grass blade can fold; no joint wraps past π).
@@ -465,23 +465,6 @@ def add_point(kap, b, alpha, b1, e1x, e1y, e1z, b2, e2x, e2y, e2z, rx, ry, rz):
     kap[b, 5, 3] += c02
     kap[b, 5, 4] += c12
     kap[b, 5, 5] += c22
-
-
-@njit(cache=True, fastmath=True, error_model="numpy")
-def positive_part(K):
-    """Make a 3×3 stiffness K (in place) safe to take implicitly: its symmetric part, made
-    positive by Gershgorin's shift."""
-    for i in range(3):
-        for j in range(i + 1, 3):
-            m = 0.5 * (K[i, j] + K[j, i])
-            K[i, j] = m
-            K[j, i] = m
-    shift = 0.0
-    for i in range(3):
-        g = K[i, i] - abs(K[i, (i + 1) % 3]) - abs(K[i, (i + 2) % 3])
-        shift = max(shift, -g)
-    for i in range(3):
-        K[i, i] += shift
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")

@@ -15,8 +15,8 @@ __all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP", "FLUTTER_STROU
 #: chord to where the lamina lets go far from it, :func:`_secant_stiffness`), exact at both
 #: ends along the axis but not across the axes nor as the lamina's own speed changes the air
 #: on it; a turn this large leaves that model. In a 30 m/s wind it binds on 0.02–0.03 % of
-#: the large cherry's leaf steps at 1/60 s, each a lamina swinging round into the flow (never
-#: back and forth), 3 % at 1/10 s. The twist, linear (driven by the flutter, damped by the
+#: the large cherry's leaf steps at 1/60 s, each a lamina swinging round into the flow, 3 %
+#: at 1/10 s. The twist, linear (driven by the flutter, damped by the
 #: air against the lamina's roll), has no such limit.
 MAX_TURN = 0.4
 #: A bend whose Newton step (τ − kθ)/(k + k_air) would pass this (rad) takes the air's chord
@@ -36,30 +36,28 @@ FLUTTER_SPEED = 4.0
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _axis_step(h, ih, J, K, d, f0, f1, th, om):
-    """One step of J·θ̈ + d·θ̇ + K·θ = f0 + f1·t/h from (θ, θ̇) = (th, om): (θ, θ̇) after it
-    (ih = 1/h).
+def _axis_step(h, J, K, d, f0, f1, th, om):
+    """One step of J·θ̈ + d·θ̇ + K·θ = f0 + f1·t/h from (θ, θ̇) = (th, om): (θ, θ̇) after it.
 
     The 2-stage Radau IIA method, in closed form. On this linear system it is the exact flow
     with exp(Z) taken as its (1, 2) Padé approximant R(Z) = (1 − ⅔Z + Z²/6)⁻¹(1 + Z/3)
     (Z = h·A, A the system's matrix): third order, exact for the forcing's ramp, A-stable (the
     energy ½(Kθ² + Jθ̇²) never grows unforced, any h) and L-stable (a swing far faster than
     the step settles in it, as backward Euler's, and never rings at the step rate, as the
-    trapezoidal rule's overdamped modes do). In scaled velocity v = hθ̇, with p = Kh²/J,
-    q = dh/J, φ = h²f/J: x⁺ = x + D⁻¹[(1 − Z/6)(Zx + φ₀e₂) + (½ − Z/6)φ₁e₂],
-    D = 1 − ⅔Z + Z²/6, Z = [[0, 1], [−p, −q]].
+    trapezoidal rule's overdamped modes do). With a = Kh/J, q = dh/J, φ = hf/J:
+    x⁺ = D⁻¹[N·x + (1 − Z/6)φ₀e₂ + (½ − Z/6)φ₁e₂], N = 1 + Z/3, D = 1 − ⅔Z + Z²/6,
+    Z = [[0, h], [−a, −q]] (no division by h: a step of 10⁻³²⁰ s is a step).
     """
     hJ = h / J
-    p, q = K * h * hJ, d * hJ
-    ph0, ph1 = h * hJ * f0, h * hJ * f1
-    v = om * h
-    w1 = ph0 - p * th - q * v
-    y0 = v - (w1 + ph1) / 6.0
-    y1 = w1 + (p * v + q * w1) / 6.0 + ph1 * (0.5 + q / 6.0)
-    d00, d01 = 1.0 - p / 6.0, -2.0 / 3.0 - q / 6.0
-    d10, d11 = p * (2.0 / 3.0 + q / 6.0), 1.0 + 2.0 * q / 3.0 + (q * q - p) / 6.0
-    r = 1.0 / (d00 * d11 - d01 * d10)
-    return th + (d11 * y0 - d01 * y1) * r, (v + (d00 * y1 - d10 * y0) * r) * ih
+    a, q = K * hJ, d * hJ
+    ph0, ph1 = hJ * f0, hJ * f1
+    y0 = th + h * (om / 3.0 - (ph0 + ph1) / 6.0)
+    y1 = om - (a * th + q * om) / 3.0 + ph0 * (1.0 + q / 6.0) + ph1 * (0.5 + q / 6.0)
+    p = a * h
+    d00, d01 = 1.0 - p / 6.0, -h * (2.0 / 3.0 + q / 6.0)
+    d10, d11 = a * (2.0 / 3.0 + q / 6.0), 1.0 + 2.0 * q / 3.0 + (q * q - p) / 6.0
+    r = 1.0 / (1.0 + q * (2.0 / 3.0 + q / 6.0) + p * ((1.0 + q) / 9.0 + p / 36.0))  # det D, a sum of positives
+    return (d11 * y0 - d01 * y1) * r, (d00 * y1 - d10 * y0) * r
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -71,9 +69,10 @@ def _secant_stiffness(tau, alpha, beta, gamma):
     moment about e is τ(δ) = c|U|(e·p)·(α + β cos δ + γ sin δ), α = (e·U)(e·n), β = U·n − α,
     γ = e·(n × U): a sinusoid. δ* is its first zero in the direction τ(0) turns the lamina,
     where it comes to rest edge-on (stable: the moment turns back beyond). The local slope
-    −τ′(0) (Newton's step) overshoots past δ* from 67° off the flow on and flips the lamina
-    from side to side; the chord τ(0)/δ* is exact at both ends and steeper than the sinusoid
-    on the way (never overshoots).
+    −τ′(0) (Newton's step) always lands beyond δ*, from 67° off the flow on farther beyond
+    it than it started, and flipped laminas from side to side; the chord τ(0)/δ* is exact at
+    both ends, so a step long against the lamina's settling lands on δ*, a shorter one short
+    of it.
     """
     sg = 1.0 if tau > 0.0 else -1.0
     rho = np.sqrt(beta * beta + gamma * gamma)
@@ -158,11 +157,12 @@ def _add_outer(C, b, w, a0, a1, a2, a3, a4, a5):
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
 def _turn_stiffness(K, b, cs2, px, py, pz, nx, ny, nz, ex, ey, ez):
-    """K[b] += the positive part (:func:`~treeanim.physics.articulated.positive_part`) of
-    Ka = −∂τ/∂φ, upper triangle only, for a lamina's normal force F = c|U|²(Û·n)n at x on its
-    twig, the twig turning by δφ (δx = δφ × x, δn = δφ × n): the leaves' pull on a twig as it
-    turns. ∂τ/∂φ = c|U|²[(Û·n)(x nᵀ − n xᵀ) + p qᵀ] with p = x × n, q = n × Û (Û = (ex, ey,
-    ez)); its symmetric part is −½c|U|²(p qᵀ + q pᵀ)."""
+    """K[b] += the symmetric part of Ka = −∂τ/∂φ made positive by Gershgorin's shift (as
+    :func:`~treeanim.physics.treestep._add_turn` takes a segment's), upper triangle only, for a
+    lamina's normal force F = c|U|²(Û·n)n at x on its twig, the twig turning by δφ
+    (δx = δφ × x, δn = δφ × n): the leaves' pull on a twig as it turns.
+    ∂τ/∂φ = c|U|²[(Û·n)(x nᵀ − n xᵀ) + p qᵀ] with p = x × n, q = n × Û (Û = (ex, ey, ez));
+    the first term is skew, so the symmetric part of Ka is −½c|U|²(p qᵀ + q pᵀ)."""
     qx, qy, qz = _cross(nx, ny, nz, ex, ey, ez)
     w = -0.5 * cs2
     k00, k11, k22 = 2.0 * w * px * qx, 2.0 * w * py * qy, 2.0 * w * pz * qz
@@ -234,7 +234,6 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
     LC[:] = 0.0
     LK[:] = 0.0
     f_max = min(MAX_FLUTTER_HZ, 0.25 / h)
-    ih = 1.0 / h
     for l in range(body.shape[0]):
         b = body[l]
         # the flutter: its phase and amplitude in the wind at the twig
@@ -314,7 +313,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
                 ew = E[l, 0, i] * wl0 + E[l, 1, i] * wl1 + E[l, 2, i] * wl2
                 tau = fn * ep
                 ka = max(0.0, -c * s * ep * ew)
-                if abs(tau - kk * th[l, i]) > SECANT_TURN * (kk + ka):  # far from rest: the air's chord
+                if abs(tau - kk * th[l, i]) > SECANT_TURN * (kk + ka):  # far from rest: the chord
                     ex = R[b, 0, 0] * E[l, 0, i] + R[b, 0, 1] * E[l, 1, i] + R[b, 0, 2] * E[l, 2, i]
                     ey = R[b, 1, 0] * E[l, 0, i] + R[b, 1, 1] * E[l, 1, i] + R[b, 1, 2] * E[l, 2, i]
                     ez = R[b, 2, 0] * E[l, 0, i] + R[b, 2, 1] * E[l, 1, i] + R[b, 2, 2] * E[l, 2, i]
@@ -323,7 +322,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
                     ka = max(ka, _secant_stiffness(tau, eu * en, un - eu * en, ew))
                 K, f0, f1 = kk + ka, tau + ka * th[l, i], 0.0
                 d = dstr[l, i] + dair
-            t1, v = _axis_step(h, ih, J[l, i], K, d, f0, f1, th[l, i], thd[l, i])
+            t1, v = _axis_step(h, J[l, i], K, d, f0, f1, th[l, i], thd[l, i])
             turn = t1 - th[l, i]
             if i > 0 and abs(turn) > MAX_TURN:  # the guard (see MAX_TURN): speed cut with it
                 v *= MAX_TURN / abs(turn)

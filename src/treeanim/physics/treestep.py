@@ -22,7 +22,7 @@ from typing import Sequence
 
 import numpy as np
 
-from .articulated import add_point, articulated_step, positive_part, rot_log, theta_of
+from .articulated import add_point, articulated_step, rot_log, theta_of
 from .compiled import njit
 from .kinematics import forward_kinematics, ground_contact
 from .leafjoint import leaf_step, pose_nodes
@@ -185,10 +185,20 @@ def _turn_stiffness(b, h, cda, un, ux, uy, uz, ua, ax, ay, az, rx, ry, rz, fx, f
 
 @njit(cache=True, fastmath=True, error_model="numpy")
 def _add_turn(b, h, Ka, Om, F, kap):
-    """Take a turn stiffness Ka of body b implicitly (backward Euler): its positive part
-    (:func:`~treeanim.physics.articulated.positive_part`) joins the body's rotational inertia
-    as h²K and its moment as −hKω."""
-    positive_part(Ka)
+    """Take a turn stiffness Ka of body b implicitly (backward Euler): its symmetric part,
+    made positive by Gershgorin's shift, joins the body's rotational inertia as h²K and its
+    moment as −hKω."""
+    for i in range(3):
+        for j in range(i + 1, 3):
+            m = 0.5 * (Ka[i, j] + Ka[j, i])
+            Ka[i, j] = m
+            Ka[j, i] = m
+    shift = 0.0
+    for i in range(3):
+        g = Ka[i, i] - abs(Ka[i, (i + 1) % 3]) - abs(Ka[i, (i + 2) % 3])
+        shift = max(shift, -g)
+    for i in range(3):
+        Ka[i, i] += shift
     for i in range(3):
         F[b, i] -= h * (Ka[i, 0] * Om[b, 0] + Ka[i, 1] * Om[b, 1] + Ka[i, 2] * Om[b, 2])
         for j in range(3):
