@@ -389,7 +389,7 @@ def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf
         e = leaf_first[l + 1]
         k = e - a - 1
         jb = body_node[b]
-        if b != last:  # the twig's rotation as a quaternion (leaves come twig by twig)
+        if b != last:  # the twig's rotation as a quaternion (kept while its leaves follow)
             last = b
             Qw, Qx, Qy, Qz = _matrix_quat(R[b])
         # the petiole's base on its twig
