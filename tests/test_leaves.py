@@ -122,7 +122,7 @@ def at_the_guard(turns):
 
 
 def test_in_a_storm_a_leaf_turns_as_the_air_turns_it_not_by_the_steps_largest_turn():
-    # Before (issue 26), in a 30 m/s wind at 1/60 s, 2.3 % of the large cherry's leaf steps
+    # Before (issue 26), in a 30 m/s wind at 1/60 s, 2.8 % of the large cherry's leaf steps
     # turned an axis by the most a step may (leafjoint.MAX_TURN, 0.4 rad): the θ-method rang
     # the flutter-driven twist (its trapezoidal rule slows a 20 Hz petiole toward the 12 Hz
     # flutter) and the air's local slope sent a lamina far from the flow past it.
