@@ -50,7 +50,8 @@ HYSTERESIS = 0.15
 SEGMENT_DRAG = 3.0 * np.pi / 16.0
 #: The same of a lamina's normal force, ⟨cos²⟩ over the sphere.
 LEAF_DRAG = 1.0 / 3.0
-_BODY_STATE = ("Q", "w", "R", "P", "Om", "V")  # TreeState's per-body arrays (the others are per leaf)
+_BODY_STATE = ("Q", "w", "R", "P", "Om", "V", "leaf_F", "leaf_C", "leaf_K")  # TreeState's per-body arrays (the
+# others are per leaf)
 _LEAF_POSE = ("leaf_nodes", "leaf_first")  # Structure's leaf arrays that only the pose reads
 
 
@@ -152,8 +153,9 @@ class Reduced:
         self.body_index = np.full(len(on), -1, np.int64)
         self.body_index[self.bodies] = np.arange(len(self.bodies))
         resting = np.flatnonzero(~leaf_on)
-        for a in (st.thd, st.leaf_F, st.leaf_kap, st.leaf_kap2):
-            a[resting] = 0.0
+        st.thd[resting] = 0.0
+        for a in (st.leaf_F, st.leaf_C, st.leaf_K):  # (a frozen twig's leaves pass it no force)
+            a[self.frozen] = 0.0
         st.w[self.frozen] = 0.0
         carry(self.frozen, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
         anc = _anchors(s.parent, on)
