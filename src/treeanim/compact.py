@@ -38,8 +38,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .loop import _conj, _exp, _log, _mul, angles
-from .pose import _levels, _rest, displacement, world_pose
+from .loop import _conj, _mul, angles
+from .physics.compiled import njit
+from .pose import _levels, _qmul, _rest, displacement, world_pose
 
 __all__ = ["PRECISIONS", "TOLERANCE", "decode", "encode", "error", "positions", "reach", "report", "runs", "shorts", "strides",
            "unit"]
@@ -122,13 +123,32 @@ def reach(tree, skel, pos: np.ndarray, joint: np.ndarray) -> np.ndarray:
 def _thin(keys: np.ndarray, s: int) -> np.ndarray:
     """(F, J, 4) the keys a client plays from every s-th key of ``keys`` (F, J, 4), F − 1 a
     multiple of s: a slerp between neighbouring kept keys."""
-    kept = keys[::s]
-    f = np.arange(len(keys))
-    i = np.minimum(f // s, len(kept) - 2)
-    u = ((f - i * s) / s)[:, None, None]
-    a, b = kept[i], kept[i + 1]
-    b = np.where(np.sum(a * b, axis=-1, keepdims=True) < 0, -b, b)
-    return _mul(a, _exp(u * _log(_mul(_conj(a), b))))
+    out = np.empty(keys.shape)
+    _slerps(np.ascontiguousarray(keys, np.float64), s, out)
+    return out
+
+
+@njit(cache=True)
+def _slerps(keys, s, out):
+    """out[f, j] = a (a⁻¹b)^u: a, b the kept keys around frame f (b's sign taken nearer a),
+    u = (f − i s)/s; ``_mul(a, _exp(u * _log(_mul(_conj(a), b))))`` per element."""
+    F, J = keys.shape[0], keys.shape[1]
+    last = (F - 1) // s - 1
+    for f in range(F):
+        i = min(f // s, last)
+        u = (f - i * s) / s
+        for j in range(J):
+            a, b = keys[i * s, j], keys[(i + 1) * s, j]
+            sign = -1.0 if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] < 0 else 1.0
+            dx, dy, dz, dw = _qmul((-a[0], -a[1], -a[2], a[3]), (sign * b[0], sign * b[1], sign * b[2], sign * b[3]))
+            if dw < 0:  # the shorter way round
+                dx, dy, dz, dw = -dx, -dy, -dz, -dw
+            sn = np.sqrt(dx * dx + dy * dy + dz * dz)
+            k = 2.0 * np.arctan2(sn, dw) / sn if sn > 1e-12 else 2.0
+            rx, ry, rz = u * dx * k, u * dy * k, u * dz * k
+            angle = np.sqrt(rx * rx + ry * ry + rz * rz)
+            c = np.sin(0.5 * angle) / angle if angle > 1e-12 else 0.5
+            out[f, j, 0], out[f, j, 1], out[f, j, 2], out[f, j, 3] = _qmul(a, (rx * c, ry * c, rz * c, np.cos(0.5 * angle)))
 
 
 def strides(keys: np.ndarray, limit: np.ndarray) -> np.ndarray:
@@ -199,7 +219,7 @@ def encode(tree, skel, keys: np.ndarray, pos: np.ndarray, joints: np.ndarray) ->
 
 
 def error(tree, skel, keys: np.ndarray, pos: np.ndarray, joints: np.ndarray, weights: np.ndarray,
-          frames: int = 31) -> tuple[float, float, int]:
+          frames: int = 31, encoded: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[float, float, int]:
     """The displacement of the mesh as the compact file skins it from the mesh skinned with the
     exact keys and positions: every vertex, at ``frames`` frames midway between evenly spread
     ones (so not all on kept keys).
@@ -212,6 +232,10 @@ def error(tree, skel, keys: np.ndarray, pos: np.ndarray, joints: np.ndarray, wei
         The exact keys.
     pos, joints, weights : (V, 3), (V, 4), (V, 4)
         The skinned vertices (:func:`treeanim.export.skin`).
+    frames : int
+        How many frames to measure.
+    encoded : (keys, stride), optional
+        :func:`encode` of ``keys``, if already at hand.
 
     Returns
     -------
@@ -225,7 +249,8 @@ def error(tree, skel, keys: np.ndarray, pos: np.ndarray, joints: np.ndarray, wei
     pick = np.unique(((np.arange(m) + 0.5) * n / m).astype(np.int64))
     q, h = positions(pos)
     exact = world_pose(tree, skel, np.asarray(keys, np.float64)[pick])
-    played = world_pose(tree, skel, decode(*encode(tree, skel, keys, pos, joints))[pick])
+    encoded = encoded if encoded is not None else encode(tree, skel, keys, pos, joints)
+    played = world_pose(tree, skel, decode(*encoded)[pick])
     return displacement(tree, (skel, exact, pos, joints, weights),
                         (skel, played, q[:, :3] * (h / _SHORT), joints, weights))
 

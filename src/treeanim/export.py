@@ -319,7 +319,7 @@ def material() -> gl.Material:
 
 def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, mesh: TreeMesh | None = None,
                present: np.ndarray | None = None, skel: Skeleton | None = None,
-               precision: str = "full") -> tuple[gl.GLTF2, bytes]:
+               precision: str = "full", encoded: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[gl.GLTF2, bytes]:
     """The glTF document and its binary buffer.
 
     Parameters
@@ -343,6 +343,9 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     precision : {"full", "compact"}
         Float32 attributes and every key, or quantised attributes and keys with each joint's
         keys thinned within :data:`treeanim.compact.TOLERANCE` (:mod:`treeanim.compact`).
+    encoded : (keys, stride), optional
+        A compact file's keys and strides (:func:`treeanim.compact.encode` of ``keys``), if
+        already at hand.
 
     Raises
     ------
@@ -413,7 +416,10 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
 
     # --- animation: a joint's every s-th key (s = 1 at full precision), one time accessor per
     # stride, the rotation accessors in one view
-    keys, stride = cp.encode(tree, skel, keys, pos, joints) if compact else (keys, np.ones(J, np.int64))
+    if compact:
+        keys, stride = encoded if encoded is not None else cp.encode(tree, skel, keys, pos, joints)
+    else:
+        stride = np.ones(J, np.int64)
     times = (np.arange(len(keys)) / fps).astype(np.float32)
     t_acc = {s: blob.accessor(times[::s], gl.SCALAR, gl.FLOAT, minmax=True) for s in np.unique(stride[1:]).tolist()}
     kept = [keys[::stride[j], j] for j in range(1, J)]
