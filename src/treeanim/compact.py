@@ -36,19 +36,25 @@ skins it against the exact keys and positions, every vertex, at 31 frames betwee
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
 
 from .loop import _conj, _mul, angles
+from .model.tree import Lamina
 from .physics.compiled import njit
 from .pose import _levels, _qmul, _rest, displacement, world_pose
+from .render.mesh import TreeMesh, build_mesh
 
-__all__ = ["PRECISIONS", "TOLERANCE", "decode", "encode", "error", "positions", "reach", "report", "runs", "shorts", "strides",
-           "unit"]
+__all__ = ["PRECISIONS", "TOLERANCE", "TEXTURE_SIZE", "card", "card_mesh", "decode", "encode", "error", "leaf_texture",
+           "leaf_uv", "positions", "reach", "report", "runs", "shorts", "strides", "unit"]
 
 #: ``export --precision``: ``compact`` (quantised, keys thinned) or ``full`` (float32, every key).
 PRECISIONS = ("compact", "full")
 #: The most one joint's thinned keys may move a vertex (m).
 TOLERANCE = 5e-4
+#: The leaf texture's side (texels): 0.5 mm a texel along a 13 cm cherry leaf.
+TEXTURE_SIZE = 256
 _SHORT = 32767.0
 
 
@@ -73,10 +79,11 @@ def shorts(q: np.ndarray) -> np.ndarray:
     return np.round(np.asarray(q, np.float64) * _SHORT).astype(np.int16)
 
 
-def runs(tris: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int, int, int]]]:
-    """The mesh's triangles (T, 3) in primitives of at most 65,535 vertices each (16-bit
-    indices; 65,535 itself is reserved): consecutive ranges of the vertices, cut where no
-    triangle straddles the cut.
+def runs(tris: np.ndarray, limit: int | None = 65535, cuts=()) -> tuple[np.ndarray, list[tuple[int, int, int, int]]]:
+    """The mesh's triangles (T, 3) in primitives of at most ``limit`` vertices each (65,535:
+    16-bit indices, 65,535 itself being reserved; None: no limit): consecutive ranges of the
+    vertices, cut where no triangle straddles the cut, and at ``cuts`` (vertices where another
+    material's begin; no triangle may straddle them).
 
     Returns
     -------
@@ -91,16 +98,19 @@ def runs(tris: np.ndarray) -> tuple[np.ndarray, list[tuple[int, int, int, int]]]
     np.add.at(straddle, lo + 1, 1)
     np.add.at(straddle, hi + 1, -1)
     clean = np.flatnonzero(np.cumsum(straddle) == 0)
-    cuts = [0]
-    while cuts[-1] < V:
-        cut = int(clean[np.searchsorted(clean, cuts[-1] + 65535, side="right") - 1])
-        if cut == cuts[-1]:
-            raise ValueError("no cut of the mesh into primitives of at most 65,535 vertices")
-        cuts.append(cut)
-    run = np.searchsorted(cuts, lo, side="right") - 1
+    forced = np.union1d(np.asarray(cuts, np.int64), [V])
+    out = [0]
+    while out[-1] < V:
+        cut = int(forced[np.searchsorted(forced, out[-1], side="right")])
+        if limit is not None and cut - out[-1] > limit:
+            cut = int(clean[np.searchsorted(clean, out[-1] + limit, side="right") - 1])
+            if cut == out[-1]:
+                raise ValueError(f"no cut of the mesh into primitives of at most {limit:,} vertices")
+        out.append(cut)
+    run = np.searchsorted(out, lo, side="right") - 1
     order = np.argsort(run, kind="stable")
-    t = np.searchsorted(run[order], np.arange(len(cuts)))
-    return order, [(int(t[k]), int(t[k + 1]), cuts[k], cuts[k + 1]) for k in range(len(cuts) - 1)]
+    t = np.searchsorted(run[order], np.arange(len(out)))
+    return order, [(int(t[k]), int(t[k + 1]), out[k], out[k + 1]) for k in range(len(out) - 1)]
 
 
 def reach(tree, skel, pos: np.ndarray, joint: np.ndarray) -> np.ndarray:
@@ -260,3 +270,56 @@ def report(error) -> str:
     rms, worst, measured = error
     return (f"compact: quantised and keys thinned to {TOLERANCE * 1000:g} mm a joint: RMS {rms * 100:.3f} cm, worst "
             f"{worst * 100:.3f} cm of vertex displacement against full precision ({measured} frames measured)")
+
+
+# ---------------------------------------------------------------------------- leaf cards
+def card(lamina: Lamina) -> Lamina:
+    """The leaf as a card: the lamina's bounding box in three columns (x at its left edge, its
+    middle and its right edge, two rows of vertices), so the cross-curl bends the card as it
+    bends the outline at those columns (between them off by at most curl·w²/16, w the box's
+    width: 0.7 mm on a 13 cm cherry leaf). The leaf's shape is the alpha of
+    :func:`leaf_texture`; the card's triangles wind as the lamina's."""
+    (x0, y0), (x1, y1) = lamina.outline.min(axis=0), lamina.outline.max(axis=0)
+    outline = np.array([(x, y) for y in (y0, y1) for x in (x0, 0.5 * (x0 + x1), x1)])
+    tris = np.array([[0, 1, 4], [0, 4, 3], [1, 2, 5], [1, 5, 4]])
+    a, b, c = lamina.outline[lamina.triangles[0]]
+    if np.cross(b - a, c - a) < 0:  # the lamina's triangles wind clockwise
+        tris = tris[:, ::-1]
+    return Lamina(lamina.shape, outline, tris, lamina.curl)
+
+
+def card_mesh(tree) -> TreeMesh:
+    """The mesh a glTF file holds: the viewer's (:func:`~treeanim.render.mesh.build_mesh`), each
+    leaf's lamina a :func:`card`."""
+    return build_mesh(tree, lamina=card(tree.lamina) if tree.lamina is not None else None)
+
+
+def leaf_uv(uv: np.ndarray, lamina: Lamina) -> np.ndarray:
+    """(V, 2) uint16 texture coordinates (normalised) of lamina points ``uv`` (V, 2) in leaf
+    units: their place in the lamina's bounding box, the tip at the image's top (glTF's v runs
+    down)."""
+    lo, hi = lamina.outline.min(axis=0), lamina.outline.max(axis=0)
+    st = (np.asarray(uv, np.float64) - lo) / (hi - lo)
+    st[:, 1] = 1.0 - st[:, 1]
+    return np.round(np.clip(st, 0.0, 1.0) * 65535).astype(np.uint16)
+
+
+def leaf_texture(lamina: Lamina, size: int = TEXTURE_SIZE) -> bytes:
+    """A PNG (size × size): white, its alpha the lamina's shape over its bounding box
+    (:func:`leaf_uv`), drawn at 4× and averaged (the edge's coverage, for the client's alpha
+    cut and mipmaps)."""
+    from PIL import Image, ImageDraw
+
+    big = 4 * size
+    lo, hi = lamina.outline.min(axis=0), lamina.outline.max(axis=0)
+    px = (lamina.outline - lo) / (hi - lo) * big
+    px[:, 1] = big - px[:, 1]
+    mask = Image.new("L", (big, big), 0)
+    draw = ImageDraw.Draw(mask)
+    for tri in lamina.triangles:
+        draw.polygon([tuple(p) for p in px[tri]], fill=255)
+    image = Image.new("RGBA", (size, size), (255, 255, 255, 0))
+    image.putalpha(mask.resize((size, size), Image.Resampling.BOX))
+    out = io.BytesIO()
+    image.save(out, format="PNG", optimize=True)
+    return out.getvalue()

@@ -31,7 +31,7 @@ from .files import remove_stale, write_bytes
 from .model.tree import Tree
 from .physics.rotation import matrix_to_quat
 from .render import palette
-from .render.mesh import MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh, build_mesh
+from .render.mesh import MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh
 
 
 @dataclass(frozen=True)
@@ -312,9 +312,57 @@ def surface(tree: Tree, mesh: TreeMesh, used: np.ndarray, season: float) -> tupl
 
 
 def material() -> gl.Material:
-    """The one material of an exported tree: its colours are the vertices', both sides drawn."""
+    """The material of an exported tree: its colours are the vertices', both sides drawn."""
     return gl.Material(name="tree", doubleSided=True, pbrMetallicRoughness=gl.PbrMetallicRoughness(
         baseColorFactor=[1, 1, 1, 1], metallicFactor=0.0, roughnessFactor=0.8))
+
+
+def leaf_material(doc: gl.GLTF2, blob: "_Blob", lamina) -> int:
+    """Add the laminas' material to ``doc``: the tree's, cut to the leaf's shape by the alpha of
+    :func:`treeanim.compact.leaf_texture` (a PNG in the buffer; alpha mode MASK). Its index."""
+    doc.images.append(gl.Image(bufferView=blob.view(cp.leaf_texture(lamina)), mimeType="image/png"))
+    doc.samplers.append(gl.Sampler(magFilter=gl.LINEAR, minFilter=gl.LINEAR_MIPMAP_LINEAR, wrapS=gl.CLAMP_TO_EDGE,
+                                   wrapT=gl.CLAMP_TO_EDGE))
+    doc.textures.append(gl.Texture(sampler=len(doc.samplers) - 1, source=len(doc.images) - 1))
+    leaf = material()
+    leaf.name, leaf.alphaMode, leaf.alphaCutoff = "leaf", gl.MASK, 0.5
+    leaf.pbrMetallicRoughness.baseColorTexture = gl.TextureInfo(index=len(doc.textures) - 1)
+    doc.materials.append(leaf)
+    return len(doc.materials) - 1
+
+
+def primitives(doc: gl.GLTF2, blob: "_Blob", tree: Tree, mesh: TreeMesh, used: np.ndarray, index: np.ndarray,
+               columns: dict, short: bool) -> list[gl.Primitive]:
+    """The mesh's primitives: ``columns`` (name: (array, type, component, normalised), the
+    ``used`` vertices' attributes, each in a view of its own) and the triangles ``index`` (T, 3),
+    in runs of consecutive vertices of one material each (:func:`treeanim.compact.runs`), each
+    of at most 65,535 vertices where ``short`` (16-bit indices): the tree's material, or the
+    leaves' (:func:`leaf_material`), whose runs add ``TEXCOORD_0`` (the laminas' vertices are
+    consecutive: :func:`~treeanim.render.mesh.build_mesh` adds them together)."""
+    leaf = mesh.material[used] == MATERIAL_LAMINA
+    doc.materials.append(material())
+    views = {name: blob.view(a.tobytes(), gl.ARRAY_BUFFER, a.strides[0]) for name, (a, *_) in columns.items()}
+    if leaf.any():
+        leaf_material(doc, blob, tree.lamina)
+        first = int(np.argmax(leaf))
+        uv = cp.leaf_uv(mesh.vertices["uv"][used][leaf], tree.lamina)
+        views["TEXCOORD_0"] = blob.view(uv.tobytes(), gl.ARRAY_BUFFER, uv.strides[0])
+    order, runs = cp.runs(index, 65535 if short else None, np.flatnonzero(np.diff(leaf)) + 1)
+    index = index[order]
+    out = []
+    for t0, t1, v0, v1 in runs:
+        attrs = {name: blob.accessor(a[v0:v1], kind, component, view=views[name], offset=v0 * a.strides[0],
+                                     normalized=norm, minmax=name == "POSITION")
+                 for name, (a, kind, component, norm) in columns.items()}
+        if leaf[v0]:
+            attrs["TEXCOORD_0"] = blob.accessor(uv[v0 - first:v1 - first], gl.VEC2, gl.UNSIGNED_SHORT,
+                                                view=views["TEXCOORD_0"], offset=(v0 - first) * uv.strides[0],
+                                                normalized=True)
+        local = (index[t0:t1] - v0).ravel().astype(np.uint16 if short else np.uint32)
+        indices = blob.accessor(local, gl.SCALAR, gl.UNSIGNED_SHORT if short else gl.UNSIGNED_INT,
+                                gl.ELEMENT_ARRAY_BUFFER, minmax=True)
+        out.append(gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices, material=int(leaf[v0])))
+    return out
 
 
 def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, mesh: TreeMesh | None = None,
@@ -334,7 +382,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     season : float
         Leaf colour.
     mesh : TreeMesh, optional
-        The tree's mesh (:func:`~treeanim.render.mesh.build_mesh`), built if not given.
+        The tree's mesh, its leaves cards (:func:`treeanim.compact.card_mesh`), built if not given.
     present : (M,) bool, optional
         Objects on the tree: the others (fallen leaves) are left out of the mesh and the skin.
     skel : Skeleton, optional
@@ -352,7 +400,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     ValueError
         If ``keys`` are not for the skeleton's joints.
     """
-    mesh = mesh if mesh is not None else build_mesh(tree)
+    mesh = mesh if mesh is not None else cp.card_mesh(tree)
     skel = skel if skel is not None else skeleton(tree, present)
     if keys.shape[1] != skel.count:
         raise ValueError(f"keys for {keys.shape[1]} joints, the skeleton has {skel.count}")
@@ -378,21 +426,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
                    JOINTS_0=(joints.astype(np.uint8), gl.VEC4, gl.UNSIGNED_BYTE, None) if byte_joints else
                    (joints, gl.VEC4, gl.UNSIGNED_SHORT, None),
                    WEIGHTS_0=(weights, gl.VEC4, gl.UNSIGNED_BYTE, True))
-    views = {name: blob.view(a.tobytes(), gl.ARRAY_BUFFER, a.strides[0]) for name, (a, *_) in columns.items()}
-    doc.materials.append(material())
-    # A compact file has one primitive per run of at most 65,535 vertices: 16-bit indices
-    order, runs = cp.runs(index) if compact else (slice(None), [(0, len(index), 0, len(pos))])
-    index = index[order]
-    primitives = []
-    for t0, t1, v0, v1 in runs:
-        attrs = {name: blob.accessor(a[v0:v1], kind, component, view=views[name], offset=v0 * a.strides[0],
-                                     normalized=norm, minmax=name == "POSITION")
-                 for name, (a, kind, component, norm) in columns.items()}
-        local = (index[t0:t1] - v0).ravel().astype(np.uint16 if compact else np.uint32)
-        indices = blob.accessor(local, gl.SCALAR, gl.UNSIGNED_SHORT if compact else gl.UNSIGNED_INT,
-                                gl.ELEMENT_ARRAY_BUFFER, minmax=True)
-        primitives.append(gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices, material=0))
-    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives))
+    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives(doc, blob, tree, mesh, used, index, columns, compact)))
 
     # --- joints: constant local translations, rotations animated
     J = skel.count

@@ -44,8 +44,8 @@ def cmd_export(args) -> int:
     except ValueError as e:
         raise UsageError(str(e)) from None
     full = skel
-    skel, raw, mesh, error = joints.fit(tree, full, raw, n, budget, sim.present)
-    mesh = mesh if mesh is not None else build_mesh(tree)  # once, for the file and the compact error
+    mesh = build_mesh(tree) if usd else compact.card_mesh(tree)  # once, for the fit, the file and its error
+    skel, raw, error = joints.fit(tree, full, raw, n, budget, sim.present, mesh)
     keys = loop.close_loop(raw, n) if fade else raw
     packed = args.precision == "compact" and not usd
     skinned = export.skin(tree, mesh, skel, sim.present)[2:] if packed else None
