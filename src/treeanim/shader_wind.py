@@ -32,11 +32,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import scripted
-from .export import material, skeleton, skin, surface
+from .compact import card_mesh
+from .export import primitives, skeleton, skin, surface
 from .model.tree import Tree
 from .physics.simulation import Simulation
 from .physics.wind.field import WindField
-from .render.mesh import TreeMesh, build_mesh
+from .render.mesh import TreeMesh
 
 __all__ = ["LEVELS", "CALIBRATION_WINDS", "BranchTable", "branch_table", "level_chains", "level_compliance",
            "object_rows", "texture", "build_shader_gltf"]
@@ -216,29 +217,23 @@ def build_shader_gltf(tree: Tree, table: BranchTable, season: float = 0.0, mesh:
 
     from .export import _Blob
 
-    mesh = mesh if mesh is not None else build_mesh(tree)
+    mesh = mesh if mesh is not None else card_mesh(tree)
     present = tree.leaves_present(season)
     keep_tris, used, pos, _, _ = skin(tree, mesh, skeleton(tree, present), present)
     doc = gl.GLTF2(asset=gl.Asset(version="2.0", generator="treeanim (shader wind)"))
     blob = _Blob(doc)
     nrm, col = surface(tree, mesh, used, season)
     tex = texture(object_rows(tree, table))
-    attrs = {
-        "POSITION": blob.accessor(pos, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER, minmax=True),
-        "NORMAL": blob.accessor(nrm, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
-        "COLOR_0": blob.accessor(col, gl.VEC4, gl.UNSIGNED_BYTE, gl.ARRAY_BUFFER, normalized=True),
-        "_OBJECT": blob.accessor(mesh.object[used].astype(np.float32), gl.SCALAR, gl.FLOAT, gl.ARRAY_BUFFER),
-    }
+    columns = {"POSITION": (pos, gl.VEC3, gl.FLOAT, None), "NORMAL": (nrm, gl.VEC3, gl.FLOAT, None),
+               "COLOR_0": (col, gl.VEC4, gl.UNSIGNED_BYTE, True),
+               "_OBJECT": (mesh.object[used].astype(np.float32), gl.SCALAR, gl.FLOAT, None)}
     entries = blob.accessor(tex.reshape(-1, 4), gl.VEC4, gl.FLOAT)
-    remap = np.cumsum(used) - 1
-    index = remap[mesh.indices[keep_tris]].astype(np.uint32).ravel()
-    indices = blob.accessor(index, gl.SCALAR, gl.UNSIGNED_INT, gl.ELEMENT_ARRAY_BUFFER, minmax=True)
-    doc.materials.append(material())
+    index = (np.cumsum(used) - 1)[mesh.indices[keep_tris]]
     wind = {"levels": LEVELS, "exponent": round(table.exponent, 4), "calibration_winds": list(CALIBRATION_WINDS),
             "table": {"accessor": entries, "width": tex.shape[1], "height": tex.shape[0], "rows": ROWS},
             "shader": "shaders/engine_wind.glsl"}
-    doc.meshes.append(gl.Mesh(name=tree.name, primitives=[gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices,
-                                                                         material=0)], extras={"treeanim_wind": wind}))
+    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives(doc, blob, tree, mesh, used, index, columns, True),
+                              extras={"treeanim_wind": wind}))
     doc.nodes.append(gl.Node(name=tree.name, mesh=0))
     doc.scenes.append(gl.Scene(name=tree.name, nodes=[0]))
     doc.scene = 0
