@@ -343,3 +343,19 @@ def test_more_joints_than_a_skin_indexes_are_refused_in_one_line():
     assert "\n" not in str(e.value)
     small = skeleton(grass)
     ex.check_joints(small)  # one grassland's 15,001 joints are fine
+
+
+def test_primitives_are_cut_at_the_materials_and_at_the_vertex_limit():
+    """compact.runs: consecutive vertex ranges, no triangle across a cut, a cut at every
+    material boundary, none longer than the limit."""
+    from treeanim.compact import runs
+
+    tris = np.array([[0, 1, 2], [4, 5, 6], [1, 2, 3], [5, 6, 4], [7, 8, 9]])  # clean cuts: 0, 4, 7, 10
+    for limit, ranges in ((None, [(0, 4), (4, 10)]), (6, [(0, 4), (4, 10)]), (5, [(0, 4), (4, 7), (7, 10)])):
+        order, cut = runs(tris, limit, cuts=[4])
+        assert [(v0, v1) for _, _, v0, v1 in cut] == ranges
+        for t0, t1, v0, v1 in cut:
+            assert np.all((tris[order[t0:t1]] >= v0) & (tris[order[t0:t1]] < v1))
+        assert sorted(order.tolist()) == list(range(len(tris)))
+    with pytest.raises(ValueError, match="at most 2 vertices"):
+        runs(tris, 2)

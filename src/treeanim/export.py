@@ -341,9 +341,10 @@ def primitives(doc: gl.GLTF2, blob: "_Blob", tree: Tree, mesh: TreeMesh, used: n
     consecutive: :func:`~treeanim.render.mesh.build_mesh` adds them together)."""
     leaf = mesh.material[used] == MATERIAL_LAMINA
     doc.materials.append(material())
+    kinds = [len(doc.materials) - 1] * 2  # the material of a run without and with laminas
     views = {name: blob.view(a.tobytes(), gl.ARRAY_BUFFER, a.strides[0]) for name, (a, *_) in columns.items()}
     if leaf.any():
-        leaf_material(doc, blob, tree.lamina)
+        kinds[1] = leaf_material(doc, blob, tree.lamina)
         first = int(np.argmax(leaf))
         uv = cp.leaf_uv(mesh.vertices["uv"][used][leaf], tree.lamina)
         views["TEXCOORD_0"] = blob.view(uv.tobytes(), gl.ARRAY_BUFFER, uv.strides[0])
@@ -361,7 +362,7 @@ def primitives(doc: gl.GLTF2, blob: "_Blob", tree: Tree, mesh: TreeMesh, used: n
         local = (index[t0:t1] - v0).ravel().astype(np.uint16 if short else np.uint32)
         indices = blob.accessor(local, gl.SCALAR, gl.UNSIGNED_SHORT if short else gl.UNSIGNED_INT,
                                 gl.ELEMENT_ARRAY_BUFFER, minmax=True)
-        out.append(gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices, material=int(leaf[v0])))
+        out.append(gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices, material=kinds[int(leaf[v0])]))
     return out
 
 
