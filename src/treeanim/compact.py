@@ -42,7 +42,7 @@ import io
 
 import numpy as np
 
-from .loop import _conj, _mul, angles
+from .loop import _conj, _mul
 from .model.tree import Lamina
 from .physics.compiled import njit
 from .pose import _levels, _qmul, _rest, displacement, world_pose
@@ -140,33 +140,58 @@ def _thin(keys: np.ndarray, s: int) -> np.ndarray:
     return out
 
 
+@njit(cache=True, inline="always")
+def _slerp(keys, s, f, j):
+    """The key a client plays at frame f of joint j from every s-th of ``keys``: a (a⁻¹b)^u, a
+    and b the kept keys around f (b's sign taken nearer a), u = (f − i s)/s (i of a); as
+    ``_mul(a, _exp(u * _log(_mul(_conj(a), b))))``, a tuple."""
+    i = min(f // s, (keys.shape[0] - 1) // s - 1)
+    u = (f - i * s) / s
+    a, b = keys[i * s, j], keys[(i + 1) * s, j]
+    sign = -1.0 if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] < 0 else 1.0
+    dx, dy, dz, dw = _qmul((-a[0], -a[1], -a[2], a[3]), (sign * b[0], sign * b[1], sign * b[2], sign * b[3]))
+    if dw < 0:  # the shorter way round
+        dx, dy, dz, dw = -dx, -dy, -dz, -dw
+    sn = np.sqrt(dx * dx + dy * dy + dz * dz)
+    k = 2.0 * np.arctan2(sn, dw) / sn if sn > 1e-12 else 2.0
+    rx, ry, rz = u * dx * k, u * dy * k, u * dz * k
+    angle = np.sqrt(rx * rx + ry * ry + rz * rz)
+    c = np.sin(0.5 * angle) / angle if angle > 1e-12 else 0.5
+    return _qmul(a, (rx * c, ry * c, rz * c, np.cos(0.5 * angle)))
+
+
 @njit(cache=True)
 def _slerps(keys, s, out):
-    """out[f, j] = a (a⁻¹b)^u: a, b the kept keys around frame f (b's sign taken nearer a),
-    u = (f − i s)/s; ``_mul(a, _exp(u * _log(_mul(_conj(a), b))))`` per element."""
-    F, J = keys.shape[0], keys.shape[1]
-    last = (F - 1) // s - 1
-    for f in range(F):
-        i = min(f // s, last)
-        u = (f - i * s) / s
-        for j in range(J):
-            a, b = keys[i * s, j], keys[(i + 1) * s, j]
-            sign = -1.0 if a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] < 0 else 1.0
-            dx, dy, dz, dw = _qmul((-a[0], -a[1], -a[2], a[3]), (sign * b[0], sign * b[1], sign * b[2], sign * b[3]))
-            if dw < 0:  # the shorter way round
-                dx, dy, dz, dw = -dx, -dy, -dz, -dw
-            sn = np.sqrt(dx * dx + dy * dy + dz * dz)
-            k = 2.0 * np.arctan2(sn, dw) / sn if sn > 1e-12 else 2.0
-            rx, ry, rz = u * dx * k, u * dy * k, u * dz * k
-            angle = np.sqrt(rx * rx + ry * ry + rz * rz)
-            c = np.sin(0.5 * angle) / angle if angle > 1e-12 else 0.5
-            out[f, j, 0], out[f, j, 1], out[f, j, 2], out[f, j, 3] = _qmul(a, (rx * c, ry * c, rz * c, np.cos(0.5 * angle)))
+    """out[f, j]: :func:`_slerp` at every frame and joint."""
+    for f in range(keys.shape[0]):
+        for j in range(keys.shape[1]):
+            out[f, j, 0], out[f, j, 1], out[f, j, 2], out[f, j, 3] = _slerp(keys, s, f, j)
+
+
+@njit(cache=True)
+def _within(keys, s, cols, limit, ok):
+    """ok[c]: joint cols[c]'s :func:`_slerp` stays within limit[c] radians of its key at every
+    frame (the angle as :func:`treeanim.loop.angles` takes it); stops at the first that does not."""
+    for c in range(len(cols)):
+        j = cols[c]
+        ok[c] = True
+        for f in range(keys.shape[0]):
+            p = _slerp(keys, s, f, j)
+            q = keys[f, j]
+            sign = -1.0 if p[0] * q[0] + p[1] * q[1] + p[2] * q[2] + p[3] * q[3] < 0 else 1.0
+            d2 = s2 = 0.0
+            for k in range(4):
+                d2 += (p[k] - sign * q[k]) ** 2
+                s2 += (p[k] + sign * q[k]) ** 2
+            if 4.0 * np.arctan2(np.sqrt(d2), np.sqrt(s2)) > limit[c]:
+                ok[c] = False
+                break
 
 
 def strides(keys: np.ndarray, limit: np.ndarray) -> np.ndarray:
     """(J,) each joint's stride: the largest divisor s of F − 1 for which every s-th of its
     keys (F, J, 4), interpolated, stays within ``limit`` (J,) radians of every key."""
-    keys = np.asarray(keys, np.float64)
+    keys = np.ascontiguousarray(keys, np.float64)
     n = len(keys) - 1
     out = np.ones(keys.shape[1], np.int64)
     todo = np.ones(keys.shape[1], bool)
@@ -174,10 +199,10 @@ def strides(keys: np.ndarray, limit: np.ndarray) -> np.ndarray:
         cols = np.flatnonzero(todo)
         if not len(cols):
             break
-        err = np.radians(angles(_thin(keys[:, cols], s), keys[:, cols]).max(axis=0))
-        ok = cols[err <= limit[cols]]
-        out[ok] = s
-        todo[ok] = False
+        ok = np.empty(len(cols), bool)
+        _within(keys, s, cols, np.ascontiguousarray(limit[cols], np.float64), ok)
+        out[cols[ok]] = s
+        todo[cols[ok]] = False
     return out
 
 

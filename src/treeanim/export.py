@@ -19,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import json
 import re
+import struct
 import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
@@ -473,6 +474,27 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     return doc, data
 
 
+def to_json(doc: gl.GLTF2, allow_nan: bool = True) -> bytes:
+    """``doc`` as compact JSON: what pygltflib's ``to_json`` writes (empty and None values left
+    out), without its deep copy of every value (11 s for the 17,048 joints' nodes, channels
+    and accessors of a large cherry)."""
+    return json.dumps(gl.delete_empty_keys(_plain(doc)), cls=gl.JsonEncoder, allow_nan=allow_nan,
+                      separators=(",", ":")).encode()
+
+
+def _plain(obj):
+    """Dataclasses, lists and dicts as plain dicts and lists (pygltflib's ``gltf_asdict``)."""
+    if isinstance(obj, gl.Attributes):
+        return dict(obj.__dict__)
+    if hasattr(type(obj), "__dataclass_fields__"):
+        return {name: _plain(getattr(obj, name)) for name in type(obj).__dataclass_fields__}
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    return obj
+
+
 def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
     """Write ``.glb`` (one file) or ``.gltf`` + ``.bin`` atomically; returns the files written.
 
@@ -481,10 +503,12 @@ def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
     a run killed at any moment leaves a matching pair (at worst plus an unused ``.bin``).
     """
     path = Path(path)
-    if path.suffix.lower() == ".glb":
+    if path.suffix.lower() == ".glb":  # the header, the JSON chunk (space-padded), the buffer's chunk
         doc.buffers[0].uri = None
-        doc.set_binary_blob(data)
-        write_bytes(path, b"".join(doc.save_to_bytes()))
+        text = to_json(doc, allow_nan=False)
+        text += b" " * (-len(text) % 4)
+        write_bytes(path, b"".join([b"glTF", struct.pack("<III", 2, 28 + len(text) + len(data), len(text)), b"JSON",
+                                    text, struct.pack("<I", len(data)), b"BIN\0", data]))
         return [path]
     bin_path = path.with_name(f"{path.stem}-{hashlib.sha1(data).hexdigest()[:8]}.bin")
     doc.buffers[0].uri = urllib.parse.quote(bin_path.name)
@@ -492,7 +516,7 @@ def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
     # A killed export's buffer was named after other content: its stale temporary files too
     remove_stale(path.parent, re.compile(re.escape(path.stem) + r"-[0-9a-f]{8}\.bin"))
     write_bytes(bin_path, data)
-    write_bytes(path, doc.to_json(separators=(",", ":")).encode())
+    write_bytes(path, to_json(doc))
     if old_bin is not None and old_bin != bin_path:
         old_bin.unlink(missing_ok=True)
     return [path, bin_path]

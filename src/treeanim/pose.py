@@ -144,8 +144,8 @@ def displacement(tree, a, b) -> tuple[float, float, int]:
         F.
     """
     (sa, (wa, pa), xa, ja, wta), (sb, (wb, pb), xb, jb, wtb) = a, b
-    f64 = np.ascontiguousarray
-    args = [(f64(w, np.float64), f64(p, np.float64), _rest(tree, s), f64(x, np.float64), f64(j, np.int64),
-             f64(wt, np.float64) / 255.0) for s, w, p, x, j, wt in ((sa, wa, pa, xa, ja, wta), (sb, wb, pb, xb, jb, wtb))]
-    sse, worst = _distances(*args[0], *args[1])
+    c = np.ascontiguousarray
+    args = [(c(w, np.float64), c(p, np.float64), _rest(tree, s), c(x, np.float64), c(j, np.int64), c(wt, np.float64) / 255.0)
+            for s, w, p, x, j, wt in ((sa, wa, pa, xa, ja, wta), (sb, wb, pb, xb, jb, wtb))]
+    sse, worst = _distances(*args[0], *args[1])  # every vertex at every frame, compiled
     return float(np.sqrt(sse / max(len(xa) * len(wa), 1))), float(np.sqrt(worst)), len(wa)
