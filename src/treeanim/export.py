@@ -484,15 +484,16 @@ def to_json(doc: gl.GLTF2, allow_nan: bool = True) -> bytes:
 
 def _plain(obj):
     """Dataclasses, lists and dicts as plain dicts and lists (pygltflib's ``gltf_asdict``)."""
-    if isinstance(obj, gl.Attributes):
-        return dict(obj.__dict__)
-    if hasattr(type(obj), "__dataclass_fields__"):
-        return {name: _plain(getattr(obj, name)) for name in type(obj).__dataclass_fields__}
+    if obj is None or isinstance(obj, (int, float, str)):
+        return obj
     if isinstance(obj, (list, tuple)):
         return [_plain(v) for v in obj]
     if isinstance(obj, dict):
         return {k: _plain(v) for k, v in obj.items()}
-    return obj
+    if isinstance(obj, gl.Attributes):
+        return dict(obj.__dict__)
+    names = getattr(type(obj), "__dataclass_fields__", None)
+    return {name: _plain(getattr(obj, name)) for name in names} if names is not None else obj
 
 
 def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
