@@ -1,8 +1,9 @@
-"""Shader wind for engines: a static mesh whose vertices carry their branch hierarchy and each
-branch's physical parameters, for a vertex shader to sway it (``shaders/engine_wind.glsl``, the
-reference; ``examples/shader_wind/index.html`` runs it in three.js).
+"""Shader wind for engines: a static mesh (the glTF one, leaves as cards:
+:func:`treeanim.compact.card_mesh`), its vertices' branch hierarchy and each branch's physical
+parameters, for a vertex shader to sway it (``shaders/engine_wind.glsl``, the reference;
+``examples/shader_wind/index.html`` runs it in three.js).
 
-Each vertex carries up to :data:`LEVELS` levels of the branches it hangs from: the trunk and the
+Each vertex hangs from up to :data:`LEVELS` levels of the branches it hangs from: the trunk and the
 three innermost (its own object, its parent, its grandparent; a leaf is its own level). These
 depend on the vertex's object only, so the file stores them once per object, in a table, and
 each vertex carries its object's index (attribute ``_OBJECT``, a float) besides its position,
