@@ -87,7 +87,7 @@ from ..model.geometry import arc_length, lamina_frames
 from ..model.geometry import perpendicular as _perpendicular
 from ..model.geometry import unit as _unit
 from ..model.tree import BRANCH_SIDES, Tree, curve_bands
-from .collars import collars, leaders, outward
+from .collars import collars, leaders, outward, tube_radius
 from .occlusion import crown_occlusion
 from .skinning import hermite, skin_points
 
@@ -288,11 +288,11 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     # A fork's leader continues its parent's tube: from the parent's end ring (its radius, and
     # the rings square to the same w, and the bark running on), without a collar.
     lead = leaders(tree, nodes, tangent) if curved else np.zeros(tree.n_objects, bool)
-    r = 0.5 * tree.node_diameter
-    r[tree.object_start[lead]] = r[tree.attach_node[lead]]
+    r = tube_radius(tree) if curved else 0.5 * tree.node_diameter
     frame, along0, arc = np.arange(tree.n_objects), np.zeros(tree.n_objects), arc_length(tree)
     for c in np.flatnonzero(lead):  # parents come first (objects are sorted by level)
         frame[c], along0[c] = frame[tree.parent[c]], along0[tree.parent[c]] + arc[tree.attach_node[c]]
+    jitter = jitter[frame]  # and its bark's shade
     inner = ~(base | tip)
     # T₀ of the segment leaving each node (module notes).
     prev = np.where(inner, nodes - 1, nodes)
@@ -331,6 +331,10 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     centre, dq = hermite(t, chord, d0, d1)
     tan = _unit(dq, tangent[src])
     slope = np.where(t == 0, node_slope, seg_slope)
+    # A leader's first ring, its parent's end ring, keeps that ring's normals.
+    lf = np.flatnonzero(first & lead[obj[src]])
+    att = tree.attach_node[obj[src[lf]]]
+    slope[lf] = (r[att] - r[att - 1]) / np.linalg.norm(P[att] - P[att - 1], axis=1)
     radius = (1.0 - t) * r[n0] + t * r[n1]
     ring_obj = obj[src]
 
