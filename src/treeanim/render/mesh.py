@@ -37,8 +37,10 @@ Geometry per object kind (triangle counts: :func:`drawn_triangles`):
   to an *apex* sunk in the parent, out of sight. Along a parent the rim is
   ρ = clip(½(R + r), 1.15 r, 1.5 r) (at most 0.95 R) from the child's axis, each side as far
   out along the child as it meets the parent's tube (radius R about the parent's tangent at
-  the joint), and the apex on the parent's axis. At a fork (a child on its
-  parent's tip) the rim is the parent's end ring, widened to max(R, 1.15 r) and raised so
+  the joint), and the apex on the parent's axis. A fork's leaders (the children on a parent's
+  tip turning at most ``FORK_LEAD``°) continue the parent's tube from its end ring, with no
+  collar and no fans between (:mod:`treeanim.render.collars`); a child turning more from a
+  parent's tip has its rim on the parent's end ring, widened to max(R, 1.15 r) and raised so
   that the cone from the apex, 2 R below the end, passes through the end ring: the parent's
   silhouette runs on into each child's; a child turned more than 70° from the parent tilts its
   rim towards it by the excess (an elbow). The collar is skinned with the child's base frame
