@@ -90,9 +90,10 @@ def bench_row(win, row: str, frames: int, warmup: int, step: bool = False) -> di
             win.swap()
         t = {k: _Timer() for k in ("sim", "draw", "driver", "update", "panel", "imgui")}
         r = v.renderer
-        for part in r.tree_pass.parts.values():
-            if part.vao is not None:
-                part.vao = _TimedVao(part.vao, t["driver"])
+        progs = r.tree_pass.programs
+        for key, (prog, vao) in progs.items():
+            if vao is not None:
+                progs[key] = (prog, _TimedVao(vao, t["driver"]))
         r.sky_pass.vao = _TimedVao(r.sky_pass.vao, t["driver"])
         r.background.vao = _TimedVao(r.background.vao, t["driver"])
         r.ground_pass.vaos = [_TimedVao(v, t["driver"]) for v in r.ground_pass.vaos]

@@ -19,7 +19,10 @@ float sun_visibility(vec3 world, vec3 n) {
     vec2 d = 0.5 / vec2(textureSize(u_shadow_map, 0));
     float lit = 0.25 * (texture(u_shadow_map, vec3(s.x - d.x, s.y - d.y, s.z)) + texture(u_shadow_map, vec3(s.x + d.x, s.y - d.y, s.z))
                       + texture(u_shadow_map, vec3(s.x - d.x, s.y + d.y, s.z)) + texture(u_shadow_map, vec3(s.x + d.x, s.y + d.y, s.z)));
-    return u_shadow_on == 0 || s.z >= 1.0 ? 1.0 : lit;
+    // A map fitted to the view (u_shadow_edge > 0) leaves trees beyond it lit, faded in.
+    vec2 border = abs(2.0 * s.xy - 1.0);
+    float beyond = clamp((max(border.x, border.y) - 1.0 + u_shadow_edge) / max(u_shadow_edge, 1e-6), 0.0, 1.0);
+    return u_shadow_on == 0 || s.z >= 1.0 ? 1.0 : mix(lit, 1.0, beyond);
 }
 
 // The same from one bilinear tap (2 x 2 texels compared and blended: an edge a texel wide), for

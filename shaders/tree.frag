@@ -16,6 +16,7 @@ noperspective in float v_edge;
 in float v_half;
 in vec3 v_light;
 in float v_haze;
+flat in float v_fade;
 
 out vec4 f_color;
 
@@ -59,7 +60,19 @@ float tent_integral(float x) {
     return x < 0.0 ? 0.5 * max(1.0 + x, 0.0) * max(1.0 + x, 0.0) : 1.0 - 0.5 * max(1.0 - x, 0.0) * max(1.0 - x, 0.0);
 }
 
+// A 4 x 4 ordered dither's threshold at a pixel, in (0, 1).
+float dither4(vec2 pixel) {
+    const float bayer[16] = float[16](0.0, 8.0, 2.0, 10.0, 12.0, 4.0, 14.0, 6.0, 3.0, 11.0, 1.0, 9.0, 15.0, 7.0, 13.0, 5.0);
+    ivec2 i = ivec2(pixel) & 3;
+    return (bayer[i.x + 4 * i.y] + 0.5) / 16.0;
+}
+
 void main() {
+#if LOD_FADE != 0
+    // A leaf or branch in the hand-over band: its full mesh keeps the pixels whose threshold is
+    // at least its fade, its coarse mesh the others, so between them it is whole.
+    if ((dither4(gl_FragCoord.xy) >= v_fade) != (LOD_FADE == 1)) discard;
+#endif
     if (PART == PART_BARK && !gl_FrontFacing) discard;  // a closed tube's far side; a thin twig's, flat
     vec3 n = normalize(v_normal);
     if (!gl_FrontFacing) n = -n;                 // double-sided: laminas, blades

@@ -1,7 +1,9 @@
 #version 330 core
 // Skinned tree: one part of the mesh (PART, defined by the renderer: PART_LEAVES, petioles and
 // laminas; PART_BARK, branch tubes; PART_BLADES, grass blades). Each part has its own program
-// with only its own code: a software rasteriser runs both sides of every branch.
+// with only its own code: a software rasteriser runs both sides of every branch. LOD_FADE
+// (leaves and bark of a scene): 0 drawn whole; 1 the full mesh and 2 the coarse one, each
+// keeping its share of the pixels of a leaf or branch in the hand-over band (tree.frag).
 
 #include "uniforms.glsl"
 #include "skin.glsl"
@@ -27,6 +29,7 @@ noperspective out float v_edge;  // thin twigs and blades: distance from the axi
 out float v_half;                // their true half width on screen, px (< 0: solid)
 out vec3 v_light;                // blades: their light at the vertex, and ...
 out float v_haze;                // ... the haze over it (see below)
+flat out float v_fade;           // LOD_FADE: the node's place in the hand-over band, 0 .. 1
 
 #include "constants.glsl"
 
@@ -65,6 +68,10 @@ void main() {
         gl_Position = vec4(0.0, 0.0, 2.0, 1.0);
         return;
     }
+    // A scene's leaf or branch in the band where its tree hands over from the full mesh to the
+    // coarse one (render/lod.py): how far in, from its node's distance (one for a whole leaf).
+    v_fade = LOD_FADE == 0 ? 0.0 : clamp((distance(node_position(in_ids.x), u_camera_pos) - u_lod_band.x)
+                                         / (u_lod_band.y - u_lod_band.x), 0.0, 1.0);
     mat3 R;
     vec3 centre;
     skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, in_tangent0, in_tangent1, v_world, R, centre);

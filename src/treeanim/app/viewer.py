@@ -26,6 +26,7 @@ import numpy as np
 
 from ..driver import MAX_FRAME_DT, FrameDriver
 from ..model.tree import Tree
+from ..physics.lod import choose_detail, object_trees, tree_extents
 from ..physics.pull import SpringPull, TreeDrag
 from ..physics.pull import grab as grab_object
 from ..physics.simulation import Simulation
@@ -216,6 +217,7 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning, ViewerHold, ViewerTimelin
             self.renderer.release()
         self.sim, self.renderer = sim, renderer
         self.picker = Picker(tree)
+        self._extents = tree_extents(tree) if getattr(tree, "n_trees", 1) > 1 else None  # a scene's (lod)
         self.signals = Signals(tree)
         self._restarted()
         lo, hi = renderer.bounds()
@@ -278,10 +280,23 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning, ViewerHold, ViewerTimelin
         the trace following the grabbed point). Returns the steps taken."""
         if self.paused:
             return 0
+        self.choose_detail()
         n = self.driver.advance(self.sim, real_dt, self.grab, self._after_step)
         if n:
             self.sim.positions, self.sim.rotations  # the pose is built lazily: count it as simulation
         return n
+
+    def choose_detail(self) -> None:
+        """A scene's trees at the detail their height on the screen asks for
+        (:func:`~treeanim.physics.lod.choose_detail`), the trees grabbed, traced or pinned at
+        full detail (the tree model; a tree holding a drag is whole anyway)."""
+        if self._extents is None or self.sim.model != "tree":
+            return
+        held = [p.object for p in self.pins] + ([self.grab.object] if self.grab is not None else [])
+        held += [self.traced[0]] if self.traced is not None else []
+        focal = max(self._fb[1], 1) / (2.0 * np.tan(np.radians(self.camera.fov_y) / 2.0))
+        hero = object_trees(self.tree)[np.asarray(held, np.int64)]
+        self.sim.set_detail(choose_detail(self.camera.eye, *self._extents, focal, hero, self.sim.detail))
 
     def _steps(self, n: int) -> None:
         """Take ``n`` steps now (paused or not), as :meth:`advance` takes them."""

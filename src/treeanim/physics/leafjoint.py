@@ -228,9 +228,10 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf_first, leaf_body, leaf_E,
-               leaf_th, leaf_on, pos, rot):
-    """Posed node positions ``pos`` (N, 3) and rest-relative rotations ``rot`` (N, 3, 3).
+def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf_first, leaf_body,
+               leaf_E, leaf_th, leaf_on, pos, rot):
+    """Posed node positions ``pos`` (N, 3) and rest-relative rotations ``rot`` (N, 3, 3) of
+    the ``bodies`` and ``leaves`` (indices; the others' nodes are left as they are).
 
     Bodies: the node at each joint takes the body's rotation and position; an object's tip
     node the last body's rotation and its end. Leaves: the petiole's k segments curl evenly,
@@ -238,7 +239,7 @@ def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf
     node (the lamina) the whole turn.
     """
     G = np.empty((3, 3))
-    for b in range(body_node.shape[0]):
+    for b in bodies:
         j = body_node[b]
         for i in range(3):
             pos[j, i] = P[b, i]
@@ -252,7 +253,7 @@ def pose_nodes(body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf
                     s += R[b, i, c] * (Xrest[t, c] - Xrest[j, c])
                     rot[t, i, c] = R[b, i, c]
                 pos[t, i] = s
-    for l in range(leaf_body.shape[0]):
+    for l in leaves:
         b = leaf_body[l]
         a = leaf_first[l]
         e = leaf_first[l + 1]

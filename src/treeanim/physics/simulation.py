@@ -19,6 +19,7 @@ import numpy as np
 
 from ..model.tree import Tree
 from ..validate import finite_float, finite_vector3, float_within, object_index
+from .lod import check_levels, object_trees
 from .paper_sim import MAX_FREQUENCY, MAX_PULL, MAX_STEP, MAX_ZETA, PaperSim
 from .tree_sim import GRAB_STIFFNESS, MAX_GRAB_STIFFNESS, TreeSim
 from .wind import fit_to_tree
@@ -43,6 +44,7 @@ _TREE_ONLY = {
     "energy": "the paper's oscillators have no mechanical energy",
     "structure": "the paper's objects are independent",
     "point_position": "the paper's model has no drag",
+    "active_dof": "the paper's objects are independent",
 }
 
 
@@ -272,6 +274,38 @@ class Simulation:
     def reset(self) -> None:
         """Back to rest at time 0, nothing held."""
         self._impl.reset()
+
+    # ------------------------------------------------------------------ levels of detail
+    def set_detail(self, levels) -> None:
+        """Simulate each tree of a scene at a level of detail (tree model; docs/design.md §17).
+
+        Parameters
+        ----------
+        levels : int or sequence of int
+            One per tree (or one for all): 0 everything; 1 the leaves and twigs ride rigidly;
+            2 only the trunk and limbs sway (a grass blade, as at 1, on its base joint); 3 the
+            tree stands still
+            (:data:`~treeanim.physics.lod.MAX_DETAIL`). A tree holding a pull or a drag stays at
+            0. A switch moves no node: what freezes keeps its shape on its parent, what thaws
+            starts from its rigid ride. :func:`~treeanim.physics.lod.choose_detail` picks levels
+            from a camera.
+
+        Raises
+        ------
+        ValueError
+            Not one integer in 0..3 per tree, or the paper model.
+        """
+        n = int(object_trees(self._tree).max(initial=0)) + 1
+        levels = check_levels(levels, n)
+        if self._model != "tree":
+            raise ValueError("detail levels need model='tree' (the paper's objects are independent)")
+        self._impl.set_detail(levels)
+
+    @property
+    def detail(self) -> np.ndarray:
+        """(T,) int: the level each tree is stepped at (all 0 on the paper's model)."""
+        d = getattr(self._impl, "detail", None)
+        return np.zeros(int(object_trees(self._tree).max(initial=0)) + 1, np.int64) if d is None else d
 
     # ------------------------------------------------------------------ interaction
     def pull(self, i: int, force_xyz) -> None:

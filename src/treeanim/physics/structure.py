@@ -229,6 +229,12 @@ class Structure:
     subtree_mass: np.ndarray  # (B,) everything beyond each joint
     omega_j: np.ndarray     # (B,) each joint's lowest swing with everything beyond it flexible (rad/s)
     omega_t: np.ndarray     # (B,) and its twisting one
+    # what rides rigidly on a body beyond itself at a coarser level of detail (physics/lod.py):
+    # its drag, isotropic c(s)·s·u at one point, c(s) = lump_cd + lump_cl/∛(1 + lump_cauchy·s²)
+    lump_cd: np.ndarray     # (B,) the rigid segments' (N·s²/m²)
+    lump_cl: np.ndarray     # (B,) the rigid leaves'
+    lump_cauchy: np.ndarray  # (B,) the rigid leaves' mean scaled Cauchy number per (m/s)²
+    lump_x0: np.ndarray     # (B, 3) the point it acts at (rest axes, from the body's joint)
 
     @classmethod
     def build(cls, tree, physics, present: np.ndarray) -> "Structure":
@@ -403,4 +409,5 @@ class Structure:
                    leaf_d=c(leaf_d), leaf_cna=c(cna), leaf_cswing=c(cswing),
                    leaf_roll2=c(width**2 / 12.0), leaf_cauchy=c(cauchy), leaf_mass=c(leaf_mass), leaf_size=c(Llam, float),
                    leaf_nodes=c(leaf_nodes, np.int64), leaf_first=leaf_first, body_of_obj=first_body,
-                   subtree_mass=sm, omega_j=omega_flex, omega_t=omega_t)
+                   subtree_mass=sm, omega_j=omega_flex, omega_t=omega_t,
+                   lump_cd=np.zeros(B), lump_cl=np.zeros(B), lump_cauchy=np.zeros(B), lump_x0=np.zeros((B, 3)))

@@ -6,6 +6,7 @@ state (:class:`~.treestep.TreeState` and the fallen leaves) and steps it with
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -14,6 +15,7 @@ from ..model.params import PhysicsParams, check_physics
 from ..model.tree import KINDS, Tree
 from . import treestep
 from .falling import FallingLeaves
+from .lod import Reduced, object_trees
 from .structure import Structure
 from .treestep import Grab, TreeState, Work
 
@@ -67,14 +69,16 @@ class TreeSim:
         self._present = tree.leaves_present(self._season)
         self._present.setflags(write=False)
         self._s = Structure.build(tree, self._physics, self._present)
-        self._work = Work(len(self._s.parent), len(self._s.leaf_body))
+        self._work = Work(len(self._s.parent))
         self._st = TreeState.rest(self._s, self._seed)
-        self._next = self._st.copy()
         self._fallen = FallingLeaves(tree.object_start, tree.object_count, tree.rest_w, self._seed)
         self._pulls: dict[int, tuple[int, np.ndarray, np.ndarray, np.ndarray]] = {}  # body, offset, applied, asked
         self._grabs: dict[int, tuple[Grab, float, float]] = {}  # object -> grab, s, stiffness
         self.wind = wind
         self._pos = self._rot = None
+        self._levels = np.zeros(int(object_trees(tree).max(initial=0)) + 1, np.int64)  # asked
+        self._detail = self._levels.copy()  # stepped: the held trees at full detail
+        self._lod: Reduced | None = None
 
     # ------------------------------------------------------------------ model
     @property
@@ -87,6 +91,7 @@ class TreeSim:
         self._work.theta_h = None  # the joints' θ follow their frequencies
         for i, (g, s, stiffness) in list(self._grabs.items()):  # their springs follow the stiffness
             self.drag(i, g.target, s, stiffness)
+        self._relevel(force=True)
 
     @property
     def season(self) -> float:
@@ -149,34 +154,70 @@ class TreeSim:
         self._st.assign(s.tree)
         self._fallen = s.fallen
         self._pos = self._rot = None
+        self._relevel(force=True)
 
     def reset(self) -> None:
         """Back to rest at time 0, nothing held, no leaf fallen."""
         self._st = TreeState.rest(self._s, self._seed)
-        self._next = self._st.copy()
         self._fallen.clear()
         self._pulls.clear()
         self._grabs.clear()
         self._pos = self._rot = None
+        self._relevel(force=True)
 
     @property
     def energy(self) -> float:
         """Kinetic energy of every part plus the elastic energy of every joint (J)."""
         return treestep.energy(self._s, self._st)
 
+    # ------------------------------------------------------------------ levels of detail
+    def set_detail(self, levels: np.ndarray) -> None:
+        """Each tree's detail level (physics/lod.py; already validated by the façade). A tree
+        holding a pull or a drag stays at full detail."""
+        self._levels = np.array(levels, np.int64)
+        self._relevel()
+
+    @property
+    def detail(self) -> np.ndarray:
+        """(T,) the detail level each tree is stepped at (a copy)."""
+        return self._detail.copy()
+
+    @property
+    def active_dof(self) -> int:
+        """The degrees of freedom a step solves: three a joint and a petiole."""
+        s = self._s
+        return 3 * (len(s.parent) + len(s.leaf_body)) if self._lod is None else self._lod.dof
+
+    def _relevel(self, force: bool = False) -> None:
+        """Step at the levels asked, the held trees at full detail."""
+        held = [*self._pulls, *self._grabs]
+        detail = self._levels.copy()
+        detail[object_trees(self._tree)[held]] = 0
+        if not force and np.array_equal(detail, self._detail):
+            return
+        self._detail = detail
+        self._lod = Reduced(self._tree, self._s, self._st, detail, self._work) if detail.any() else None
+        self._pos = self._rot = None
+
     # ------------------------------------------------------------------ stepping
     def step(self, dt: float) -> None:
         """Advance by ``dt`` seconds (already validated by the façade). Atomic: a wind that
-        fails leaves the state as it was."""
-        s, st = self._s, self._st
+        fails leaves the state as it was (the winds are sampled before anything moves)."""
+        s, st, red = self._s, self._st, self._lod
         t = st.time
-        U = self._sample(treestep.sample_points(s, st), t)
         pulls = [(b, ofs, f) for b, ofs, f, _ in self._pulls.values()]
-        treestep.step(s, st, self._next, U, dt, self._work, pulls,
-                       [g for g, _, _ in self._grabs.values()], self._physics.leaf_flutter)
+        grabs = [g for g, _, _ in self._grabs.values()]
+        work = self._work
+        if red is not None:  # the active part; the held trees are whole, so their bodies are in it
+            s, st, work, at = red.s, red.gather(st), red.work, red.body_index
+            pulls = [(at[b], ofs, f) for b, ofs, f in pulls]
+            grabs = [dataclasses.replace(g, body=at[g.body]) for g in grabs]
+        U = self._sample(treestep.sample_points(s, st), t)
         if len(self._fallen):
             self._fallen.step(None if self.wind is None else (lambda p: self._sample(p, t)), dt)
-        self._st, self._next = self._next, self._st
+        treestep.step(s, st, st, U, dt, work, pulls, grabs, self._physics.leaf_flutter)
+        if red is not None:
+            red.scatter(self._st, self._s)
         self._pos = self._rot = None
 
     def _sample(self, points: np.ndarray, t: float) -> np.ndarray:
@@ -205,14 +246,20 @@ class TreeSim:
         return self._rot
 
     def _pose(self) -> None:
-        N = self._tree.n_nodes
-        pos, rot = np.empty((N, 3)), np.empty((N, 3, 3))
-        treestep.pose(self._s, self._st, self._tree.rest_positions, pos, rot)
+        N, red = self._tree.n_nodes, self._lod
+        if red is not None and red.last is not None:  # the still trees' nodes are where they were
+            pos, rot = red.last[0].copy(), red.last[1].copy()
+            treestep.pose(self._s, self._st, self._tree.rest_positions, pos, rot, red.moving)
+        else:
+            pos, rot = np.empty((N, 3)), np.empty((N, 3, 3))
+            treestep.pose(self._s, self._st, self._tree.rest_positions, pos, rot)
         if len(self._fallen):
             self._fallen.pose(pos, rot)
         pos.setflags(write=False)
         rot.setflags(write=False)
         self._pos, self._rot = pos, rot
+        if red is not None:
+            red.last = pos, rot
 
     # ------------------------------------------------------------------ interaction
     def _point(self, i: int, s: float) -> tuple[int, np.ndarray]:
@@ -239,6 +286,7 @@ class TreeSim:
         n = float(np.linalg.norm(force))
         f_max = self._strength(b, ofs)[1]
         self._pulls[i] = (b, ofs, force * (f_max / n) if n > f_max else force, force)
+        self._relevel()
 
     @property
     def pulls(self) -> dict[int, np.ndarray]:
@@ -277,6 +325,7 @@ class TreeSim:
         m = float(self._s.subtree_mass[b])
         g = Grab(body=b, offset=ofs, target=target, k=k, c=2.0 * np.sqrt(k * m), f_max=float(f_max), mass=m)
         self._grabs[i] = (g, s, float(stiffness))
+        self._relevel()
 
     @property
     def drags(self) -> dict[int, tuple[np.ndarray, float]]:
@@ -288,9 +337,10 @@ class TreeSim:
         if i is None:
             self._pulls.clear()
             self._grabs.clear()
-            return
-        self._pulls.pop(i, None)
-        self._grabs.pop(i, None)
+        else:
+            self._pulls.pop(i, None)
+            self._grabs.pop(i, None)
+        self._relevel()
 
     def tip_position(self, i: int) -> np.ndarray:
         """Posed world position of object ``i``'s tip node."""

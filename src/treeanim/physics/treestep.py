@@ -109,10 +109,11 @@ def sample_points(s: Structure, st: TreeState) -> np.ndarray:
 
 @njit(cache=True, fastmath=True, error_model="numpy")
 def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf_N, leaf_kap, leaf_U, leaf_kap2,
-                leaf_speed, F, kap):
-    """The air's force on every segment (across it) and the leaves' forces, with their implicit
-    damping terms κ as points (see :func:`~treeanim.physics.articulated.articulated_step`) and
-    the segments' turn stiffness (:func:`_turn_stiffness`)."""
+                leaf_speed, lump_cd, lump_cl, lump_cauchy, lump_x0, F, kap):
+    """The air's force on every segment (across it), on what rides rigidly on it at a coarser
+    level of detail (:func:`_lump_force`) and the leaves' forces, with their implicit damping
+    terms κ as points (see :func:`~treeanim.physics.articulated.articulated_step`) and the
+    segments' turn stiffness (:func:`_turn_stiffness`)."""
     B = R.shape[0]
     Ka = np.empty((3, 3))
     for b in range(B):
@@ -142,6 +143,8 @@ def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf
         add_point(kap, b, h * c, -h * c, ax, ay, az, h * c, ux * q, uy * q, uz * q, rx, ry, rz)
         if c > 0.0:
             _turn_stiffness(b, h, cda[b], un, ux, uy, uz, d, ax, ay, az, rx, ry, rz, fx, fy, fz, Om, F, kap, Ka)
+        if lump_cd[b] > 0.0 or lump_cl[b] > 0.0:
+            _lump_force(b, h, R, Om, V, U, lump_cd[b], lump_cl[b], lump_cauchy[b], lump_x0[b], F, kap, Ka)
     for l in range(leaf_body.shape[0]):
         b = leaf_body[l]
         rx, ry, rz = leaf_X[l, 0], leaf_X[l, 1], leaf_X[l, 2]
@@ -158,6 +161,39 @@ def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf
             _leaf_turn_stiffness(b, h, leaf_kap[l] * leaf_speed[l], leaf_U[l], leaf_N[l], rx, ry, rz,
                                  fx, fy, fz, Ka)
             _add_turn(b, h, Ka, Om, F, kap)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _lump_force(b, h, R, Om, V, U, cd, cl, cauchy, x0, F, kap, Ka):
+    """The drag of the twigs and leaves riding rigidly on body b (physics/lod.py): isotropic,
+    c(s)·s·u with u the wind relative to the point x where it acts and s = |u|, c(s) = cd +
+    cl/∛(1 + cauchy·s²) (the leaves folding as :func:`~.leafjoint.leaf_step`'s do); its
+    damping −∂f/∂v ≈ c·s(1 + ûûᵀ) and its lever's turn stiffness (x·f)1 − x fᵀ implicit."""
+    x = R[b, 0, 0] * x0[0] + R[b, 0, 1] * x0[1] + R[b, 0, 2] * x0[2]
+    y = R[b, 1, 0] * x0[0] + R[b, 1, 1] * x0[1] + R[b, 1, 2] * x0[2]
+    z = R[b, 2, 0] * x0[0] + R[b, 2, 1] * x0[1] + R[b, 2, 2] * x0[2]
+    ux = U[b, 0] - (V[b, 0] + Om[b, 1] * z - Om[b, 2] * y)
+    uy = U[b, 1] - (V[b, 1] + Om[b, 2] * x - Om[b, 0] * z)
+    uz = U[b, 2] - (V[b, 2] + Om[b, 0] * y - Om[b, 1] * x)
+    s = np.sqrt(ux * ux + uy * uy + uz * uz)
+    if s <= 0.0:
+        return
+    cs = (cd + cl / np.cbrt(1.0 + cauchy * s * s)) * s
+    fx, fy, fz = cs * ux, cs * uy, cs * uz
+    F[b, 0] += y * fz - z * fy
+    F[b, 1] += z * fx - x * fz
+    F[b, 2] += x * fy - y * fx
+    F[b, 3] += fx
+    F[b, 4] += fy
+    F[b, 5] += fz
+    add_point(kap, b, h * cs, h * cs, ux / s, uy / s, uz / s, 0.0, 0.0, 0.0, 0.0, x, y, z)
+    xf = x * fx + y * fy + z * fz
+    r = (x, y, z)
+    f = (fx, fy, fz)
+    for i in range(3):
+        for j in range(3):
+            Ka[i, j] = (xf if i == j else 0.0) - r[i] * f[j]
+    _add_turn(b, h, Ka, Om, F, kap)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -226,7 +262,9 @@ def _add_turn(b, h, Ka, Om, F, kap):
 class Work:
     """Scratch arrays of one structure's step (allocated once)."""
 
-    def __init__(self, B: int, L: int):
+    _ARRAYS = ("F", "kap", "IA", "pA", "Dinv", "U", "Ur", "u", "acc")
+
+    def __init__(self, B: int):
         self.F = np.zeros((B, 6))
         self.kap = np.zeros((B, 6, 6))
         self.IA = np.empty((B, 6, 6))
@@ -238,6 +276,14 @@ class Work:
         self.acc = np.empty((B, 6))  # each body's change of spatial velocity over the step
         self.theta = None
         self.theta_h = None
+
+    def head(self, B: int) -> "Work":
+        """Scratch of a structure of B bodies (at most this one's) in this one's first rows
+        (never used at the same time as this one)."""
+        w = Work(0)
+        for name in self._ARRAYS:
+            setattr(w, name, getattr(self, name)[:B])
+        return w
 
 
 def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: float, work: Work,
@@ -268,7 +314,8 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     w.kap[:] = 0.0
     Ub = np.ascontiguousarray(wind)
     _air_forces(dt, out.R, out.Om, out.V, s.mid0, s.axis, s.cda, Ub, s.leaf_body,
-                out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, out.leaf_speed, w.F, w.kap)
+                out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, out.leaf_speed,
+                s.lump_cd, s.lump_cl, s.lump_cauchy, s.lump_x0, w.F, w.kap)
     for b, ofs, f in pulls:
         _point_force(b, out.R[b] @ ofs, np.asarray(f, float), dt, out, w)
     for g in grabs:
@@ -332,10 +379,12 @@ def _point_force(b: int, r: np.ndarray, f: np.ndarray, h: float, st: TreeState, 
     _add_turn(b, h, Ka, st.Om, w.F, w.kap)
 
 
-def pose(s: Structure, st: TreeState, rest: np.ndarray, pos: np.ndarray, rot: np.ndarray) -> None:
-    """Write the posed nodes: ``pos`` (N, 3) and rest-relative rotations ``rot`` (N, 3, 3)."""
-    pose_nodes(s.node, s.tip, s.tip_node, rest, st.R, st.P, s.leaf_nodes, s.leaf_first, s.leaf_body, s.leaf_E,
-               st.th, s.leaf_on, pos, rot)
+def pose(s: Structure, st: TreeState, rest: np.ndarray, pos: np.ndarray, rot: np.ndarray, parts=None) -> None:
+    """Write the posed nodes: ``pos`` (N, 3) and rest-relative rotations ``rot`` (N, 3, 3), of
+    the ``parts`` (bodies, leaves) only where given (the other nodes left as they are)."""
+    bodies, leaves = (np.arange(len(s.parent)), np.arange(len(s.leaf_body))) if parts is None else parts
+    pose_nodes(bodies, leaves, s.node, s.tip, s.tip_node, rest, st.R, st.P, s.leaf_nodes, s.leaf_first, s.leaf_body,
+               s.leaf_E, st.th, s.leaf_on, pos, rot)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")

@@ -25,8 +25,10 @@ import numpy as np
 
 from ..model.scene import Scene as TreeScene
 from ..model.tree import Tree
+from .culling import TreeOrder
 from .ground_maps import ground_texture
 from .leaf_maps import lamina_box, leaf_texture
+from .lod import LOD_LAMINA_CORNERS, coarse_laminas, coarse_tubes, lod_band, median_leaf
 from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
 from .scene import Scene, clip_ground
@@ -41,78 +43,118 @@ def release_all(*objects) -> None:
             o.release()
 
 
-class _Part:
-    """One part of the mesh: its program, and its triangles' range in the index buffer."""
-
-    def __init__(self, prog: moderngl.Program, first: int, count: int) -> None:
-        self.prog = prog
-        self.vao: moderngl.VertexArray | None = None
-        self.first = first
-        self.count = count
-
-    def render(self) -> None:
-        if self.count:
-            self.vao.render(moderngl.TRIANGLES, vertices=self.count, first=self.first)
-
-
 class TreePass:
     """The tree's skinned mesh: one static vertex buffer, one index buffer part after part, a
     program per part (``PART`` in ``tree.vert``/``tree.frag``: each holds only its own code), and
     the ``Tree`` block.
+
+    Each part's triangles lie tree by tree (:class:`~.culling.TreeOrder`), and after the parts
+    a scene's far trees' leaves and bark (:func:`~.lod.coarse_laminas`,
+    :func:`~.lod.coarse_tubes`), so :meth:`view` can keep a scene's draws to the trees in view,
+    and its far trees coarse: two more programs for leaves and two for bark (``LOD_FADE`` 1 and
+    2) draw the full and coarse meshes of the trees in the hand-over band, dithered. A lone
+    tree is one range a part, always drawn whole.
 
     Parameters
     ----------
     ctx : moderngl.Context
     mesh : TreeMesh
     tree : Tree
-        The mesh's tree (its bark's look).
+        The mesh's tree (its bark's look; its trees, if a scene).
+    pad : float
+        How far the surface reaches beyond the nodes (the trees' spheres).
+
+    Attributes
+    ----------
+    order : TreeOrder
+    drawn : dict
+        The last frame's draws: ``trees`` in view, ``triangles`` and ``draws`` (calls).
     """
 
-    def __init__(self, ctx: moderngl.Context, mesh: TreeMesh, tree: Tree) -> None:
+    def __init__(self, ctx: moderngl.Context, mesh: TreeMesh, tree: Tree, pad: float = 0.0) -> None:
         self.vbo = self.ibo = self.block = self.leaf_maps = None
-        self.parts: dict[str, _Part] = {}
+        self.programs: dict[tuple[str, int], tuple[moderngl.Program, moderngl.VertexArray | None]] = {}
+        self.order = TreeOrder(tree, mesh, pad)
+        self.many = self.order.n_trees > 1
+        self.leaf = median_leaf(tree)
+        self.drawn = {"trees": 0, "triangles": 0, "draws": 0}
         try:
             self.block = UniformBlock(ctx, "Tree")
             bark = tree.bark
             if tree.lamina is not None and len(tree.lamina.outline):
                 self.leaf_maps = leaf_texture(ctx, tree.lamina)
             self.block.set(bark_color=bark.color, bark=(bark.furrows, bark.depth, bark.interlace, bark.lenticels),
-                           lamina_box=lamina_box(tree.lamina) if self.leaf_maps is not None else (1.0, 1.0))
-            tris = [mesh.part_indices(name) for name in PARTS]
+                           lamina_box=lamina_box(tree.lamina) if self.leaf_maps is not None else (1.0, 1.0),
+                           lod_band=(1e30, 2e30))
+            tris, self.ranges, first = [], {}, 0
+            groups = [(name, mesh.part_indices(name)) for name in PARTS]
+            if self.many:
+                groups += [("COARSE_LEAVES", coarse_laminas(mesh, tree, LOD_LAMINA_CORNERS)), ("COARSE_BARK", coarse_tubes(mesh))]
+            for name, t in groups:
+                t, self.ranges[name] = self.order.group(t, first)
+                tris.append(t)
+                first += self.ranges[name].total
             if mesh.triangle_count:
                 self.vbo = ctx.buffer(mesh.vertices.tobytes())
-                self.ibo = ctx.buffer(np.concatenate(tris).tobytes())
-            first = 0
-            for k, (name, t) in enumerate(zip(PARTS, tris)):
-                part = self.parts[name] = _Part(load_program(ctx, "tree.vert", "tree.frag", defines={"PART": k}),
-                                                first, 3 * len(t))
-                if part.count:
-                    part.vao = ctx.vertex_array(part.prog, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRIBUTES)],
-                                                index_buffer=self.ibo, index_element_size=4)
-                first += part.count
+                self.ibo = ctx.buffer(np.concatenate(tris).astype(np.uint32).tobytes())
+            variants = [(name, 0) for name in PARTS] + ([(n, f) for n in ("LEAVES", "BARK") for f in (1, 2)] if self.many else [])
+            for name, fade in variants:
+                prog = load_program(ctx, "tree.vert", "tree.frag", defines={"PART": list(PARTS).index(name), "LOD_FADE": fade})
+                vao = None
+                if self.ranges[name].total:
+                    vao = ctx.vertex_array(prog, [(self.vbo, VERTEX_FORMAT, *VERTEX_ATTRIBUTES)],
+                                           index_buffer=self.ibo, index_element_size=4)
+                self.programs[name, fade] = (prog, vao)
         except BaseException:
             self.release()
             raise
+        self.view()
 
     def apply(self, scene: Scene) -> None:
         """Take the scene's settings (leaves' translucency, thin lines' width)."""
         self.block.set(translucency=scene.translucency, thin_pixels=scene.thin_pixels)
 
+    def view(self, view_proj: np.ndarray | None = None, eye=None, pixels_per_metre: float = 0.0) -> None:
+        """Which trees the next frame's draws hold: of a scene, those whose sphere reaches into
+        ``view_proj``'s volume, their leaves full or coarse by their distance from the ``eye``
+        and how long a leaf is on screen (:func:`~.lod.lod_band`); None: every tree, full."""
+        n = self.order.n_trees
+        keep, full, coarse = np.ones(n, bool), np.ones(n, bool), np.zeros(n, bool)
+        if view_proj is not None and self.many:
+            keep = self.order.visible(view_proj)
+            band = lod_band(self.leaf, pixels_per_metre)
+            self.block.set(lod_band=band)
+            d = np.linalg.norm(self.order.centres - np.asarray(eye, float), axis=1)
+            full, coarse = d + self.order.radii <= band[0], d - self.order.radii >= band[1]
+        both = keep & ~(full | coarse)
+        # each part's draws: (ranges, program variant, trees)
+        self._draws = {"LEAVES": [("LEAVES", 0, keep & full), ("COARSE_LEAVES", 0, keep & coarse),
+                                  ("LEAVES", 1, both), ("COARSE_LEAVES", 2, both)],
+                       "BARK": [("BARK", 0, keep & full), ("COARSE_BARK", 0, keep & coarse),
+                                ("BARK", 1, both), ("COARSE_BARK", 2, both)],
+                       "BLADES": [("BLADES", 0, keep)]}
+        self.drawn = {"trees": int(keep.sum()), "triangles": 0, "draws": 0}
+
     def draw(self, *parts: str, season: float) -> None:
-        """Draw ``parts`` (names of ``mesh.PARTS``) in order, the leaves coloured for ``season``
-        (0 summer .. 1 winter); the shadow map bound to its unit."""
+        """Draw ``parts`` (names of ``mesh.PARTS``) in order, of the trees :meth:`view` kept, the
+        leaves coloured for ``season`` (0 summer .. 1 winter); the shadow map bound to its unit."""
         self.block.set(season=season)
         self.block.use()
         if self.leaf_maps is not None:
             self.leaf_maps.use(SAMPLERS["leaf_maps"].unit)
         for name in parts:
-            self.parts[name].render()
+            for ranges, fade, keep in self._draws[name]:
+                vao = self.programs[name, fade][1] if keep.any() else None  # a lone tree: no coarse ranges
+                for first, count in self.ranges[ranges].runs(keep) if vao is not None else ():
+                    vao.render(moderngl.TRIANGLES, vertices=count, first=first)
+                    self.drawn["triangles"] += count // 3
+                    self.drawn["draws"] += 1
 
     def release(self) -> None:
         """Free the GL objects (idempotent)."""
-        for part in self.parts.values():
-            release_all(part.vao, part.prog)
-        self.parts = {}
+        for prog, vao in self.programs.values():
+            release_all(vao, prog)
+        self.programs = {}
         release_all(self.vbo, self.ibo, self.block, self.leaf_maps)
         self.vbo = self.ibo = self.block = self.leaf_maps = None
 

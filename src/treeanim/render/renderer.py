@@ -35,11 +35,13 @@ import numpy as np
 
 from ..model.tree import Tree
 from .camera import OrbitCamera
+from .lod import THIN_CASTER_TEXELS, caster_classes
 from .mesh import TreeMesh, build_mesh
 from .passes import BackgroundCache, GroundPass, OverlayPass, SkyPass, TreePass, release_all
 from .scene import Scene
 from .shaders import DEPTH_FOOTPRINT, DEPTH_GROUND
 from .shadow import ShadowMap, shadow_indices
+from .shadow_view import MIN_REACH, VIEW_REACH, view_slice
 from .uniforms import SAMPLERS, UniformBlock
 
 #: Width in texels of the node and object textures (GL 3.3 guarantees 1024).
@@ -59,7 +61,8 @@ def _bound_framebuffer(ctx: moderngl.Context) -> moderngl.Framebuffer:
 
 
 class Renderer:
-    """Draws one tree (plus sky, ground and overlays) on any moderngl context of GL >= 3.3.
+    """Draws one tree or a scene of many (plus sky, ground and overlays) on any moderngl context
+    of GL >= 3.3; a scene tree by tree, those in view (docs/design.md §17, Drawing).
 
     Parameters
     ----------
@@ -101,9 +104,17 @@ class Renderer:
         try:
             self.light = UniformBlock(ctx, "Light")
             self.view = UniformBlock(ctx, "View")
-            self.tree_pass = TreePass(ctx, self.mesh, tree)
+            self.tree_pass = TreePass(ctx, self.mesh, tree, self.pad)
             bound = _bound_framebuffer(ctx)
-            self.shadow = ShadowMap(ctx, self.tree_pass.vbo, shadow_indices(self.mesh, tree), self.scene.shadow_size)
+            casters = shadow_indices(self.mesh, tree, coarse_bark=self.tree_pass.many)
+            classes = caster_classes(self.mesh, tree, casters) if self.tree_pass.many else [(math.inf, casters)]
+            self._casters, tris, first = [], [], 0  # (thickest diameter, ranges) of each class
+            for thickest, t in classes:
+                t, ranges = self.tree_pass.order.group(t, first)
+                self._casters.append((thickest, ranges))
+                tris.append(t)
+                first += ranges.total
+            self.shadow = ShadowMap(ctx, self.tree_pass.vbo, np.concatenate(tris), self.scene.shadow_size)
             bound.use()  # making the map's framebuffer bound it
 
             # --- per-frame textures
@@ -128,6 +139,7 @@ class Renderer:
             self._present_season: float | None = None
             self._highlight = np.zeros(M, bool)
             self._objects_dirty = True
+            self._shadow_runs = None  # the shadow map's draws (None: all)
             self.update(tree.rest_positions, np.broadcast_to(np.eye(3), (N, 3, 3)))
         except BaseException:
             self.release()
@@ -249,12 +261,14 @@ class Renderer:
         self._upload_objects(season)
         self.node_texture.use(SAMPLERS["nodes"].unit)
         self.object_texture.use(SAMPLERS["objects"].unit)
+        vp = camera.view_projection(width, height)
+        pixels_per_metre = 0.5 * height / math.tan(math.radians(camera.fov_y) / 2)
+        self._cull(camera, vp, pixels_per_metre)
         if self.scene.shadow:
             ctx.disable(moderngl.CULL_FACE | moderngl.BLEND)
-            self.shadow.draw()
-        vp = camera.view_projection(width, height)
+            self.shadow.draw(self._shadow_runs)
         self.view.set(view_proj=vp, inv_view_proj=np.linalg.inv(vp.astype(np.float64)), camera_pos=camera.eye,
-                      viewport=(width, height), pixels_per_metre=0.5 * height / math.tan(math.radians(camera.fov_y) / 2))
+                      viewport=(width, height), pixels_per_metre=pixels_per_metre)
         for block in (self.light, self.view, self.shadow.block):
             block.use()
         key = (width, height, vp.tobytes(), tuple(camera.eye), self._applied_scene)
@@ -285,6 +299,29 @@ class Renderer:
         self.tree_pass.draw("BARK", "BLADES", season=season)
         ctx.disable(moderngl.BLEND)
         self.overlay_pass.draw([o for o in overlays if o is not None], self.tree)
+
+    def _cull(self, camera: OrbitCamera, vp: np.ndarray, pixels_per_metre: float) -> None:
+        """A scene's draws for this view: the trees in it, far leaves coarse, and the shadow map
+        fitted to the view and drawn with the trees in the sun's view of it, less twigs far
+        thinner than its texel. A lone tree is drawn whole, its shadow map fitted to it."""
+        self._shadow_runs = None
+        if not self.tree_pass.many:
+            self.tree_pass.view()  # the frame's counts start afresh
+            return
+        self.tree_pass.view(vp, camera.eye, pixels_per_metre)
+        if self.scene.shadow:
+            reach = max(VIEW_REACH * camera.distance, MIN_REACH)
+            self.shadow.follow(view_slice(vp, camera.eye, camera.forward, reach))
+            visible = self.tree_pass.order.visible(self.shadow.matrix)
+            thinnest = THIN_CASTER_TEXELS * self.shadow.texel
+            self._shadow_runs = [run for thickest, ranges in self._casters if thickest > thinnest for run in ranges.runs(visible)]
+
+    @property
+    def drawn(self) -> dict:
+        """The last frame's draws of the tree: ``trees`` in view, ``triangles`` and ``draws``
+        (calls) of the colour passes, ``shadow_triangles`` of the shadow map's."""
+        runs = [(0, sum(r.total for _, r in self._casters))] if self._shadow_runs is None else self._shadow_runs
+        return dict(self.tree_pass.drawn, shadow_triangles=sum(c for _, c in runs) // 3 if self.scene.shadow else 0)
 
     def _ground_shown(self, camera: OrbitCamera) -> bool:
         return bool(self.scene.show_ground and camera.eye[1] > 0.0)

@@ -14,18 +14,26 @@ import moderngl
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
 
-from ..model.lamina import ear_clip
 from ..model.tree import Tree
-from .mesh import BLADE_CLUMP, MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, VERTEX_ATTRIBUTES, VERTEX_DTYPE, VERTEX_FORMAT, TreeMesh
+from .culling import SWAY_MARGIN
+from .lod import coarse_laminas, coarse_tubes
+from .mesh import (
+    BLADE_CLUMP,
+    MATERIAL_BARK,
+    MATERIAL_BLADE,
+    MATERIAL_LAMINA,
+    MATERIAL_PETIOLE,
+    VERTEX_ATTRIBUTES,
+    VERTEX_DTYPE,
+    VERTEX_FORMAT,
+    TreeMesh,
+)
 from .shaders import load_program
+from .shadow_view import EDGE_FADE, clip_convex, view_window, window_on_ground
 from .uniforms import UniformBlock
 
 #: Attributes the shadow pass reads; the rest of each vertex is skipped.
 SHADOW_ATTRIBUTES = ("in_ids", "in_offset", "in_extra", "in_curve", "in_tangent0", "in_tangent1")
-#: The box round the tree at rest grows by this fraction of its size each way (sway room), but
-#: by no more than its height (nothing sways further than it stands tall: a meadow's box grows
-#: by a blade's length, not by 15 % of the meadow's width).
-SWAY_MARGIN = 0.15
 #: The lowest sun elevation the map is fitted for (sin of it): lower suns cast the shadow of
 #: a sun at this height, not an endless one.
 MIN_SUN_HEIGHT = 0.15
@@ -47,11 +55,13 @@ def _skipping_format() -> str:
     return " ".join(parts)
 
 
-def shadow_indices(mesh: TreeMesh, tree: Tree) -> np.ndarray:
+def shadow_indices(mesh: TreeMesh, tree: Tree, coarse_bark: bool = False) -> np.ndarray:
     """The triangles the shadow pass draws: the mesh's, without petioles (a few millimetres
     across, far below a texel), with each lamina outlined by :data:`SHADOW_LAMINA_CORNERS`
     of its corners (a lamina's vertices are its outline's, in order, per leaf), and each blade
-    clump casting its simulated blade's shadow (an object's first triangles: mesh notes).
+    clump casting its simulated blade's shadow (an object's first triangles: mesh notes);
+    with ``coarse_bark`` (a scene's), the bark's tubes with half their sides
+    (:func:`~.lod.coarse_tubes`).
 
     Returns
     -------
@@ -63,17 +73,9 @@ def shadow_indices(mesh: TreeMesh, tree: Tree) -> np.ndarray:
     obj = np.repeat(np.arange(len(mesh.object_triangles)), mesh.object_triangles)
     copy = (first == MATERIAL_BLADE) & (np.arange(len(first)) - mesh.object_triangle_start[obj]
                                         >= mesh.object_triangles[obj] // BLADE_CLUMP)
-    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA) & ~copy]]
-    lamina = np.flatnonzero(material == MATERIAL_LAMINA)
-    if len(lamina):
-        outline = tree.lamina.outline
-        K = len(outline)
-        corners = np.unique(np.linspace(0, K, SHADOW_LAMINA_CORNERS, endpoint=False).round().astype(int))
-        try:
-            tris = corners[ear_clip(outline[corners])]
-        except ValueError:  # the coarse outline crosses itself: keep the full lamina
-            tris = np.asarray(tree.lamina.triangles)
-        keep.append(lamina.reshape(-1, K)[:, tris].reshape(-1, 3))
+    bark = coarse_bark & (first == MATERIAL_BARK)
+    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA) & ~copy & ~bark],
+            coarse_laminas(mesh, tree, SHADOW_LAMINA_CORNERS), coarse_tubes(mesh) if coarse_bark else np.zeros((0, 3), np.uint32)]
     return np.ascontiguousarray(np.concatenate(keep), dtype=np.uint32)
 
 
@@ -106,6 +108,13 @@ def _box_and_shadow(sun: np.ndarray, lo, hi) -> tuple[np.ndarray, np.ndarray]:
     below the ground stand for the ground under them)."""
     corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
     return corners, _shadow(sun, corners)
+
+
+def _receivers(sun: np.ndarray, lo, hi) -> tuple[np.ndarray, np.ndarray]:
+    """The box that holds the box ``lo`` .. ``hi`` and its shadow on the ground: all that a
+    caster inside it can shade."""
+    pts = np.vstack(_box_and_shadow(sun, lo, hi))
+    return pts.min(axis=0), pts.max(axis=0)
 
 
 def _shadow(sun: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -145,7 +154,17 @@ def ground_footprint(sun, points, reach: float) -> np.ndarray:
     return xz[ConvexHull(xz).vertices]
 
 
-def light_view_projection(sun: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, float]:
+def sun_basis(sun) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(right, up, forward): the sun's view axes, unit; it looks along forward, towards the
+    ground, from the sun :func:`cast_direction` makes of ``sun``."""
+    forward = -cast_direction(sun)
+    up = np.array([0.0, 1.0, 0.0]) if abs(forward[1]) < 0.99 else np.array([0.0, 0.0, 1.0])
+    right = np.cross(forward, up)
+    right /= np.linalg.norm(right)
+    return right, np.cross(right, forward), forward
+
+
+def light_view_projection(sun: np.ndarray, lo: np.ndarray, hi: np.ndarray, window=None) -> tuple[np.ndarray, float]:
     """The sun's orthographic view-projection for a tree in the box ``lo`` .. ``hi``.
 
     Parameters
@@ -154,6 +173,9 @@ def light_view_projection(sun: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tu
         Unit vector towards the sun.
     lo, hi : (3,) float
         Corners of the box that holds every caster (world, y up, ground at y = 0).
+    window : (x0, x1, y0, y1) or None
+        The map's extent across the sun's rays (along :func:`sun_basis`' right and up, metres);
+        None: the box's and its shadow's, and a margin.
 
     Returns
     -------
@@ -162,18 +184,13 @@ def light_view_projection(sun: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tu
     extent : float
         The larger side of the map's footprint (metres), for the texel size.
     """
-    sun = cast_direction(sun)
-    forward = -sun  # the sun looks along -sun
-    up = np.array([0.0, 1.0, 0.0]) if abs(sun[1]) < 0.99 else np.array([0.0, 0.0, 1.0])
-    right = np.cross(forward, up)
-    right /= np.linalg.norm(right)
-    up = np.cross(right, forward)
-    corners, ground = _box_and_shadow(sun, lo, hi)
+    right, up, forward = sun_basis(sun)
+    corners, ground = _box_and_shadow(cast_direction(sun), lo, hi)
     pts = np.vstack([corners, ground])
     x, y, d = pts @ right, pts @ up, pts @ forward  # d: distance along the sun's rays
     x0, x1, y0, y1 = x.min(), x.max(), y.min(), y.max()
     pad = 0.02 * max(x1 - x0, y1 - y0)
-    x0, x1, y0, y1 = x0 - pad, x1 + pad, y0 - pad, y1 + pad
+    x0, x1, y0, y1 = (x0 - pad, x1 + pad, y0 - pad, y1 + pad) if window is None else window
     near, far = d.min() - pad, d.max() + pad
     view = np.eye(4)
     view[0, :3], view[1, :3], view[2, :3] = right, up, -forward  # a right-handed eye space
@@ -223,12 +240,15 @@ class ShadowMap:
         self.matrix = np.eye(4, dtype=np.float32)
         self.texel = 1.0
         self.footprint = np.zeros((0, 2))
+        self.window: tuple | None = None  # :meth:`follow`'s window; None: the whole tree's map
         self._fitted: tuple | None = None
-        self.block.set(light_view_proj=self.matrix, shadow_texel=self.texel, shadow_on=1)
+        self.block.set(light_view_proj=self.matrix, shadow_texel=self.texel, shadow_on=1, shadow_edge=0.0)
         self.clear()
 
     def fit(self, sun, lo, hi, points, pad: float) -> None:
-        """Fit the sun's view to the box ``lo`` .. ``hi`` grown by :data:`SWAY_MARGIN` (cached),
+        """Fit the sun's view to the box ``lo`` .. ``hi`` grown by :data:`~.culling.SWAY_MARGIN`
+        of its size each way for sway, but by no more than its height (nothing sways further than
+        it stands tall: a meadow's box grows by a blade's length, not by 15 % of its width) (cached),
         and the ground's :attr:`footprint` to the tree's ``points`` (its nodes at rest) grown by
         the same and by ``pad`` (how far its surface reaches beyond them)."""
         key = (tuple(np.round(sun, 9)), tuple(lo), tuple(hi))
@@ -237,11 +257,35 @@ class ShadowMap:
         self._fitted = key
         lo, hi = np.asarray(lo, float), np.asarray(hi, float)
         grow = min(SWAY_MARGIN * (hi - lo).max(), hi[1] - lo[1])
-        self.matrix, extent = light_view_projection(sun, lo - grow, hi + grow)
-        self.texel = extent / self.size
-        reach = grow + pad + FOOTPRINT_TEXELS * self.texel / cast_direction(sun)[1]  # texels long on the ground
-        self.footprint = ground_footprint(sun, points, reach)
-        self.block.set(light_view_proj=self.matrix, shadow_texel=self.texel)
+        self._sun, self._box = cast_direction(sun), (lo - grow, hi + grow)
+        matrix, self._extent = light_view_projection(sun, *self._box)
+        texel = self._extent / self.size
+        reach = grow + pad + FOOTPRINT_TEXELS * texel / self._sun[1]  # texels long on the ground
+        self._whole = matrix, texel, ground_footprint(sun, points, reach)
+        self._receivers = _receivers(self._sun, *self._box)
+        self.window = None
+        self._show(*self._whole, edge=0.0)
+
+    def _show(self, matrix: np.ndarray, texel: float, footprint: np.ndarray, edge: float) -> None:
+        self.matrix, self.texel, self.footprint = matrix, texel, footprint
+        self.block.set(light_view_proj=matrix, shadow_texel=texel, shadow_edge=edge)
+
+    def follow(self, slice_planes: np.ndarray) -> None:
+        """Fit the map to what a view sees (after :meth:`fit`): the receivers inside
+        ``slice_planes`` (:func:`~.shadow_view.view_slice`), snapped to the texel grid
+        (:func:`~.shadow_view.view_window`), shadows fading out at its border; or the whole
+        tree's map where that is no larger."""
+        basis = sun_basis(self._sun)
+        window = view_window(basis, self._receivers, slice_planes, self.size, self._extent)
+        if window == self.window:
+            return
+        self.window = window
+        if window is None:
+            self._show(*self._whole, edge=0.0)
+            return
+        matrix, side = light_view_projection(self._sun, *self._box, window=window)
+        footprint = clip_convex(self._whole[2], window_on_ground(basis, window))
+        self._show(matrix, side / self.size, footprint, edge=EDGE_FADE)
 
     def enable(self, on: bool) -> None:
         """Shadows on (the map drawn each frame by :meth:`draw`) or off (the map cleared, its
@@ -254,9 +298,10 @@ class ShadowMap:
         """Nothing in the map: everything lit."""
         self.fbo.clear(depth=1.0)
 
-    def draw(self) -> None:
+    def draw(self, runs=None) -> None:
         """Draw the tree into the map (the node and object textures bound to units 0 and 1, as
-        for the scene). Leaves the map's framebuffer bound."""
+        for the scene): the (first, count) ``runs`` of its indices, or all (None). Leaves the
+        map's framebuffer bound."""
         ctx = self.ctx
         self.fbo.use()
         ctx.viewport = (0, 0, self.size, self.size)
@@ -267,7 +312,8 @@ class ShadowMap:
         ctx.enable(moderngl.DEPTH_TEST)
         ctx.depth_func = "<"
         ctx.polygon_offset = 1.5, 2.0  # slope-scaled bias against acne on grazing faces
-        self.vao.render(moderngl.TRIANGLES, vertices=self.count)
+        for first, count in [(0, self.count)] if runs is None else runs:
+            self.vao.render(moderngl.TRIANGLES, vertices=count, first=first)
         ctx.polygon_offset = 0.0, 0.0
 
     def release(self) -> None:

@@ -49,6 +49,7 @@ BLOCKS: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("mat4", "light_view_proj", "world -> the shadow map's clip space"),
         ("int", "shadow_on", "0: everything in sunlight"),
         ("float", "shadow_texel", "one shadow-map texel, metres"),
+        ("float", "shadow_edge", "shadows fade out over this share of the map's half side at its border (0: none)"),
     ),
     # TreePass's (tree.vert, tree.frag, tree_light.glsl).
     "Tree": (
@@ -58,6 +59,7 @@ BLOCKS: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("vec3", "bark_color", "sRGB"),
         ("vec4", "bark", "furrows around a branch, furrow depth, interlacing, lenticels"),
         ("vec2", "lamina_box", "the lamina's half width and length: its uv over the leaf maps"),
+        ("vec2", "lod_band", "metres from the eye where a scene's leaves hand over from full to coarse"),
     ),
     # GroundPass's (ground.frag).
     "Ground": (

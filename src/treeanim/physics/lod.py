@@ -1,0 +1,298 @@
+"""Levels of detail of the tree model (docs/design.md §17): a far tree is simulated with fewer
+degrees of freedom, the rest of it riding rigidly on what still moves.
+
+Each tree of a scene has a detail level (:data:`MAX_DETAIL` the coarsest):
+
+* 0 — everything: every segment's joint and every leaf's petiole;
+* 1 — the leaves and the twigs (branches that bear no branch) ride rigidly on their parents, a
+  grass blade on its base joint;
+* 2 — only the trunk and the limbs (the first two orders of branches) sway, the rest of the
+  crown riding on them; a grass blade on its base joint, as at 1 (a blade has nothing to
+  ride on, and grass bends far more for its height than a tree);
+* 3 — the tree stands still.
+
+:class:`Reduced` is the step's view of a scene with levels: the active bodies and leaves as a
+:class:`~.structure.Structure` of their own (their parents renumbered), so every compiled pass
+runs over them only. What rides rigidly on an active body joins its inertia (where it is when
+frozen, so the reduced model's energy is the whole tree's) and its drag (one isotropic drag per
+body, :func:`~.treestep._lump_force`); it keeps its shape relative to that body — its joints'
+rotations as they were, no relative velocity — and is carried along by :func:`carry`. So a
+switch never moves a node: going coarser drops only the relative velocities, going finer
+starts the freed joints from their rigid ride.
+
+:func:`choose_detail` picks the levels from the camera (each tree's height on the screen).
+"""
+
+from __future__ import annotations
+
+import numbers
+from dataclasses import fields
+
+import numpy as np
+
+from ..model.scene import Scene
+from .compiled import njit
+from .kinematics import _place
+from .structure import Structure
+from .treestep import TreeState, Work
+
+__all__ = ["MAX_DETAIL", "DETAIL_PIXELS", "Reduced", "active_parts", "carry", "check_levels", "choose_detail",
+           "object_trees", "tree_extents"]
+
+#: The coarsest detail level.
+MAX_DETAIL = 3
+#: A tree's height on the screen (px) below which it takes detail level 1, 2 and 3.
+DETAIL_PIXELS = (240.0, 80.0, 8.0)
+#: A tree goes coarser only when it is this much under a level's height (no flicker at the edge).
+HYSTERESIS = 0.15
+#: The mean drag along the flow of a segment at a random angle to it, per ½ρC_d·d·ℓ:
+#: ⟨sin³⟩ over the sphere, 3π/16.
+SEGMENT_DRAG = 3.0 * np.pi / 16.0
+#: The same of a lamina's normal force, ⟨cos²⟩ over the sphere.
+LEAF_DRAG = 1.0 / 3.0
+_BODY_STATE = ("Q", "w", "R", "P", "Om", "V")  # TreeState's per-body arrays (the others are per leaf)
+_LEAF_POSE = ("leaf_nodes", "leaf_first")  # Structure's leaf arrays that only the pose reads
+
+
+def object_trees(tree) -> np.ndarray:
+    """(M,) the tree each object belongs to (all 0 for a single tree)."""
+    return tree.object_tree if isinstance(tree, Scene) else np.zeros(tree.n_objects, np.int64)
+
+
+def check_levels(levels, n_trees: int) -> np.ndarray:
+    """``levels`` (one integer per tree, or one for all) as an (n_trees,) int array, or one
+    ValueError line."""
+    if isinstance(levels, numbers.Integral) and not isinstance(levels, bool):
+        levels = [levels] * n_trees
+    try:
+        a = np.asarray(levels)
+    except (TypeError, ValueError):
+        a = np.asarray([None])
+    if a.dtype == bool or not np.issubdtype(a.dtype, np.integer) or a.shape != (n_trees,):
+        raise ValueError(f"levels must be one integer per tree ({n_trees}), got {_brief(levels)}")
+    if len(a) and (a.min() < 0 or a.max() > MAX_DETAIL):
+        raise ValueError(f"levels must be in 0..{MAX_DETAIL}, got {int(a.min())}..{int(a.max())}")
+    return a.astype(np.int64)
+
+
+def _brief(x) -> str:
+    s = repr(x)
+    return s if len(s) <= 60 else s[:57] + "..."
+
+
+def active_parts(tree, s: Structure, levels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(B,) bool bodies and (L,) bool leaves that move at the trees' detail ``levels``: a
+    body's parent is always among them when it is."""
+    lv = levels[object_trees(tree)]
+    kind = np.asarray(tree.kind)
+    par = np.asarray(tree.parent)
+    bears = np.zeros(tree.n_objects, bool)  # bears a branch
+    grows = (par >= 0) & (kind != "leaf")
+    bears[par[grows]] = True
+    limb = (kind == "branch") & (np.asarray(tree.level) <= 2)
+    keep = (lv == 0) | ((lv == 1) & bears) | ((lv == 2) & limb) | ((lv < MAX_DETAIL) & (kind == "blade"))
+    o = s.obj
+    first = s.body_of_obj[o] == np.arange(len(o))  # (a blade's base joint)
+    bodies = keep[o] & ((lv[o] == 0) | (kind[o] != "blade") | first)
+    return bodies, lv[s.leaf_obj] == 0
+
+
+def _anchors(parent: np.ndarray, active: np.ndarray) -> np.ndarray:
+    """(B,) each body's nearest active body on the way to the root, itself if active (−1:
+    none, it stands on the ground), by pointer jumping."""
+    anc = np.where(active, np.arange(len(parent)), -2)
+    up = parent.copy()
+    while True:
+        u = np.flatnonzero(anc == -2)
+        if not len(u):
+            return anc
+        p = up[u]
+        a = np.where(p < 0, -1, anc[np.maximum(p, 0)])
+        anc[u] = a
+        still = a == -2
+        up[u[still]] = up[p[still]]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def carry(bodies, parent, r0, Q, w, R, P, Om, V):
+    """Place ``bodies`` (ascending: parents first) on their parents by their joints, as
+    :func:`~.kinematics.forward_kinematics` does."""
+    for b in bodies:
+        _place(b, parent, r0, Q, w, R, P, Om, V)
+
+
+class Reduced:
+    """The active part of a tree (or scene) at its detail levels, and the state it steps.
+
+    Building it freezes the rest in ``st`` (no relative velocity; the frozen leaves pass no
+    force); it steps in the first rows of the whole structure's ``work``. :meth:`gather`
+    copies the active part of a full state into :attr:`state`; :meth:`scatter` writes it back
+    and carries the frozen part along.
+
+    Attributes
+    ----------
+    s : Structure
+        The active bodies (parents renumbered) and leaves, with what rides on each.
+    bodies, leaves : (B', ) and (L', ) int
+        Their indices in the full structure; ``frozen`` the other bodies.
+    body_index : (B,) int
+        A body's index in :attr:`s` (−1: frozen).
+    carried : (F,) int
+        The frozen bodies that ride on an active one (the others stand still).
+    moving : ((B″,) int, (L″,) int)
+        The bodies and leaves that move: their nodes are all a pose after the first rewrites.
+    last : (pos, rot) or None
+        The last whole pose, kept by the simulation.
+    """
+
+    def __init__(self, tree, s: Structure, st: TreeState, levels: np.ndarray, work: Work):
+        on, leaf_on = active_parts(tree, s, levels)
+        self.bodies, self.leaves = np.flatnonzero(on), np.flatnonzero(leaf_on)
+        self.frozen = np.flatnonzero(~on)
+        self.body_index = np.full(len(on), -1, np.int64)
+        self.body_index[self.bodies] = np.arange(len(self.bodies))
+        resting = np.flatnonzero(~leaf_on)
+        for a in (st.thd, st.leaf_F, st.leaf_kap, st.leaf_kap2):
+            a[resting] = 0.0
+        st.w[self.frozen] = 0.0
+        carry(self.frozen, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
+        anc = _anchors(s.parent, on)
+        self.carried = self.frozen[anc[self.frozen] >= 0]  # (the rest stands still from now on)
+        moving = anc >= 0
+        self.moving = np.flatnonzero(moving), np.flatnonzero(moving[s.leaf_body])
+        self.last = None  # the last pose of the whole tree (set by its simulation)
+        self.s = self._structure(s, st, anc, resting)
+        self.work = work.head(len(self.bodies))
+        self.state = TreeState(time=st.time, **{f.name: getattr(st, f.name)[self._rows(f.name)]
+                                                  for f in fields(TreeState) if f.name != "time"})
+
+    def _rows(self, name: str) -> np.ndarray:
+        return self.bodies if name in _BODY_STATE else self.leaves
+
+    def _structure(self, s: Structure, st: TreeState, anc: np.ndarray, resting: np.ndarray) -> Structure:
+        """The active part of ``s``, what rides on each body (``anc``: its anchor) lumped into
+        it; ``resting``: the frozen leaves."""
+        B = len(s.parent)
+        m0, h0, J0 = s.m0.copy(), s.h0.copy(), s.J0.copy()
+        f = self.carried  # (what stands on the ground holds nothing up)
+        a = anc[f]
+        Ra = st.R[a]
+        C = np.einsum("kji,kjl->kil", Ra, st.R[f])  # the frozen body in its anchor's rest axes
+        d = np.einsum("kji,kj->ki", Ra, st.P[f] - st.P[a])
+        m = s.m0[f]
+        hf = np.einsum("kij,kj->ki", C, s.h0[f])
+        Jf = np.einsum("kij,kjl,kml->kim", C, s.J0[f], C)
+        eye = np.eye(3)
+        Jf += (2.0 * np.einsum("ki,ki->k", d, hf) + m * np.einsum("ki,ki->k", d, d))[:, None, None] * eye
+        Jf -= d[:, :, None] * hf[:, None, :] + hf[:, :, None] * d[:, None, :] + m[:, None, None] * d[:, :, None] * d[:, None, :]
+        np.add.at(m0, a, m)
+        np.add.at(h0, a, hf + m[:, None] * d)
+        np.add.at(J0, a, Jf)
+        # the drag of what rides: segments at their middles, leaves at their laminas
+        ride = resting[anc[s.leaf_body[resting]] >= 0]
+        t = s.leaf_body[ride]
+        la = anc[t]
+        lx = st.P[t] + np.einsum("kij,kj->ki", st.R[t], s.leaf_base0[ride] + s.leaf_rc0[ride]) - st.P[la]
+        xs = d + np.einsum("kij,kj->ki", C, s.mid0[f])  # (anchor's rest axes)
+        xl = np.einsum("kji,kj->ki", st.R[la], lx)
+        cd = SEGMENT_DRAG * s.cda[f]
+        cl = LEAF_DRAG * s.leaf_cna[ride] * s.leaf_on[ride]
+        lump = np.zeros((B, 6))  # cd, cl, cl·cauchy, (cd + cl)·x
+        np.add.at(lump, a, np.column_stack([cd, 0 * cd, 0 * cd, cd[:, None] * xs]))
+        np.add.at(lump, la, np.column_stack([0 * cl, cl, cl * s.leaf_cauchy[ride], cl[:, None] * xl]))
+        lump = lump[self.bodies]
+        weight = np.maximum(lump[:, 0] + lump[:, 1], 1e-300)
+        out = {}
+        for fl in fields(Structure):
+            v = getattr(s, fl.name)
+            if fl.name in _LEAF_POSE:
+                v = np.zeros(len(self.leaves) + 1, np.int64) if fl.name == "leaf_first" else v[:0]
+            elif fl.name == "body_of_obj":
+                v = np.where(v >= 0, self.body_index[np.maximum(v, 0)], -1)
+            elif fl.name.startswith("leaf_"):
+                v = v[self.leaves]
+            else:
+                v = {"m0": m0, "h0": h0, "J0": J0}.get(fl.name, v)[self.bodies]
+            out[fl.name] = np.ascontiguousarray(v)
+        out["parent"] = np.where(out["parent"] >= 0, self.body_index[np.maximum(out["parent"], 0)], -1)
+        out["leaf_body"] = np.ascontiguousarray(self.body_index[out["leaf_body"]])
+        out.update(lump_cd=np.ascontiguousarray(lump[:, 0]), lump_cl=np.ascontiguousarray(lump[:, 1]),
+                   lump_cauchy=lump[:, 2] / np.maximum(lump[:, 1], 1e-300),
+                   lump_x0=np.ascontiguousarray(lump[:, 3:] / weight[:, None]))
+        return Structure(**out)
+
+    @property
+    def dof(self) -> int:
+        """The degrees of freedom stepped: three a joint and a petiole."""
+        return 3 * (len(self.bodies) + len(self.leaves))
+
+    def gather(self, st: TreeState) -> TreeState:
+        """:attr:`state` as the active part of ``st``."""
+        sub = self.state
+        for f in fields(TreeState):
+            if f.name != "time":
+                np.take(getattr(st, f.name), self._rows(f.name), axis=0, out=getattr(sub, f.name))
+        sub.time = st.time
+        return sub
+
+    def scatter(self, st: TreeState, full: Structure) -> None:
+        """Write :attr:`state` into ``st`` and carry the frozen bodies along (``full``: the
+        whole structure)."""
+        sub = self.state
+        for f in fields(TreeState):
+            if f.name != "time":
+                getattr(st, f.name)[self._rows(f.name)] = getattr(sub, f.name)
+        st.time = sub.time
+        carry(self.carried, full.parent, full.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
+
+
+def tree_extents(tree) -> tuple[np.ndarray, np.ndarray]:
+    """Each tree's root (T, 3) — the lowest of its nodes — and height (T,) above it (m)."""
+    X = np.asarray(tree.rest_positions, float)
+    owner = object_trees(tree)[tree.node_object]
+    T = int(owner.max()) + 1 if len(owner) else 0
+    low = np.full(T, np.inf)
+    np.minimum.at(low, owner, X[:, 1])
+    top = np.full(T, -np.inf)
+    np.maximum.at(top, owner, X[:, 1])
+    lowest = np.flatnonzero(X[:, 1] == low[owner])
+    roots = np.empty((T, 3))
+    roots[owner[lowest]] = X[lowest]
+    return roots, top - low
+
+
+def choose_detail(eye, roots: np.ndarray, heights: np.ndarray, focal_px: float, hero=(),
+                  current: np.ndarray | None = None) -> np.ndarray:
+    """Detail levels from the camera: a tree's height on the screen (px) against
+    :data:`DETAIL_PIXELS`.
+
+    Parameters
+    ----------
+    eye : (3,) float
+        The camera's position.
+    roots, heights : (T, 3), (T,) float
+        Each tree's root and height (:func:`tree_extents`).
+    focal_px : float
+        Pixels a unit at unit distance spans on the screen: the viewport's height over
+        2·tan(fov_y/2).
+    hero : iterable of int
+        Trees kept at full detail (the one grabbed or selected).
+    current : (T,) int or None
+        The levels now: a tree goes coarser only when :data:`HYSTERESIS` under a level's height.
+
+    Returns
+    -------
+    (T,) int
+        0 (full) … :data:`MAX_DETAIL`.
+    """
+    roots = np.asarray(roots, float)
+    heights = np.asarray(heights, float)
+    centre = roots + np.outer(0.5 * heights, [0.0, 1.0, 0.0])
+    dist = np.maximum(np.linalg.norm(centre - np.asarray(eye, float), axis=1), 1e-6)
+    px = heights * float(focal_px) / dist
+    edges = np.asarray(DETAIL_PIXELS)
+    levels = np.sum(px[:, None] < edges, axis=1)
+    if current is not None:  # finer at once, coarser past the band
+        levels = np.clip(np.asarray(current), np.sum(px[:, None] * (1.0 + HYSTERESIS) < edges, axis=1), levels)
+    levels[np.asarray(list(hero), np.int64)] = 0
+    return levels.astype(np.int64)
