@@ -29,7 +29,7 @@ vec3 ground_albedo(vec2 xz, float px) {
     vec3 grass = mix(srgb_to_linear(vec3(0.24, 0.38, 0.11)), srgb_to_linear(vec3(0.36, 0.47, 0.15)),
                      smoothstep(0.3, 0.7, broad));
     vec3 dry = srgb_to_linear(vec3(0.56, 0.53, 0.30));
-    grass = mix(grass, dry, 0.45 * smoothstep(0.5, 0.8, 0.6 * wide.a + 0.4 * broad + 0.4 * (fine.a - 0.5)));
+    grass = mix(grass, dry, 0.5 * smoothstep(0.5, 0.8, 0.4 * wide.a + 0.6 * broad + 0.4 * (fine.a - 0.5)));
     grass *= (1.0 + 1.2 * (fine.r - 0.5)) * (1.0 + 0.8 * (wide.r - 0.5));
     vec3 soil = mix(srgb_to_linear(vec3(0.36, 0.31, 0.24)), srgb_to_linear(vec3(0.52, 0.46, 0.35)), fine.b);
     soil *= 0.85 + 0.3 * fine.g;
