@@ -131,9 +131,9 @@ def fork_seams(tree, children):
 
 @pytest.mark.parametrize("name", ["small_cherry", "large_cherry"])
 def test_a_forks_leader_grows_out_of_its_parent_without_a_seam(name):
-    """Of the branches on a limb's tip, the straightest (Tree.fork_leaders) continues the limb's
-    tube: its first ring is the limb's end ring, vertex for vertex, at rest and in a 25 m/s
-    wind; the rings' planes agree within 0.5° (before: a collar tilted on the end ring), the
+    """Of the branches on a limb's tip, those turning at most 75° (Tree.fork_leaders) continue
+    the limb's tube: each one's first ring is the limb's end ring, vertex for vertex, at rest
+    and in a 25 m/s wind; the rings' planes agree within 0.5° (before: a collar tilted on the end ring), the
     rest axis's tangent runs on through the fork, and no cap lies between them."""
     tree = ta.load_preset(name)
     leader = tree.fork_leaders()[0]
