@@ -91,8 +91,9 @@ void main() {
         n = relief(n, 2.0 * m.ba - 1.0);
     }
     // A blade is lit at its vertices (tree.vert), and only shaded across here.
+    float sun = PART == PART_LEAVES ? sun_visibility_tap(v_world, n) : sun_visibility(v_world, n);
     vec3 c = PART == PART_BLADES ? v_light * (0.85 + 0.3 * (1.0 - abs(v_uv.x)))
-                                 : tree_light(albedo, n, V, v_ao, sun_visibility(v_world, n), through, v_highlight);
+                                 : tree_light(albedo, n, V, v_ao, sun, through, v_highlight);
     // A thin twig or blade: its true width filtered by a tent one pixel either side (pixels
     // a column apart then sum to its width, wherever it falls between them).
     float cover = PART == PART_LEAVES || v_half < 0.0 ? 1.0 : tent_integral(v_edge + v_half) - tent_integral(v_edge - v_half);

@@ -265,10 +265,11 @@ def test_a_pulled_twigs_collar_stays_on_the_trunk():
     assert slipped.max() > 5 * moved.max()
 
 
-def test_a_bent_fork_keeps_its_rims_on_the_parents_end():
+def test_a_bent_fork_keeps_its_limbs_on_the_parents_end():
     """Turn a fork's trunk top and limbs rigidly about the trunk's middle node: the trunk's end
-    ring and the limbs' rims turn together (the trunk ends in its limbs' base frame, not the
-    1.5x turn of a free tip), so the rims stay on the end ring."""
+    ring and the limbs' first rings (the end ring again: an even fork's limbs are its leaders)
+    turn together (the trunk ends in its limbs' base frame, not the 1.5x turn of a free tip),
+    so the limbs stay on the end ring."""
     tree = fork_tree()
     mesh = build_mesh(tree)
     rest, _ = mesh.skin(tree.rest_positions, identity(tree))
@@ -279,8 +280,8 @@ def test_a_bent_fork_keeps_its_rims_on_the_parents_end():
     rotations = np.array(identity(tree))
     rotations[np.r_[j, moving]] = R
     pts, _ = mesh.skin(P, rotations)
-    rim, _ = collar(tree, mesh)
-    limbs = rim & np.isin(mesh.object, [1, 2])
+    limbs = np.isin(mesh.object, [1, 2]) & (mesh.node == tree.object_start[mesh.object]) & (mesh.vertices["curve"][:, 0] == 0)
+    assert limbs.sum() == 2 * 16
     uses = np.bincount(mesh.indices.ravel(), minlength=mesh.vertex_count)
     trunk_end = (mesh.object == 0) & (mesh.node == j) & (mesh.vertices["curve"][:, 0] == 1) & (uses < 16)
     assert trunk_end.sum() == 16
@@ -312,7 +313,7 @@ def test_a_rendered_fork_has_no_lip_and_no_seam(offscreen):
     assert mask[rows].any(axis=1).all()
     right = np.array([np.flatnonzero(mask[y]).max() for y in rows])
     left = np.array([np.flatnonzero(mask[y]).min() for y in rows])
-    assert right[0] - left[0] > 1.5 * (right[-1] - left[-1])  # the limbs spread above the trunk
+    assert right[0] - left[0] > 1.2 * (right[-1] - left[-1])  # the limbs spread above the trunk
     # Going up (back through the rows) an edge moves outwards or stays, within a pixel.
     assert np.all(np.diff(right[::-1]) >= -1), right.tolist()
     assert np.all(np.diff(left[::-1]) <= 1), left.tolist()

@@ -11,6 +11,7 @@ from conftest import beam_tree, grass_patch, identity, rot, small_tree, twig_tre
 from treeanim.model.geometry import unit as _unit
 from treeanim.model.tree import curve_bands
 from treeanim.render.camera import OrbitCamera
+from treeanim.render.collars import tube_radius
 from treeanim.render.mesh import (
     BLADE_CLUMP,
     MATERIAL_BARK,
@@ -137,7 +138,7 @@ def test_rest_geometry():
     # Tube rings lie on the segments' rest curves at the tapering radius (the end fans' centres,
     # on the axis, are left out): one ring at every band's ends, but where a child's base ring
     # is its collar (tests/test_junctions.py; a fork's leader has none, tests/test_wood.py).
-    P, r = tree.rest_positions, 0.5 * tree.node_diameter
+    P, r = tree.rest_positions, tube_radius(tree)  # a leader starts at its parent's end radius
     t = mesh.vertices["curve"][:, 0]
     obj = mesh.object
     lead = tree.fork_leaders()[0]
@@ -384,7 +385,7 @@ def test_pick_axis_runs_through_the_rings_the_mesh_draws():
     t_mesh = mesh.vertices["curve"][:, 0]
     inside = np.flatnonzero(picker.t > 0)
     assert len(inside) > 20
-    r = 0.5 * tree.node_diameter
+    r = tube_radius(tree)
     for q in inside:
         j, t = picker.node[q], picker.t[q]
         ring = pts[bark & (mesh.node == j) & np.isclose(t_mesh, t)]

@@ -117,3 +117,41 @@ def test_far_ground_fades_into_the_sky_at_the_horizon(offscreen, tree, towards_s
 def test_the_air_is_brighter_towards_the_sun(offscreen, tree):
     (towards, h1), (away, h2) = horizon_column(offscreen, tree, True), horizon_column(offscreen, tree, False)
     assert towards[int(h1 + 2.5)] > away[int(h2 + 2.5)] + 8.0, (towards[int(h1 + 2.5)], away[int(h2 + 2.5)])
+
+
+def ground_bands(img, cam, bands):
+    """Luminance across the ground between distances (near, far) metres from the eye along the
+    view, each row less its mean: (the spread of steps from pixel to pixel along the rows; the
+    spread of 16-pixel blocks' means)."""
+    lum = luminance(img)
+    ahead = cam.forward * np.array([1.0, 0.0, 1.0])
+    ahead /= np.linalg.norm(ahead)
+    for near, far in bands:
+        rows = cam.project(cam.eye * np.array([1.0, 0.0, 1.0]) + np.array([[near], [far]]) * ahead, W, H)[:, 1]
+        band = lum[int(rows.min()):int(rows.max()) + 1]
+        band = band - band.mean(axis=1, keepdims=True)
+        blocks = band[:, :W // 16 * 16].reshape(len(band), W // 16, 16).mean(axis=2)
+        yield np.std(np.diff(band, axis=1)), np.std(blocks)
+
+
+def test_the_ground_has_grain_near_and_fades_to_its_mean_not_into_blotches(offscreen, tree):
+    """Looking across the ground from eye height (1.7 m, 12° down), the grass 3-6 m away has
+    grain from pixel to pixel (before: 0.8 grey levels, noise faded by a pixel's longest side
+    on the ground), and 8-16 m away no blotches of a metre or two smeared along the view
+    (before: 2.7 grey levels from block to block): its detail fades to its mean."""
+    cam = OrbitCamera(target=(0.0, 1.7, 0.0), distance=0.01, azimuth=0.0, elevation=12.0)
+    img = render(offscreen, tree, cam, shadow=False, clouds=0.0)
+    (grain, _), (_, blotches) = ground_bands(img, cam, [(3.0, 6.0), (8.0, 16.0)])
+    assert grain > 2.0 and blotches < 2.0, (grain, blotches)
+
+
+def test_bare_soil_is_dry_earth_no_darker_than_the_grass(offscreen, tree):
+    """Seen from above, the ground has patches of bare soil (redder than green) and they are
+    dry earth, at least as bright as the grass round them, not dark puddles (before: none in
+    this view, and the soil a dark brown)."""
+    cam = OrbitCamera(target=(0.0, 0.0, 0.0), distance=14.0, azimuth=20.0, elevation=80.0)
+    img = render(offscreen, tree, cam, shadow=False)
+    red, lum = redness(img), luminance(img)
+    soil, grass = red > 0.02, red < -0.1
+    assert soil.mean() > 0.002 and grass.mean() > 0.8, (soil.mean(), grass.mean())
+    assert np.median(lum[soil]) > np.median(lum[grass]), (np.median(lum[soil]), np.median(lum[grass]))

@@ -35,10 +35,8 @@ CURVE_TURN = 4.0
 #: ... but at most this many.
 CURVE_MOST = 6
 #: A fork's leader, which continues its parent's tube, turns at most this many degrees from it
-#: (see :meth:`Tree.fork_leaders`).
-FORK_LEAD = 45.0
-#: ... and at most this fraction of the turn of the next straightest branch on the same tip.
-FORK_CLEAR = 0.5
+#: (see :meth:`Tree.fork_leaders`; a fork may have several).
+FORK_LEAD = 75.0
 
 
 def curve_bands(object_count: np.ndarray, turn: np.ndarray | float = 0.0) -> np.ndarray:
@@ -174,15 +172,14 @@ class Tree:
         return chord / np.maximum(np.linalg.norm(chord, axis=1, keepdims=True), 1e-12)
 
     def fork_leaders(self) -> tuple[np.ndarray, np.ndarray]:
-        """The forks' leaders: of the branches on a branch's tip, the one that turns least from
-        its last segment, if by at most ``FORK_LEAD``° and at most ``FORK_CLEAR`` times as much
-        as the next (the renderer draws it as the parent's tube running on; an even fork keeps
-        its collars).
+        """The forks' leaders: the branches on a branch's tip that turn at most ``FORK_LEAD``°
+        from its last segment (the renderer draws each as the parent's tube running on, so an
+        even fork's branches grow out of one crotch; a branch turning more keeps its collar).
 
         Returns
         -------
         leader : (L,) int
-            The leaders (their parents: ``parent[leader]``).
+            The leaders (their parents: ``parent[leader]``; an even fork's parent has several).
         turn : (L,) float
             The angle between the parent's last chord and the leader's first, radians.
         """
@@ -191,14 +188,9 @@ class Tree:
         on_tip = self.attach_node[child] == tip
         child, tip = child[on_tip], tip[on_tip]
         chord = self._chords()
-        cos = np.clip(np.sum(chord[tip - 1] * chord[self.object_start[child]], axis=1), -1.0, 1.0)
-        turn = np.arccos(cos)
-        order = np.lexsort((turn, tip))
-        first = np.unique(tip[order], return_index=True)[1]
-        best = order[first]  # the straightest on each tip, and the next straightest
-        second = np.where(np.diff(np.r_[first, len(order)]) > 1, turn[order[np.minimum(first + 1, len(order) - 1)]], np.pi)
-        best = best[(turn[best] <= np.radians(FORK_LEAD)) & (turn[best] <= FORK_CLEAR * second)]
-        return child[best], turn[best]
+        turn = np.arccos(np.clip(np.sum(chord[tip - 1] * chord[self.object_start[child]], axis=1), -1.0, 1.0))
+        lead = turn <= np.radians(FORK_LEAD)
+        return child[lead], turn[lead]
 
     def joint_turn(self) -> np.ndarray:
         """(M,) float: the largest angle between consecutive chords of each object at rest, and

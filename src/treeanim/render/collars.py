@@ -1,7 +1,8 @@
 """Welded junctions (docs/design.md §10): where a child branch's tube meets its parent's, its
-base ring is a collar on the parent's surface (or, at a fork, on the parent's end ring) and
-its base cap a cone sunk inside the parent; but a fork's leader, the branch on a parent's tip
-that turns least from it, continues the parent's tube. Used by :mod:`treeanim.render.mesh`."""
+base ring is a collar on the parent's surface (or, for a branch turning sharply from a
+parent's tip, on the parent's end ring) and its base cap a cone sunk inside the parent; but a
+fork's leaders, the branches on a parent's tip that turn less, continue the parent's tube, so
+an even fork's branches part in one crotch. Used by :mod:`treeanim.render.mesh`."""
 
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ COLLAR_FORK = 70.0
 
 
 def leaders(tree: Tree, nodes: np.ndarray, tangent: np.ndarray) -> np.ndarray:
-    """The forks' leaders (:meth:`Tree.fork_leaders`) and their tangents. A leader starts
+    """The forks' leaders (:meth:`Tree.fork_leaders`) and their tangents. Each leader starts
     with its parent's tangent at the fork, set in ``tangent`` (unit, one row per node of
     ``nodes``, which holds every branch's): the rest curve runs on through the fork, the leader
     turning in its first segment (its bands: :meth:`Tree.joint_turn`), the parent as drawn
@@ -42,6 +43,15 @@ def leaders(tree: Tree, nodes: np.ndarray, tangent: np.ndarray) -> np.ndarray:
     lead = np.zeros(tree.n_objects, bool)
     lead[child] = True
     return lead
+
+
+def tube_radius(tree: Tree) -> np.ndarray:
+    """(N,) float: the tubes' radius at each node as drawn, metres: a fork's leader
+    (:func:`leaders`) starts at its parent's end radius."""
+    r = 0.5 * np.asarray(tree.node_diameter, float)
+    lead = tree.fork_leaders()[0]
+    r[tree.object_start[lead]] = r[tree.attach_node[lead]]
+    return r
 
 
 def outward(q: np.ndarray, axis: np.ndarray) -> np.ndarray:

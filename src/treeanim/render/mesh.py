@@ -37,8 +37,10 @@ Geometry per object kind (triangle counts: :func:`drawn_triangles`):
   to an *apex* sunk in the parent, out of sight. Along a parent the rim is
   ρ = clip(½(R + r), 1.15 r, 1.5 r) (at most 0.95 R) from the child's axis, each side as far
   out along the child as it meets the parent's tube (radius R about the parent's tangent at
-  the joint), and the apex on the parent's axis. At a fork (a child on its
-  parent's tip) the rim is the parent's end ring, widened to max(R, 1.15 r) and raised so
+  the joint), and the apex on the parent's axis. A fork's leaders (the children on a parent's
+  tip turning at most ``FORK_LEAD``°) continue the parent's tube from its end ring, with no
+  collar and no fans between (:mod:`treeanim.render.collars`); a child turning more from a
+  parent's tip has its rim on the parent's end ring, widened to max(R, 1.15 r) and raised so
   that the cone from the apex, 2 R below the end, passes through the end ring: the parent's
   silhouette runs on into each child's; a child turned more than 70° from the parent tilts its
   rim towards it by the excess (an elbow). The collar is skinned with the child's base frame
@@ -87,7 +89,7 @@ from ..model.geometry import arc_length, lamina_frames
 from ..model.geometry import perpendicular as _perpendicular
 from ..model.geometry import unit as _unit
 from ..model.tree import BRANCH_SIDES, Lamina, Tree, curve_bands
-from .collars import collars, leaders, outward
+from .collars import collars, leaders, outward, tube_radius
 from .occlusion import crown_occlusion
 from .skinning import hermite, skin_points
 
@@ -288,11 +290,11 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     # A fork's leader continues its parent's tube: from the parent's end ring (its radius, and
     # the rings square to the same w, and the bark running on), without a collar.
     lead = leaders(tree, nodes, tangent) if curved else np.zeros(tree.n_objects, bool)
-    r = 0.5 * tree.node_diameter
-    r[tree.object_start[lead]] = r[tree.attach_node[lead]]
+    r = tube_radius(tree) if curved else 0.5 * tree.node_diameter
     frame, along0, arc = np.arange(tree.n_objects), np.zeros(tree.n_objects), arc_length(tree)
     for c in np.flatnonzero(lead):  # parents come first (objects are sorted by level)
         frame[c], along0[c] = frame[tree.parent[c]], along0[tree.parent[c]] + arc[tree.attach_node[c]]
+    jitter = jitter[frame]  # and its bark's shade
     inner = ~(base | tip)
     # T₀ of the segment leaving each node (module notes).
     prev = np.where(inner, nodes - 1, nodes)
@@ -331,6 +333,10 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
     centre, dq = hermite(t, chord, d0, d1)
     tan = _unit(dq, tangent[src])
     slope = np.where(t == 0, node_slope, seg_slope)
+    # A leader's first ring, its parent's end ring, keeps that ring's normals.
+    lf = np.flatnonzero(first & lead[obj[src]])
+    att = tree.attach_node[obj[src[lf]]]
+    slope[lf] = (r[att] - r[att - 1]) / np.linalg.norm(P[att] - P[att - 1], axis=1)
     radius = (1.0 - t) * r[n0] + t * r[n1]
     ring_obj = obj[src]
 

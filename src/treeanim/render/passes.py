@@ -26,6 +26,7 @@ import numpy as np
 from ..model.scene import Scene as TreeScene
 from ..model.tree import Tree
 from .culling import TreeOrder
+from .ground_maps import ground_texture
 from .leaf_maps import lamina_box, leaf_texture
 from .lod import LOD_LAMINA_CORNERS, coarse_laminas, coarse_tubes, lod_band, median_leaf
 from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh
@@ -175,9 +176,10 @@ class GroundPass:
     def __init__(self, ctx: moderngl.Context, tree: Tree, bounds) -> None:
         self.progs: list[moderngl.Program] = []
         self.vaos: list[moderngl.VertexArray] = []
-        self.vbo = self.block = None
+        self.vbo = self.block = self.maps = None
         try:
             self.block = UniformBlock(ctx, "Ground")
+            self.maps = ground_texture(ctx)
             for shadowed in (0, 1):
                 self.progs.append(load_program(ctx, "ground.vert", "ground.frag", defines={"SUN_SHADOW": shadowed}))
             self.vbo = ctx.buffer(reserve=4096, dynamic=True)
@@ -230,13 +232,14 @@ class GroundPass:
                 self.vbo.orphan(2 * tris.nbytes)
             self.vbo.write(tris.tobytes())
             self.block.use()
+            self.maps.use(SAMPLERS["ground_maps"].unit)
             self.vaos[int(shadowed)].render(moderngl.TRIANGLES, vertices=len(tris))
 
     def release(self) -> None:
         """Free the GL objects (idempotent)."""
-        release_all(*self.vaos, *self.progs, self.vbo, self.block)
+        release_all(*self.vaos, *self.progs, self.vbo, self.block, self.maps)
         self.vaos, self.progs = [], []
-        self.vbo = self.block = None
+        self.vbo = self.block = self.maps = None
 
 
 class SkyPass:

@@ -23,7 +23,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..model.tree import Tree, curve_bands
-from .collars import leaders
+from .collars import leaders, tube_radius
 from .mesh import _node_tangents, _object_nodes, lamina_frames, segment_tangents
 from .skinning import hermite, skin_points
 
@@ -50,7 +50,7 @@ class Picker:
         kind = np.asarray(tree.kind)
         P = tree.rest_positions
         N = tree.n_nodes
-        r = 0.5 * np.asarray(tree.node_diameter, float)
+        r = tube_radius(tree)
 
         # The tubes' rings, as render/mesh.py's _tubes places them: from each node but an
         # object's tip, one ring per band of the segment leaving it; then the object's end

@@ -98,6 +98,7 @@ SAMPLERS: dict[str, Sampler] = {
     "background": Sampler("sampler2D", 3, "the background cache (background.frag)"),
     "leaf_maps": Sampler("sampler2D", 4, "the lamina's albedo, translucency and relief (leaf_maps.py)"),
     "draft": Sampler("sampler2D", 5, "draft mode's smaller picture, scaled up (app/draft.py)"),
+    "ground_maps": Sampler("sampler2D", 6, "the ground's tufts, patches, grain and tint (ground_maps.py)"),
 }
 
 #: std140 base alignment and size (bytes) of each member type.
