@@ -36,8 +36,8 @@ from .kinematics import _place
 from .structure import Structure
 from .treestep import TreeState, Work
 
-__all__ = ["MAX_DETAIL", "DETAIL_PIXELS", "Reduced", "active_parts", "carry", "check_levels", "choose_detail",
-           "object_trees", "tree_extents"]
+__all__ = ["MAX_DETAIL", "DETAIL_PIXELS", "Parts", "Reduced", "carry", "check_levels", "choose_detail", "object_trees",
+           "tree_extents"]
 
 #: The coarsest detail level.
 MAX_DETAIL = 3
@@ -80,37 +80,48 @@ def _brief(x) -> str:
     return s if len(s) <= 60 else s[:57] + "..."
 
 
-def active_parts(tree, s: Structure, levels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(B,) bool bodies and (L,) bool leaves that move at the trees' detail ``levels``: a
-    body's parent is always among them when it is."""
-    lv = levels[object_trees(tree)]
-    kind = np.asarray(tree.kind)
-    par = np.asarray(tree.parent)
-    bears = np.zeros(tree.n_objects, bool)  # bears a branch
-    grows = (par >= 0) & (kind != "leaf")
-    bears[par[grows]] = True
-    limb = (kind == "branch") & (np.asarray(tree.level) <= 2)
-    keep = (lv == 0) | ((lv == 1) & bears) | ((lv == 2) & limb) | ((lv < MAX_DETAIL) & (kind == "blade"))
-    o = s.obj
-    first = s.body_of_obj[o] == np.arange(len(o))  # (a blade's base joint)
-    bodies = keep[o] & ((lv[o] == 0) | (kind[o] != "blade") | first)
-    return bodies, lv[s.leaf_obj] == 0
+class Parts:
+    """Which bodies and leaves of a structure move at each detail level, worked out once (a
+    level change then costs a gather and a few compiled passes over the bodies and leaves).
+
+    Attributes
+    ----------
+    body_tree, leaf_tree : (B,) and (L,) int
+        The tree of each body and leaf.
+    body_levels : (B,) uint8
+        Bit ``l`` set where the body moves at level ``l`` (a leaf moves at level 0 only).
+    """
+
+    def __init__(self, tree, s: Structure):
+        trees = object_trees(tree)
+        self.body_tree, self.leaf_tree = trees[s.obj], trees[s.leaf_obj]
+        kind = np.asarray(tree.kind)
+        par = np.asarray(tree.parent)
+        bears = np.zeros(tree.n_objects, bool)  # bears a branch
+        grows = (par >= 0) & (kind != "leaf")
+        bears[par[grows]] = True
+        blade = kind == "blade"
+        limb = (kind == "branch") & (np.asarray(tree.level) <= 2)
+        o = s.obj
+        first = s.body_of_obj[o] == np.arange(len(o))  # (a blade's base joint)
+        coarse = (bears | blade)[o] & (~blade[o] | first), (limb | blade)[o] & (~blade[o] | first)
+        self.body_levels = (1 + 2 * coarse[0] + 4 * coarse[1]).astype(np.uint8)
+
+    def active(self, levels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(B,) bool bodies and (L,) bool leaves that move at the trees' detail ``levels``: a
+        body's parent is always among them when it is."""
+        return (self.body_levels >> levels[self.body_tree].astype(np.uint8)) & 1 == 1, levels[self.leaf_tree] == 0
 
 
-def _anchors(parent: np.ndarray, active: np.ndarray) -> np.ndarray:
+@njit(cache=True, error_model="numpy")
+def _anchors(parent, active):
     """(B,) each body's nearest active body on the way to the root, itself if active (−1:
-    none, it stands on the ground), by pointer jumping."""
-    anc = np.where(active, np.arange(len(parent)), -2)
-    up = parent.copy()
-    while True:
-        u = np.flatnonzero(anc == -2)
-        if not len(u):
-            return anc
-        p = up[u]
-        a = np.where(p < 0, -1, anc[np.maximum(p, 0)])
-        anc[u] = a
-        still = a == -2
-        up[u[still]] = up[p[still]]
+    none, it stands on the ground); parents come first."""
+    anc = np.empty(len(parent), np.int64)
+    for b in range(len(parent)):
+        p = parent[b]
+        anc[b] = b if active[b] else (anc[p] if p >= 0 else -1)
+    return anc
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -119,6 +130,62 @@ def carry(bodies, parent, r0, Q, w, R, P, Om, V):
     :func:`~.kinematics.forward_kinematics` does."""
     for b in bodies:
         _place(b, parent, r0, Q, w, R, P, Om, V)
+
+
+@njit(cache=True, error_model="numpy")
+def _lump(carried, anc, R, P, s_m0, s_h0, s_J0, mid0, cda, leaf_body, leaf_on, leaf_x0, leaf_cna, leaf_cauchy,
+          m0, h0, J0, lump):
+    """Lump what rides on each active body into it: the ``carried`` bodies' inertia into
+    ``m0``, ``h0``, ``J0`` (where they are, in their anchor's rest axes), their drag and the
+    riding leaves' (``leaf_on`` False for the leaves that move or are absent; ``leaf_x0``: the
+    laminas' rest centroids from their twig's joint) into ``lump``: cd, cl, cl·cauchy,
+    (cd + cl)·x."""
+    C, Jf, hf, d = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty(3)
+    for f in carried:  # (what stands on the ground holds nothing up)
+        a = anc[f]
+        for i in range(3):  # the frozen body in its anchor's rest axes
+            d[i] = 0.0
+            for j in range(3):
+                d[i] += R[a, j, i] * (P[f, j] - P[a, j])
+                C[i, j] = 0.0
+                for k in range(3):
+                    C[i, j] += R[a, k, i] * R[f, k, j]
+        m = s_m0[f]
+        for i in range(3):
+            hf[i] = C[i, 0] * s_h0[f, 0] + C[i, 1] * s_h0[f, 1] + C[i, 2] * s_h0[f, 2]
+        dh = d[0] * hf[0] + d[1] * hf[1] + d[2] * hf[2]
+        dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
+        for i in range(3):
+            for n in range(3):
+                s = 0.0
+                for j in range(3):
+                    for k in range(3):
+                        s += C[i, j] * s_J0[f, j, k] * C[n, k]
+                if i == n:
+                    s += 2.0 * dh + m * dd
+                Jf[i, n] = s - (d[i] * hf[n] + hf[i] * d[n] + m * d[i] * d[n])
+        m0[a] += m
+        cd = SEGMENT_DRAG * cda[f]
+        lump[a, 0] += cd
+        for i in range(3):
+            h0[a, i] += hf[i] + m * d[i]
+            for n in range(3):
+                J0[a, i, n] += Jf[i, n]
+            lump[a, 3 + i] += cd * (d[i] + (C[i, 0] * mid0[f, 0] + C[i, 1] * mid0[f, 1] + C[i, 2] * mid0[f, 2]))
+    for q in range(len(leaf_body)):  # the leaves at their laminas
+        t = leaf_body[q]
+        a = anc[t]
+        if not leaf_on[q] or a < 0:
+            continue
+        cl = LEAF_DRAG * leaf_cna[q]
+        lump[a, 1] += cl
+        lump[a, 2] += cl * leaf_cauchy[q]
+        for i in range(3):
+            x = 0.0
+            for j in range(3):
+                x += R[a, j, i] * (P[t, j] + (R[t, j, 0] * leaf_x0[q, 0] + R[t, j, 1] * leaf_x0[q, 1]
+                                              + R[t, j, 2] * leaf_x0[q, 2]) - P[a, j])
+            lump[a, 3 + i] += cl * x
 
 
 class Reduced:
@@ -145,8 +212,8 @@ class Reduced:
         The last whole pose, kept by the simulation.
     """
 
-    def __init__(self, tree, s: Structure, st: TreeState, levels: np.ndarray, work: Work):
-        on, leaf_on = active_parts(tree, s, levels)
+    def __init__(self, parts: Parts, s: Structure, st: TreeState, levels: np.ndarray, work: Work):
+        on, leaf_on = parts.active(levels)
         self.bodies, self.leaves = np.flatnonzero(on), np.flatnonzero(leaf_on)
         self.frozen = np.flatnonzero(~on)
         self.body_index = np.full(len(on), -1, np.int64)
@@ -160,8 +227,8 @@ class Reduced:
         self.carried = self.frozen[anc[self.frozen] >= 0]  # (the rest stands still from now on)
         moving = anc >= 0
         self.moving = np.flatnonzero(moving), np.flatnonzero(moving[s.leaf_body])
-        self.last = None  # the last pose of the whole tree (set by its simulation)
-        self.s = self._structure(s, st, anc, resting)
+        self.last = None  # the last whole pose (set by its simulation)
+        self.s = self._structure(s, st, anc, leaf_on)
         self.work = work.head(len(self.bodies))
         self.state = TreeState(time=st.time, **{f.name: getattr(st, f.name)[self._rows(f.name)]
                                                   for f in fields(TreeState) if f.name != "time"})
@@ -169,37 +236,13 @@ class Reduced:
     def _rows(self, name: str) -> np.ndarray:
         return self.bodies if name in _BODY_STATE else self.leaves
 
-    def _structure(self, s: Structure, st: TreeState, anc: np.ndarray, resting: np.ndarray) -> Structure:
+    def _structure(self, s: Structure, st: TreeState, anc: np.ndarray, leaf_on: np.ndarray) -> Structure:
         """The active part of ``s``, what rides on each body (``anc``: its anchor) lumped into
-        it; ``resting``: the frozen leaves."""
-        B = len(s.parent)
+        it; ``leaf_on``: the leaves that move."""
         m0, h0, J0 = s.m0.copy(), s.h0.copy(), s.J0.copy()
-        f = self.carried  # (what stands on the ground holds nothing up)
-        a = anc[f]
-        Ra = st.R[a]
-        C = np.einsum("kji,kjl->kil", Ra, st.R[f])  # the frozen body in its anchor's rest axes
-        d = np.einsum("kji,kj->ki", Ra, st.P[f] - st.P[a])
-        m = s.m0[f]
-        hf = np.einsum("kij,kj->ki", C, s.h0[f])
-        Jf = np.einsum("kij,kjl,kml->kim", C, s.J0[f], C)
-        eye = np.eye(3)
-        Jf += (2.0 * np.einsum("ki,ki->k", d, hf) + m * np.einsum("ki,ki->k", d, d))[:, None, None] * eye
-        Jf -= d[:, :, None] * hf[:, None, :] + hf[:, :, None] * d[:, None, :] + m[:, None, None] * d[:, :, None] * d[:, None, :]
-        np.add.at(m0, a, m)
-        np.add.at(h0, a, hf + m[:, None] * d)
-        np.add.at(J0, a, Jf)
-        # the drag of what rides: segments at their middles, leaves at their laminas
-        ride = resting[anc[s.leaf_body[resting]] >= 0]
-        t = s.leaf_body[ride]
-        la = anc[t]
-        lx = st.P[t] + np.einsum("kij,kj->ki", st.R[t], s.leaf_base0[ride] + s.leaf_rc0[ride]) - st.P[la]
-        xs = d + np.einsum("kij,kj->ki", C, s.mid0[f])  # (anchor's rest axes)
-        xl = np.einsum("kji,kj->ki", st.R[la], lx)
-        cd = SEGMENT_DRAG * s.cda[f]
-        cl = LEAF_DRAG * s.leaf_cna[ride] * s.leaf_on[ride]
-        lump = np.zeros((B, 6))  # cd, cl, cl·cauchy, (cd + cl)·x
-        np.add.at(lump, a, np.column_stack([cd, 0 * cd, 0 * cd, cd[:, None] * xs]))
-        np.add.at(lump, la, np.column_stack([0 * cl, cl, cl * s.leaf_cauchy[ride], cl[:, None] * xl]))
+        lump = np.zeros((len(s.parent), 6))
+        _lump(self.carried, anc, st.R, st.P, s.m0, s.h0, s.J0, s.mid0, s.cda, s.leaf_body, s.leaf_on & ~leaf_on,
+              s.leaf_base0 + s.leaf_rc0, s.leaf_cna, s.leaf_cauchy, m0, h0, J0, lump)
         lump = lump[self.bodies]
         weight = np.maximum(lump[:, 0] + lump[:, 1], 1e-300)
         out = {}
