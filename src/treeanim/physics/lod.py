@@ -51,7 +51,6 @@ SEGMENT_DRAG = 3.0 * np.pi / 16.0
 #: The same of a lamina's normal force, ⟨cos²⟩ over the sphere.
 LEAF_DRAG = 1.0 / 3.0
 _BODY_STATE = ("Q", "w", "R", "P", "Om", "V")  # TreeState's per-body arrays (the others are per leaf)
-_LEAF_POSE = ("leaf_nodes", "leaf_first")  # Structure's leaf arrays that only the pose reads
 
 
 def object_trees(tree) -> np.ndarray:
@@ -132,17 +131,33 @@ def carry(bodies, parent, r0, Q, w, R, P, Om, V):
         _place(b, parent, r0, Q, w, R, P, Om, V)
 
 
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _freeze(on, leaf_on, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V, thd, leaf_F, leaf_kap, leaf_kap2):
+    """Freeze the bodies not ``on`` (no relative velocity, placed on their parents) and the
+    leaves not ``leaf_on`` (at rest, passing no force)."""
+    for b in range(len(on)):
+        if not on[b]:
+            st_w[b, :] = 0.0
+            _place(b, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V)
+    for q in range(len(leaf_on)):
+        if not leaf_on[q]:
+            thd[q, :] = 0.0
+            leaf_F[q, :] = 0.0
+            leaf_kap[q] = 0.0
+            leaf_kap2[q] = 0.0
+
+
 @njit(cache=True, error_model="numpy")
-def _lump(carried, anc, R, P, s_m0, s_h0, s_J0, mid0, cda, leaf_body, leaf_on, leaf_x0, leaf_cna, leaf_cauchy,
-          m0, h0, J0, lump):
-    """Lump what rides on each active body into it: the ``carried`` bodies' inertia into
-    ``m0``, ``h0``, ``J0`` (where they are, in their anchor's rest axes), their drag and the
-    riding leaves' (``leaf_on`` False for the leaves that move or are absent; ``leaf_x0``: the
-    laminas' rest centroids from their twig's joint) into ``lump``: cd, cl, cl·cauchy,
-    (cd + cl)·x."""
+def _lump(carried, anc, index, R, P, s_m0, s_h0, s_J0, mid0, cda, leaf_body, leaf_on, leaf_base0, leaf_rc0,
+          leaf_cna, leaf_cauchy, m0, h0, J0, lump):
+    """Lump what rides on each active body (``index``: its row in ``m0`` … ``lump``) into it:
+    the ``carried`` bodies' inertia into ``m0``, ``h0``, ``J0`` (where they are, in their
+    anchor's rest axes), their drag and the riding leaves' (``leaf_on``: the leaves that ride,
+    present) into ``lump``: cd, cl, cl·cauchy, (cd + cl)·x."""
     C, Jf, hf, d = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty(3)
     for f in carried:  # (what stands on the ground holds nothing up)
         a = anc[f]
+        r = index[a]
         for i in range(3):  # the frozen body in its anchor's rest axes
             d[i] = 0.0
             for j in range(3):
@@ -164,28 +179,30 @@ def _lump(carried, anc, R, P, s_m0, s_h0, s_J0, mid0, cda, leaf_body, leaf_on, l
                 if i == n:
                     s += 2.0 * dh + m * dd
                 Jf[i, n] = s - (d[i] * hf[n] + hf[i] * d[n] + m * d[i] * d[n])
-        m0[a] += m
+        m0[r] += m
         cd = SEGMENT_DRAG * cda[f]
-        lump[a, 0] += cd
+        lump[r, 0] += cd
         for i in range(3):
-            h0[a, i] += hf[i] + m * d[i]
+            h0[r, i] += hf[i] + m * d[i]
             for n in range(3):
-                J0[a, i, n] += Jf[i, n]
-            lump[a, 3 + i] += cd * (d[i] + (C[i, 0] * mid0[f, 0] + C[i, 1] * mid0[f, 1] + C[i, 2] * mid0[f, 2]))
+                J0[r, i, n] += Jf[i, n]
+            lump[r, 3 + i] += cd * (d[i] + (C[i, 0] * mid0[f, 0] + C[i, 1] * mid0[f, 1] + C[i, 2] * mid0[f, 2]))
     for q in range(len(leaf_body)):  # the leaves at their laminas
         t = leaf_body[q]
         a = anc[t]
         if not leaf_on[q] or a < 0:
             continue
+        r = index[a]
         cl = LEAF_DRAG * leaf_cna[q]
-        lump[a, 1] += cl
-        lump[a, 2] += cl * leaf_cauchy[q]
+        lump[r, 1] += cl
+        lump[r, 2] += cl * leaf_cauchy[q]
         for i in range(3):
             x = 0.0
             for j in range(3):
-                x += R[a, j, i] * (P[t, j] + (R[t, j, 0] * leaf_x0[q, 0] + R[t, j, 1] * leaf_x0[q, 1]
-                                              + R[t, j, 2] * leaf_x0[q, 2]) - P[a, j])
-            lump[a, 3 + i] += cl * x
+                x += R[a, j, i] * (P[t, j] + (R[t, j, 0] * (leaf_base0[q, 0] + leaf_rc0[q, 0])
+                                              + R[t, j, 1] * (leaf_base0[q, 1] + leaf_rc0[q, 1])
+                                              + R[t, j, 2] * (leaf_base0[q, 2] + leaf_rc0[q, 2])) - P[a, j])
+            lump[r, 3 + i] += cl * x
 
 
 class Reduced:
@@ -218,11 +235,8 @@ class Reduced:
         self.frozen = np.flatnonzero(~on)
         self.body_index = np.full(len(on), -1, np.int64)
         self.body_index[self.bodies] = np.arange(len(self.bodies))
-        resting = np.flatnonzero(~leaf_on)
-        for a in (st.thd, st.leaf_F, st.leaf_kap, st.leaf_kap2):
-            a[resting] = 0.0
-        st.w[self.frozen] = 0.0
-        carry(self.frozen, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
+        _freeze(on, leaf_on, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V, st.thd, st.leaf_F, st.leaf_kap,
+                st.leaf_kap2)
         anc = _anchors(s.parent, on)
         self.carried = self.frozen[anc[self.frozen] >= 0]  # (the rest stands still from now on)
         moving = anc >= 0
@@ -230,7 +244,7 @@ class Reduced:
         self.last = None  # the last whole pose (set by its simulation)
         self.s = self._structure(s, st, anc, leaf_on)
         self.work = work.head(len(self.bodies))
-        self.state = TreeState(time=st.time, **{f.name: getattr(st, f.name)[self._rows(f.name)]
+        self.state = TreeState(time=st.time, **{f.name: np.empty((len(self._rows(f.name)),) + getattr(st, f.name).shape[1:])
                                                   for f in fields(TreeState) if f.name != "time"})
 
     def _rows(self, name: str) -> np.ndarray:
@@ -239,29 +253,21 @@ class Reduced:
     def _structure(self, s: Structure, st: TreeState, anc: np.ndarray, leaf_on: np.ndarray) -> Structure:
         """The active part of ``s``, what rides on each body (``anc``: its anchor) lumped into
         it; ``leaf_on``: the leaves that move."""
-        m0, h0, J0 = s.m0.copy(), s.h0.copy(), s.J0.copy()
-        lump = np.zeros((len(s.parent), 6))
-        _lump(self.carried, anc, st.R, st.P, s.m0, s.h0, s.J0, s.mid0, s.cda, s.leaf_body, s.leaf_on & ~leaf_on,
-              s.leaf_base0 + s.leaf_rc0, s.leaf_cna, s.leaf_cauchy, m0, h0, J0, lump)
-        lump = lump[self.bodies]
-        weight = np.maximum(lump[:, 0] + lump[:, 1], 1e-300)
-        out = {}
-        for fl in fields(Structure):
-            v = getattr(s, fl.name)
-            if fl.name in _LEAF_POSE:
-                v = np.zeros(len(self.leaves) + 1, np.int64) if fl.name == "leaf_first" else v[:0]
-            elif fl.name == "body_of_obj":
-                v = np.where(v >= 0, self.body_index[np.maximum(v, 0)], -1)
-            elif fl.name.startswith("leaf_"):
-                v = v[self.leaves]
-            else:
-                v = {"m0": m0, "h0": h0, "J0": J0}.get(fl.name, v)[self.bodies]
-            out[fl.name] = np.ascontiguousarray(v)
-        out["parent"] = np.where(out["parent"] >= 0, self.body_index[np.maximum(out["parent"], 0)], -1)
-        out["leaf_body"] = np.ascontiguousarray(self.body_index[out["leaf_body"]])
-        out.update(lump_cd=np.ascontiguousarray(lump[:, 0]), lump_cl=np.ascontiguousarray(lump[:, 1]),
+        bodies = self.bodies
+        m0, h0, J0 = s.m0[bodies], s.h0[bodies], s.J0[bodies]
+        lump = np.zeros((len(bodies), 6))
+        _lump(self.carried, anc, self.body_index, st.R, st.P, s.m0, s.h0, s.J0, s.mid0, s.cda, s.leaf_body,
+              s.leaf_on & ~leaf_on, s.leaf_base0, s.leaf_rc0, s.leaf_cna, s.leaf_cauchy, m0, h0, J0, lump)
+        renumber = np.append(self.body_index, -1)  # (−1 stays −1)
+        out = dict(m0=m0, h0=h0, J0=J0, parent=renumber[s.parent[bodies]], body_of_obj=renumber[s.body_of_obj],
+                   leaf_body=self.body_index[s.leaf_body[self.leaves]],
+                   leaf_nodes=s.leaf_nodes[:0], leaf_first=np.zeros(len(self.leaves) + 1, np.int64),
+                   lump_cd=lump[:, 0].copy(), lump_cl=lump[:, 1].copy(),
                    lump_cauchy=lump[:, 2] / np.maximum(lump[:, 1], 1e-300),
-                   lump_x0=np.ascontiguousarray(lump[:, 3:] / weight[:, None]))
+                   lump_x0=lump[:, 3:] / np.maximum(lump[:, 0] + lump[:, 1], 1e-300)[:, None])
+        for fl in fields(Structure):
+            if fl.name not in out:
+                out[fl.name] = getattr(s, fl.name)[self.leaves if fl.name.startswith("leaf_") else bodies]
         return Structure(**out)
 
     @property
