@@ -132,15 +132,15 @@ def carry(bodies, parent, r0, Q, w, R, P, Om, V):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _freeze(on, leaf_on, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V, thd, leaf_F, leaf_kap, leaf_kap2):
-    """Freeze the bodies not ``on`` (no relative velocity, placed on their parents) and the
-    leaves not ``leaf_on`` (at rest, passing no force)."""
-    for b in range(len(on)):
-        if not on[b]:
+def _freeze(bodies, leaves, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V, thd, leaf_F, leaf_kap, leaf_kap2):
+    """Freeze the ``bodies`` (bool: no relative velocity, placed on their parents) and the
+    ``leaves`` (bool: at rest, passing no force)."""
+    for b in range(len(bodies)):
+        if bodies[b]:
             st_w[b, :] = 0.0
             _place(b, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V)
-    for q in range(len(leaf_on)):
-        if not leaf_on[q]:
+    for q in range(len(leaves)):
+        if leaves[q]:
             thd[q, :] = 0.0
             leaf_F[q, :] = 0.0
             leaf_kap[q] = 0.0
@@ -229,13 +229,19 @@ class Reduced:
         The last whole pose, kept by the simulation.
     """
 
-    def __init__(self, parts: Parts, s: Structure, st: TreeState, levels: np.ndarray, work: Work):
+    def __init__(self, parts: Parts, s: Structure, st: TreeState, levels: np.ndarray, work: Work,
+                 was: np.ndarray | None = None):
         on, leaf_on = parts.active(levels)
         self.bodies, self.leaves = np.flatnonzero(on), np.flatnonzero(leaf_on)
         self.frozen = np.flatnonzero(~on)
         self.body_index = np.full(len(on), -1, np.int64)
         self.body_index[self.bodies] = np.arange(len(self.bodies))
-        _freeze(on, leaf_on, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V, st.thd, st.leaf_F, st.leaf_kap,
+        freeze, rest = ~on, ~leaf_on
+        if was is not None:  # the trees that kept their level are frozen already
+            changed = levels != was
+            freeze &= changed[parts.body_tree]
+            rest &= changed[parts.leaf_tree]
+        _freeze(freeze, rest, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V, st.thd, st.leaf_F, st.leaf_kap,
                 st.leaf_kap2)
         anc = _anchors(s.parent, on)
         self.carried = self.frozen[anc[self.frozen] >= 0]  # (the rest stands still from now on)
@@ -254,7 +260,7 @@ class Reduced:
         """The active part of ``s``, what rides on each body (``anc``: its anchor) lumped into
         it; ``leaf_on``: the leaves that move."""
         bodies = self.bodies
-        m0, h0, J0 = s.m0[bodies], s.h0[bodies], s.J0[bodies]
+        m0, h0, J0 = (np.take(a, bodies, axis=0) for a in (s.m0, s.h0, s.J0))
         lump = np.zeros((len(bodies), 6))
         _lump(self.carried, anc, self.body_index, st.R, st.P, s.m0, s.h0, s.J0, s.mid0, s.cda, s.leaf_body,
               s.leaf_on & ~leaf_on, s.leaf_base0, s.leaf_rc0, s.leaf_cna, s.leaf_cauchy, m0, h0, J0, lump)
@@ -267,7 +273,8 @@ class Reduced:
                    lump_x0=lump[:, 3:] / np.maximum(lump[:, 0] + lump[:, 1], 1e-300)[:, None])
         for fl in fields(Structure):
             if fl.name not in out:
-                out[fl.name] = getattr(s, fl.name)[self.leaves if fl.name.startswith("leaf_") else bodies]
+                out[fl.name] = np.take(getattr(s, fl.name), self.leaves if fl.name.startswith("leaf_") else bodies,
+                                       axis=0)
         return Structure(**out)
 
     @property

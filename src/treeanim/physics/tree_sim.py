@@ -197,8 +197,8 @@ class TreeSim:
         detail[object_trees(self._tree)[held]] = 0
         if not force and np.array_equal(detail, self._detail):
             return
-        self._detail = detail
-        self._lod = Reduced(self._parts, self._s, self._st, detail, self._work) if detail.any() else None
+        was, self._detail = None if force else self._detail, detail  # (force: a new state or structure)
+        self._lod = Reduced(self._parts, self._s, self._st, detail, self._work, was) if detail.any() else None
         self._pos = self._rot = None
 
     # ------------------------------------------------------------------ stepping
