@@ -209,9 +209,12 @@ class Reduced:
     """The active part of a tree (or scene) at its detail levels, and the state it steps.
 
     Building it freezes the rest in ``st`` (no relative velocity; the frozen leaves pass no
-    force); it steps in the first rows of the whole structure's ``work``. :meth:`gather`
-    copies the active part of a full state into :attr:`state`; :meth:`scatter` writes it back
-    and carries the frozen part along.
+    force) — given the levels ``was`` that ``st`` was last stepped at, only the trees whose
+    level changed: the others' frozen parts are as a freeze would leave them (:meth:`scatter`
+    carries them) — and lumps what rides into the active bodies, in a few compiled passes over
+    the bodies and leaves. It steps in the first rows of the whole
+    structure's ``work``. :meth:`gather` copies the active part of a full state into
+    :attr:`state`; :meth:`scatter` writes it back and carries the frozen part along.
 
     Attributes
     ----------
