@@ -148,61 +148,58 @@ def _freeze(bodies, leaves, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V, thd
 
 
 @njit(cache=True, error_model="numpy")
-def _lump(carried, anc, index, R, P, s_m0, s_h0, s_J0, mid0, cda, leaf_body, leaf_on, leaf_base0, leaf_rc0,
-          leaf_cna, leaf_cauchy, m0, h0, J0, lump):
-    """Lump what rides on each active body (``index``: its row in ``m0`` … ``lump``) into it:
-    the ``carried`` bodies' inertia into ``m0``, ``h0``, ``J0`` (where they are, in their
-    anchor's rest axes), their drag and the riding leaves' (``leaf_on``: the leaves that ride,
-    present) into ``lump``: cd, cl, cl·cauchy, (cd + cl)·x."""
-    C, Jf, hf, d = np.empty((3, 3)), np.empty((3, 3)), np.empty(3), np.empty(3)
-    for f in carried:  # (what stands on the ground holds nothing up)
+def _lump(todo, anc, index, parent, r0, Q, s_m0, s_h0, s_J0, mid0, cda, leaf_body, leaf_on, leaf_base0, leaf_rc0,
+          leaf_cna, leaf_cauchy, C, d, m0, h0, J0, lump):
+    """Lump what rides on each active body (``index``: its row in ``m0`` … ``lump``) into it,
+    over the bodies ``todo`` and their leaves: a carried body's inertia into ``m0``, ``h0``,
+    ``J0`` where its joints hold it (``C``, ``d``: each body's rotation and joint in its
+    anchor's rest axes, by its joints from the anchor's — fixed while it rides, as its joints
+    are), its drag and the riding leaves' (``leaf_on``: those that ride, present) into
+    ``lump``: cd, cl, cl·cauchy, (cd + cl)·x."""
+    CJ, hf = np.empty((3, 3)), np.empty(3)
+    for f in range(len(parent)):
         a = anc[f]
-        r = index[a]
-        for i in range(3):  # the frozen body in its anchor's rest axes
-            d[i] = 0.0
+        if not todo[f] or a < 0:  # (what stands on the ground holds nothing up)
+            continue
+        if a == f:
+            C[f] = np.eye(3)
+            d[f] = 0.0
+            continue
+        p, r = parent[f], index[a]
+        for i in range(3):
+            d[f, i] = d[p, i] + (C[p, i, 0] * r0[f, 0] + C[p, i, 1] * r0[f, 1] + C[p, i, 2] * r0[f, 2])
             for j in range(3):
-                d[i] += R[a, j, i] * (P[f, j] - P[a, j])
-                C[i, j] = 0.0
-                for k in range(3):
-                    C[i, j] += R[a, k, i] * R[f, k, j]
-        m = s_m0[f]
+                C[f, i, j] = C[p, i, 0] * Q[f, 0, j] + C[p, i, 1] * Q[f, 1, j] + C[p, i, 2] * Q[f, 2, j]
         for i in range(3):
-            hf[i] = C[i, 0] * s_h0[f, 0] + C[i, 1] * s_h0[f, 1] + C[i, 2] * s_h0[f, 2]
-        dh = d[0] * hf[0] + d[1] * hf[1] + d[2] * hf[2]
-        dd = d[0] * d[0] + d[1] * d[1] + d[2] * d[2]
-        for i in range(3):
-            for n in range(3):
-                s = 0.0
-                for j in range(3):
-                    for k in range(3):
-                        s += C[i, j] * s_J0[f, j, k] * C[n, k]
-                if i == n:
-                    s += 2.0 * dh + m * dd
-                Jf[i, n] = s - (d[i] * hf[n] + hf[i] * d[n] + m * d[i] * d[n])
-        m0[r] += m
+            hf[i] = C[f, i, 0] * s_h0[f, 0] + C[f, i, 1] * s_h0[f, 1] + C[f, i, 2] * s_h0[f, 2]
+            for j in range(3):
+                CJ[i, j] = C[f, i, 0] * s_J0[f, 0, j] + C[f, i, 1] * s_J0[f, 1, j] + C[f, i, 2] * s_J0[f, 2, j]
+        m, x = s_m0[f], d[f]
         cd = SEGMENT_DRAG * cda[f]
+        shift = 2.0 * (x[0] * hf[0] + x[1] * hf[1] + x[2] * hf[2]) + m * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2])
+        m0[r] += m
         lump[r, 0] += cd
         for i in range(3):
-            h0[r, i] += hf[i] + m * d[i]
-            for n in range(3):
-                J0[r, i, n] += Jf[i, n]
-            lump[r, 3 + i] += cd * (d[i] + (C[i, 0] * mid0[f, 0] + C[i, 1] * mid0[f, 1] + C[i, 2] * mid0[f, 2]))
+            h0[r, i] += hf[i] + m * x[i]
+            lump[r, 3 + i] += cd * (x[i] + (C[f, i, 0] * mid0[f, 0] + C[f, i, 1] * mid0[f, 1] + C[f, i, 2] * mid0[f, 2]))
+            for n in range(3):  # C J Cᵀ about the anchor's joint
+                Jf = CJ[i, 0] * C[f, n, 0] + CJ[i, 1] * C[f, n, 1] + CJ[i, 2] * C[f, n, 2]
+                if i == n:
+                    Jf += shift
+                J0[r, i, n] += Jf - (x[i] * hf[n] + hf[i] * x[n] + m * x[i] * x[n])
     for q in range(len(leaf_body)):  # the leaves at their laminas
         t = leaf_body[q]
         a = anc[t]
-        if not leaf_on[q] or a < 0:
+        if not todo[t] or not leaf_on[q] or a < 0:
             continue
         r = index[a]
         cl = LEAF_DRAG * leaf_cna[q]
         lump[r, 1] += cl
         lump[r, 2] += cl * leaf_cauchy[q]
         for i in range(3):
-            x = 0.0
-            for j in range(3):
-                x += R[a, j, i] * (P[t, j] + (R[t, j, 0] * (leaf_base0[q, 0] + leaf_rc0[q, 0])
-                                              + R[t, j, 1] * (leaf_base0[q, 1] + leaf_rc0[q, 1])
-                                              + R[t, j, 2] * (leaf_base0[q, 2] + leaf_rc0[q, 2])) - P[a, j])
-            lump[r, 3 + i] += cl * x
+            lump[r, 3 + i] += cl * (d[t, i] + (C[t, i, 0] * (leaf_base0[q, 0] + leaf_rc0[q, 0])
+                                               + C[t, i, 1] * (leaf_base0[q, 1] + leaf_rc0[q, 1])
+                                               + C[t, i, 2] * (leaf_base0[q, 2] + leaf_rc0[q, 2])))
 
 
 class Reduced:
@@ -233,25 +230,33 @@ class Reduced:
     """
 
     def __init__(self, parts: Parts, s: Structure, st: TreeState, levels: np.ndarray, work: Work,
-                 was: np.ndarray | None = None):
+                 was: np.ndarray | None = None, prev: Reduced | None = None):
         on, leaf_on = parts.active(levels)
         self.bodies, self.leaves = np.flatnonzero(on), np.flatnonzero(leaf_on)
         self.frozen = np.flatnonzero(~on)
         self.body_index = np.full(len(on), -1, np.int64)
         self.body_index[self.bodies] = np.arange(len(self.bodies))
-        freeze, rest = ~on, ~leaf_on
-        if was is not None:  # the trees that kept their level are frozen already
-            changed = levels != was
-            freeze &= changed[parts.body_tree]
-            rest &= changed[parts.leaf_tree]
-        _freeze(freeze, rest, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V, st.thd, st.leaf_F, st.leaf_kap,
-                st.leaf_kap2)
+        changed = np.ones(len(levels), bool) if was is None else levels != was
+        todo = changed[parts.body_tree]
+        _freeze(~on & todo, ~leaf_on & changed[parts.leaf_tree], s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om,
+                st.V, st.thd, st.leaf_F, st.leaf_kap, st.leaf_kap2)
         anc = _anchors(s.parent, on)
         self.carried = self.frozen[anc[self.frozen] >= 0]  # (the rest stands still from now on)
         moving = anc >= 0
         self.moving = np.flatnonzero(moving), np.flatnonzero(moving[s.leaf_body])
         self.last = None  # the last whole pose (set by its simulation)
-        self.s = self._structure(s, st, anc, leaf_on)
+        # what rides, lumped anew on the trees that changed, as it was on the others
+        m0, h0, J0 = (np.take(a, self.bodies, axis=0) for a in (s.m0, s.h0, s.J0))
+        self.lump = np.zeros((len(self.bodies), 6))  # cd, cl, cl·cauchy, (cd + cl)·x
+        kept = ~todo[self.bodies]
+        if prev is not None and kept.any():
+            rows = prev.body_index[self.bodies[kept]]
+            for new, old in ((m0, prev.s.m0), (h0, prev.s.h0), (J0, prev.s.J0), (self.lump, prev.lump)):
+                new[kept] = old[rows]
+        _lump(todo, anc, self.body_index, s.parent, s.r0, st.Q, s.m0, s.h0, s.J0, s.mid0, s.cda, s.leaf_body,
+              s.leaf_on & ~leaf_on, s.leaf_base0, s.leaf_rc0, s.leaf_cna, s.leaf_cauchy, np.empty_like(st.Q),
+              np.empty_like(st.P), m0, h0, J0, self.lump)
+        self.s = self._structure(s, m0, h0, J0)
         self.work = work.head(len(self.bodies))
         self.state = TreeState(time=st.time, **{f.name: np.empty((len(self._rows(f.name)),) + getattr(st, f.name).shape[1:])
                                                   for f in fields(TreeState) if f.name != "time"})
@@ -259,14 +264,10 @@ class Reduced:
     def _rows(self, name: str) -> np.ndarray:
         return self.bodies if name in _BODY_STATE else self.leaves
 
-    def _structure(self, s: Structure, st: TreeState, anc: np.ndarray, leaf_on: np.ndarray) -> Structure:
-        """The active part of ``s``, what rides on each body (``anc``: its anchor) lumped into
-        it; ``leaf_on``: the leaves that move."""
-        bodies = self.bodies
-        m0, h0, J0 = (np.take(a, bodies, axis=0) for a in (s.m0, s.h0, s.J0))
-        lump = np.zeros((len(bodies), 6))
-        _lump(self.carried, anc, self.body_index, st.R, st.P, s.m0, s.h0, s.J0, s.mid0, s.cda, s.leaf_body,
-              s.leaf_on & ~leaf_on, s.leaf_base0, s.leaf_rc0, s.leaf_cna, s.leaf_cauchy, m0, h0, J0, lump)
+    def _structure(self, s: Structure, m0: np.ndarray, h0: np.ndarray, J0: np.ndarray) -> Structure:
+        """The active part of ``s``, with the inertia ``m0``, ``h0``, ``J0`` and the drag
+        :attr:`lump` of what rides on each body."""
+        bodies, lump = self.bodies, self.lump
         renumber = np.append(self.body_index, -1)  # (−1 stays −1)
         out = dict(m0=m0, h0=h0, J0=J0, parent=renumber[s.parent[bodies]], body_of_obj=renumber[s.body_of_obj],
                    leaf_body=self.body_index[s.leaf_body[self.leaves]],

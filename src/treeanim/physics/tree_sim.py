@@ -198,7 +198,7 @@ class TreeSim:
         if not force and np.array_equal(detail, self._detail):
             return
         was, self._detail = None if force else self._detail, detail  # (force: a new state or structure)
-        self._lod = Reduced(self._parts, self._s, self._st, detail, self._work, was) if detail.any() else None
+        self._lod = Reduced(self._parts, self._s, self._st, detail, self._work, was, self._lod) if detail.any() else None
         self._pos = self._rot = None
 
     # ------------------------------------------------------------------ stepping
