@@ -148,6 +148,18 @@ def _freeze(bodies, leaves, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V, thd
 
 
 @njit(cache=True, error_model="numpy")
+def _start(bodies, rows, s_m0, s_h0, s_J0, p_m0, p_h0, p_J0, p_lump, m0, h0, J0, lump):
+    """Each active body's inertia and the drag of what rides on it, to start from: as it was
+    (``rows``: its row in the previous reduced structure, −1: none) or its own alone."""
+    for r in range(len(bodies)):
+        b, p = bodies[r], rows[r]
+        if p >= 0:
+            m0[r], h0[r], J0[r], lump[r] = p_m0[p], p_h0[p], p_J0[p], p_lump[p]
+        else:
+            m0[r], h0[r], J0[r], lump[r] = s_m0[b], s_h0[b], s_J0[b], 0.0
+
+
+@njit(cache=True, error_model="numpy")
 def _lump(todo, anc, index, parent, r0, Q, s_m0, s_h0, s_J0, mid0, cda, leaf_body, leaf_on, leaf_base0, leaf_rc0,
           leaf_cna, leaf_cauchy, C, d, m0, h0, J0, lump):
     """Lump what rides on each active body (``index``: its row in ``m0`` … ``lump``) into it,
@@ -246,13 +258,15 @@ class Reduced:
         self.moving = np.flatnonzero(moving), np.flatnonzero(moving[s.leaf_body])
         self.last = None  # the last whole pose (set by its simulation)
         # what rides, lumped anew on the trees that changed, as it was on the others
-        m0, h0, J0 = (np.take(a, self.bodies, axis=0) for a in (s.m0, s.h0, s.J0))
-        self.lump = np.zeros((len(self.bodies), 6))  # cd, cl, cl·cauchy, (cd + cl)·x
-        kept = ~todo[self.bodies]
-        if prev is not None and kept.any():
-            rows = prev.body_index[self.bodies[kept]]
-            for new, old in ((m0, prev.s.m0), (h0, prev.s.h0), (J0, prev.s.J0), (self.lump, prev.lump)):
-                new[kept] = old[rows]
+        n = len(self.bodies)
+        m0, h0, J0, self.lump = np.empty(n), np.empty((n, 3)), np.empty((n, 3, 3)), np.empty((n, 6))
+        new = m0, h0, J0, self.lump
+        if prev is None:
+            rows, old = np.full(n, -1), new
+        else:
+            rows = np.where(todo[self.bodies], -1, prev.body_index[self.bodies])
+            old = prev.s.m0, prev.s.h0, prev.s.J0, prev.lump
+        _start(self.bodies, rows, s.m0, s.h0, s.J0, *old, *new)
         _lump(todo, anc, self.body_index, s.parent, s.r0, st.Q, s.m0, s.h0, s.J0, s.mid0, s.cda, s.leaf_body,
               s.leaf_on & ~leaf_on, s.leaf_base0, s.leaf_rc0, s.leaf_cna, s.leaf_cauchy, np.empty_like(st.Q),
               np.empty_like(st.P), m0, h0, J0, self.lump)
