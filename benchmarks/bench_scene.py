@@ -113,7 +113,7 @@ def main() -> None:
         for what, pairs in (("one tree", [(f, framed) for f in finer]), ("close ↔ framed", [(close, framed)] * a.switches)):
             changed = int(np.sum(pairs[0][0] != framed))
             switches.append(f"| {name} | {what} | {changed} | " + " | ".join(f"{1e3 * x:.1f}" for x in _switch(sim, pairs)) + " |")
-    print("\n| scene | switch | trees changed | set_detail, cpu (ms) | the next step + pose, cpu (ms) |")
+    print("\n| scene | switch | trees changed | set_detail, cpu (ms) | step + pose after it, cpu (ms) |")
     print("|---|---|---|---|---|")
     print("\n".join(switches))
 
