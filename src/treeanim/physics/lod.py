@@ -218,12 +218,29 @@ class Reduced:
     """The active part of a tree (or scene) at its detail levels, and the state it steps.
 
     Building it freezes the rest in ``st`` (no relative velocity; the frozen leaves pass no
-    force) — given the levels ``was`` that ``st`` was last stepped at, only the trees whose
-    level changed: the others' frozen parts are as a freeze would leave them (:meth:`scatter`
-    carries them) — and lumps what rides into the active bodies, in a few compiled passes over
-    the bodies and leaves. It steps in the first rows of the whole
-    structure's ``work``. :meth:`gather` copies the active part of a full state into
-    :attr:`state`; :meth:`scatter` writes it back and carries the frozen part along.
+    force) and lumps what rides into the active bodies, in a few compiled passes over the
+    bodies and leaves. It steps in the first rows of the whole structure's ``work``.
+    :meth:`gather` copies the active part of a full state into :attr:`state`; :meth:`scatter`
+    writes it back and carries the frozen part along.
+
+    Parameters
+    ----------
+    parts : Parts
+        Of ``s``.
+    s : Structure
+        The whole structure.
+    st : TreeState
+        The whole state (frozen where it does not move).
+    levels : (T,) int
+        The trees' detail levels.
+    work : Work
+        The whole structure's scratch.
+    was : (T,) int or None
+        The levels ``st`` was last stepped at (None: unknown). Only the trees whose level
+        changed are frozen and lumped anew: the others' frozen parts are as a freeze leaves them
+        (:meth:`scatter` carries them) and what rides on them is lumped as in ``prev``.
+    prev : Reduced or None
+        The one ``st`` was stepped with at ``was`` (None: every tree at level 0).
 
     Attributes
     ----------
@@ -235,6 +252,8 @@ class Reduced:
         A body's index in :attr:`s` (−1: frozen).
     carried : (F,) int
         The frozen bodies that ride on an active one (the others stand still).
+    lump : (B', 6) float
+        The drag of what rides on each active body: cd, cl, cl·cauchy, (cd + cl)·x.
     moving : ((B″,) int, (L″,) int)
         The bodies and leaves that move: their nodes are all a pose after the first rewrites.
     last : (pos, rot) or None
@@ -257,21 +276,19 @@ class Reduced:
         moving = anc >= 0
         self.moving = np.flatnonzero(moving), np.flatnonzero(moving[s.leaf_body])
         self.last = None  # the last whole pose (set by its simulation)
-        # what rides, lumped anew on the trees that changed, as it was on the others
         n = len(self.bodies)
         m0, h0, J0, self.lump = np.empty(n), np.empty((n, 3)), np.empty((n, 3, 3)), np.empty((n, 6))
         new = m0, h0, J0, self.lump
-        if prev is None:
+        if was is None or prev is None:
             rows, old = np.full(n, -1), new
-        else:
-            rows = np.where(todo[self.bodies], -1, prev.body_index[self.bodies])
-            old = prev.s.m0, prev.s.h0, prev.s.J0, prev.lump
+        else:  # what rides on the trees that kept their level, as it was
+            rows, old = np.where(todo[self.bodies], -1, prev.body_index[self.bodies]), (prev.s.m0, prev.s.h0, prev.s.J0, prev.lump)
         _start(self.bodies, rows, s.m0, s.h0, s.J0, *old, *new)
         _lump(todo, anc, self.body_index, s.parent, s.r0, st.Q, s.m0, s.h0, s.J0, s.mid0, s.cda, s.leaf_body,
               s.leaf_on & ~leaf_on, s.leaf_base0, s.leaf_rc0, s.leaf_cna, s.leaf_cauchy, np.empty_like(st.Q),
-              np.empty_like(st.P), m0, h0, J0, self.lump)
+              np.empty_like(st.P), *new)
         self.s = self._structure(s, m0, h0, J0)
-        self.work = work.head(len(self.bodies))
+        self.work = work.head(n)
         self.state = TreeState(time=st.time, **{f.name: np.empty((len(self._rows(f.name)),) + getattr(st, f.name).shape[1:])
                                                   for f in fields(TreeState) if f.name != "time"})
 
