@@ -1,11 +1,14 @@
-// treeanim's reference shader wind for engines (GLSL; three.js, Unity, Unreal and Godot port it
-// line for line). It sways a static mesh written by `treeanim export --motion shader`, whose
-// vertices carry four levels of the branches they hang from, trunk first (level 0):
-//   _PIVOT{l}  xyz: the branch's base at rest; w: its frequency in Hz (0: no such level)
-//   _AXIS{l}   xyz: the branch's rest direction (unit); w: its compliance c: the mean bend in
+// treeanim's reference shader wind for engines (GLSL ES 3.0; three.js, Unity, Unreal and Godot
+// port it line for line). It sways a static mesh written by `treeanim export --motion shader`:
+// each vertex carries its object's index (attribute _OBJECT, a float), and the file's table
+// (the accessor named by the mesh's extras.treeanim_wind.table, loaded as an RGBA float texture
+// of `width` x `height` texels, nearest filtering) holds each object's four levels of the
+// branches it hangs from, trunk first (level 0), in 9 texels (tree_wind_fetch):
+//   pivot[l]   xyz: the branch's base at rest; w: its frequency in Hz (0: no such level)
+//   axis[l]    xyz: the branch's rest direction (unit); w: its compliance c: the mean bend in
 //              rad is c U^n in a wind of U m/s at the canopy top (n: the mesh's
 //              extras.treeanim_wind.exponent, the tree's; 2 for rigid wood, less with leaves)
-//   _DAMPING   the damping ratio of each level
+//   damping    the damping ratio of each level
 // All measured from treeanim's simulation of the tree (docs/design.md §16).
 //
 // Each level bends about the horizontal axis across the wind, through its pivot, by
@@ -47,6 +50,17 @@ float tree_wind_bend(vec4 pivot, vec4 axis, float zeta, vec3 dir, float speed, f
     float resonant = 0.28 / sqrt(max(zeta, 0.01));
     return load * (1.0 + 2.0 * turb * tree_wind_gust(t - travel)
                    + 2.0 * turb * resonant * sin(TREE_WIND_TAU * pivot.w * t + tree_wind_phase(pivot.xyz)));
+}
+
+// Object o's entry: texels (o mod width, 9 floor(o / width) + r), r = 0..8.
+void tree_wind_fetch(highp sampler2D table, int width, int object, out vec4 pivot[4], out vec4 axis[4],
+                     out vec4 damping) {
+    ivec2 at = ivec2(object % width, 9 * (object / width));
+    for (int l = 0; l < 4; ++l) {
+        pivot[l] = texelFetch(table, at + ivec2(0, l), 0);
+        axis[l] = texelFetch(table, at + ivec2(0, 4 + l), 0);
+    }
+    damping = texelFetch(table, at + ivec2(0, 8), 0);
 }
 
 // The swayed position of a vertex at rest position p (and its normal, turned alike).

@@ -1,4 +1,5 @@
-// Loads a glTF file with three.js's GLTFLoader (in Node, no browser: the file has no textures), plays
+// Loads a glTF file with three.js's GLTFLoader (in Node, no browser, so no image decoder: the leaves'
+// texture is skipped, a plugin answering null for it; it cuts the leaves' shape, not their motion), plays
 // its first animation with an AnimationMixer and prints every skinned vertex in world space at the
 // times asked for, as three.js skins them (SkinnedMesh.applyBoneTransform): {"<time>": [x, y, z, ...]}.
 // three.js is found in NODE_PATH (an ES module does not search it by itself).
@@ -12,7 +13,9 @@ const { GLTFLoader } = await three('examples/jsm/loaders/GLTFLoader.js');
 
 const [file, ...times] = process.argv.slice(2);
 const bytes = fs.readFileSync(file);
-new GLTFLoader().parse(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength), '', (gltf) => {
+const loader = new GLTFLoader();
+loader.register(() => ({ name: 'treeanim_no_images', loadTexture: () => Promise.resolve(null) }));
+loader.parse(bytes.buffer.slice(bytes.byteOffset, bytes.byteOffset + bytes.byteLength), '', (gltf) => {
   const mixer = new THREE.AnimationMixer(gltf.scene);
   mixer.clipAction(gltf.animations[0]).play();
   const out = {};

@@ -1,6 +1,7 @@
 """glTF export: the Khronos validator accepts the files (no errors, no warnings), and they play back the
 simulation."""
 
+import io
 import json
 import os
 import re
@@ -10,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from PIL import Image
 
 import treeanim as ta
 from gltf_readback import attribute, clip, joint_world_positions, load, play, skinned_vertices, triangles
@@ -92,12 +94,28 @@ def test_export_validates_and_plays_back(tmp_path, preset, name, seconds, fps, w
     assert moved > (0.002 if preset == "grassland" else 0.01)
 
 
+def card_triangles(tree, season=0.0):
+    """The triangles a glTF file draws: the tree's, each present leaf's lamina a 4-triangle card."""
+    leaves = np.sum((tree.kind == "leaf") & tree.leaves_present(season))
+    return tree.stats(season)["triangles"] - leaves * (len(tree.lamina.triangles) - 4)
+
+
 def test_export_mesh_matches_tree(tmp_path):
+    """... its leaves cards cut to the leaf's shape by a texture's alpha: the texture covers as
+    much of the card as the lamina does (within 1 %), the material cuts at half coverage."""
     out = tmp_path / "cherry.glb"
     assert export("small_cherry", "--seconds", "0.2", "--fps", "10", "--out", str(out)).returncode == 0
     doc, blob = load(out)
     tree = ta.load_preset("small_cherry")
-    assert triangles(doc) == tree.stats()["triangles"]
+    assert triangles(doc) == card_triangles(tree)
+    leaf = doc.materials[1]
+    assert (leaf.alphaMode, leaf.alphaCutoff) == ("MASK", 0.5)
+    image = doc.images[doc.textures[leaf.pbrMetallicRoughness.baseColorTexture.index].source]
+    view = doc.bufferViews[image.bufferView]
+    alpha = np.asarray(Image.open(io.BytesIO(blob[view.byteOffset:view.byteOffset + view.byteLength])))[..., 3]
+    box = np.prod(np.ptp(tree.lamina.outline, axis=0))
+    assert np.mean(alpha / 255.0) * box == pytest.approx(tree.lamina.area, rel=0.01)
+    assert np.mean(alpha >= 128) * box == pytest.approx(tree.lamina.area, rel=0.01)
     pos = skinned_vertices(doc, blob)
     lo, hi = tree.rest_positions.min(axis=0), tree.rest_positions.max(axis=0)
     assert np.all(pos.min(axis=0) > lo - 0.2) and np.all(pos.max(axis=0) < hi + 0.2)
@@ -124,7 +142,7 @@ def test_winter_export_drops_leaves(tmp_path):
         assert len(doc.animations[0].channels) == joints[-1] - 1
         used = np.unique(attribute(doc, blob, "JOINTS_0"))
         assert used.max() < joints[-1]
-    assert tris == [tree.stats(0.0)["triangles"], tree.stats(1.0)["triangles"]]
+    assert tris == [card_triangles(tree, 0.0), card_triangles(tree, 1.0)]
     assert joints[1] < joints[0] // 5, "a winter tree is mostly bare"
     report = validate(winter)
     assert (report["numErrors"], report["numWarnings"]) == (0, 0), report["messages"][:5]
@@ -262,15 +280,17 @@ def test_export_bad_input(tmp_path, args, words):
 
 
 def test_exported_leaf_colours_turn_with_the_season(tmp_path):
+    """The laminas' colours (the leaf material's primitives) turn from green to red-brown."""
     means = []
     for season in ("0", "0.5", "1"):
         out = tmp_path / f"s{season}.glb"
         assert export("small_cherry", "--seconds", "0.2", "--fps", "10", "--season", season, "--out", str(out)).returncode == 0
         doc, blob = load(out)
         col = attribute(doc, blob, "COLOR_0")[:, :3]
-        pos = skinned_vertices(doc, blob)
-        crown = pos[:, 1] > 1.5  # leaves and twigs, not the trunk
-        means.append(col[crown].mean(axis=0))
+        prims = doc.meshes[0].primitives
+        lamina = np.concatenate([np.full(doc.accessors[p.attributes.POSITION].count, doc.materials[p.material].name == "leaf")
+                                 for p in prims])
+        means.append(col[lamina].mean(axis=0))
     (r0, g0, _), (r5, g5, _), (r1, g1, _) = means
     assert g0 > 2 * r0, "summer leaves are green"
     assert r5 > g5 and r1 > g1, "autumn and winter leaves are red-brown"
@@ -323,3 +343,19 @@ def test_more_joints_than_a_skin_indexes_are_refused_in_one_line():
     assert "\n" not in str(e.value)
     small = skeleton(grass)
     ex.check_joints(small)  # one grassland's 15,001 joints are fine
+
+
+def test_primitives_are_cut_at_the_materials_and_at_the_vertex_limit():
+    """compact.runs: consecutive vertex ranges, no triangle across a cut, a cut at every
+    material boundary, none longer than the limit."""
+    from treeanim.compact import runs
+
+    tris = np.array([[0, 1, 2], [4, 5, 6], [1, 2, 3], [5, 6, 4], [7, 8, 9]])  # clean cuts: 0, 4, 7, 10
+    for limit, ranges in ((None, [(0, 4), (4, 10)]), (6, [(0, 4), (4, 10)]), (5, [(0, 4), (4, 7), (7, 10)])):
+        order, cut = runs(tris, limit, cuts=[4])
+        assert [(v0, v1) for _, _, v0, v1 in cut] == ranges
+        for t0, t1, v0, v1 in cut:
+            assert np.all((tris[order[t0:t1]] >= v0) & (tris[order[t0:t1]] < v1))
+        assert sorted(order.tolist()) == list(range(len(tris)))
+    with pytest.raises(ValueError, match="at most 2 vertices"):
+        runs(tris, 2)

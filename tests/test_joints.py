@@ -11,8 +11,8 @@ import pytest
 import treeanim as ta
 from gltf_readback import attribute, clip, joint_world_positions, load
 from test_export import export, validate
+from treeanim import compact, joints
 from treeanim import export as ex
-from treeanim import joints
 from treeanim.options import joint_budget
 from treeanim.render.mesh import build_mesh
 
@@ -73,7 +73,7 @@ def test_target_chooses_a_budget_and_merged_joints_ride_rigidly(tmp_path):
     sim = ta.Simulation(tree, wind=ta.WindField(speed=8.0))
     full = ex.skeleton(tree, sim.present)
     raw = ex.bake(sim, full, 11, 10.0)
-    skel, keys, _, error = joints.fit(tree, full, raw, 10, 256, sim.present)
+    skel, keys, error = joints.fit(tree, full, raw, 10, 256, sim.present, compact.card_mesh(tree))
     assert np.array_equal(clip(doc, blob)[1], keys[:, 1:]), "the command writes what joints.fit returns"
     world, pos = joints.world_pose(tree, full, raw)
     idx = joints.full_index(full, skel)

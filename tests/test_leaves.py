@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import treeanim as ta
+from treeanim.physics.leafjoint import MAX_TURN
 
 
 def leaf_tips(tree):
@@ -91,13 +92,52 @@ def test_no_leaf_snaps_through_in_a_gale_at_any_frame_rate(name):
 @pytest.mark.parametrize("name", ["tulip_poplar", "small_cherry"])
 def test_a_leafs_turn_per_frame_shrinks_with_the_frame_in_a_fresh_breeze(name):
     # A bounded angular speed: four times the frames, about a quarter the turn per frame. At
-    # 7 m/s (p99.9: 22° a frame at 1/30 s, 6° at 1/120 s) a leaf's swings are slower than a frame; in a gale a leaf settles in the flow
-    # faster than a 1/120 s frame (its time constant lever/|U| is 10–20 ms at 30 m/s) and
-    # every frame rate shows it thrash at the step's largest turn (leafjoint.MAX_TURN).
+    # 7 m/s (p99.9: 22° a frame at 1/30 s, 6° at 1/120 s) a leaf's swings are slower than a
+    # frame; in a gale a lamina settles in the flow within a few milliseconds (lever/|U|), its
+    # turn per frame set by the gusts and its flutter rather than by the frame.
     slow = rotation_per_frame(name, 7.0, 1 / 30)
     fast = rotation_per_frame(name, 7.0, 1 / 120)
     p_slow, p_fast = np.percentile(slow, 99.9), np.percentile(fast, 99.9)
     assert p_fast < 0.4 * p_slow, (p_fast, p_slow)
+
+
+def petiole_turns(name, speed, dt, seconds):
+    """(T, L, 3) each leaf's turn about its petiole's three axes (twist, bend, bend) in each
+    step after the first second, in a ``speed`` wind along x (summer: every leaf on the tree)."""
+    sim = ta.Simulation(ta.load_preset(name), wind=ta.WindField(speed=speed, direction=(1.0, 0.0, 0.0)))
+    prev, turns = sim.state.tree.th, []
+    for k in range(int(round(seconds / dt))):
+        sim.step(dt)
+        th = sim.state.tree.th
+        if k * dt >= 1.0:
+            turns.append(th - prev)
+        prev = th
+    assert np.isfinite(sim.positions).all()
+    return np.array(turns)
+
+
+def at_the_guard(turns):
+    """Where a step's turn is the most a step may turn (leafjoint.MAX_TURN), to round-off."""
+    return np.abs(np.abs(turns) - MAX_TURN) < 1e-9
+
+
+def test_in_a_storm_a_leaf_turns_as_the_air_turns_it_not_by_the_steps_largest_turn():
+    # Before (issue 26), in a 30 m/s wind at 1/60 s, 2.8 % of the large cherry's leaf steps
+    # turned an axis by the most a step may (leafjoint.MAX_TURN, 0.4 rad): the θ-method rang
+    # the flutter-driven twist (its trapezoidal rule slows a 20 Hz petiole toward the 12 Hz
+    # flutter) and the air's local slope sent a lamina far from the flow past it.
+    capped = at_the_guard(petiole_turns("large_cherry", 30.0, 1 / 60, 3.0)).any(axis=2)
+    assert capped.mean() < 0.001, capped.mean()
+
+
+def test_at_ten_frames_a_second_a_leaf_in_a_storm_never_flips_from_side_to_side():
+    # Before (issue 26): at 1/10 s in a 30 m/s wind 1.1 % of the large cherry's leaf steps
+    # turned an axis by the largest turn one way and the next step the other (the twist's
+    # trapezoidal rule and the air's Newton step, each overshooting).
+    turns = petiole_turns("large_cherry", 30.0, 0.1, 5.0)
+    capped = at_the_guard(turns)
+    flips = capped[1:] & capped[:-1] & (np.sign(turns[1:]) != np.sign(turns[:-1]))
+    assert flips.any(axis=2).mean() < 0.003, flips.any(axis=2).mean()
 
 
 # ---------------------------------------------------------------- falling leaves
@@ -171,3 +211,30 @@ def test_leaves_back_on_the_tree_leave_the_ground_and_the_paper_drops_them_unsee
     assert np.abs(sim.positions[leaf_nodes(sim.tree, fell)] - rest).max() < 0.5  # on their twigs again
     paper = drop_leaves(5.0, 0.5, model="paper")[0]
     assert np.array_equal(paper.shown, paper.present)
+
+
+def test_a_petiole_axis_step_never_gains_energy_and_is_third_order():
+    """leafjoint._axis_step, J·θ̈ + d·θ̇ + K·θ = f₀ + f₁·t/h over one step: unforced, the
+    energy ½(Kθ² + Jθ̇²) never grows at any step, stiffness, damping or inertia (10⁻⁶ to 10⁶ s,
+    a leaf's settings at their bounds); its local error falls as h⁴; a free body's ramp is
+    exact."""
+    from treeanim.physics.leafjoint import _axis_step
+
+    rng = np.random.default_rng(0)
+    for _ in range(20000):
+        h, J, K = 10 ** rng.uniform(-6, 6), 10 ** rng.uniform(-17, 0), 10 ** rng.uniform(-14, 3)
+        d = 10 ** rng.uniform(-12, 2) * rng.integers(0, 2)
+        th, om = rng.normal(), rng.normal() * np.sqrt(K / J)
+        th1, om1 = _axis_step(h, J, K, d, 0.0, 0.0, th, om)
+        assert K * th1**2 + J * om1**2 <= (K * th**2 + J * om**2) * (1 + 1e-12), (h, J, K, d)
+
+    J, w, zeta = 2e-6, 2 * np.pi * 12.0, 0.3  # a petiole's bend
+    wd = w * np.sqrt(1 - zeta**2)
+
+    def error(h):  # from θ = 1 at rest: the exact free swing e^(−ζωt)(cos ω_d t + ζω/ω_d sin ω_d t)
+        exact = np.exp(-zeta * w * h) * (np.cos(wd * h) + zeta * w / wd * np.sin(wd * h))
+        return abs(_axis_step(h, J, J * w * w, 2 * zeta * w * J, 0.0, 0.0, 1.0, 0.0)[0] - exact)
+
+    assert 13.0 < error(1e-3) / error(5e-4) < 18.0, error(1e-3) / error(5e-4)
+    th, om = _axis_step(0.1, 2.0, 0.0, 0.0, 4.0, 6.0, 0.5, 1.0)  # θ̈ = 2 + 30t: θ = ½ + t + t² + 5t³
+    assert np.allclose([th, om], [0.5 + 0.1 + 0.01 + 0.005, 1.0 + 0.2 + 0.15], rtol=1e-14)

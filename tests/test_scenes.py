@@ -109,6 +109,25 @@ def test_trees_of_their_own_seeds_differ_and_of_one_seed_are_alike():
     assert len(x0) != len(x1) or not np.allclose(x0, x1, atol=0.05)
 
 
+def test_two_trees_20_m_apart_across_the_wind_sway_each_their_own_way(cherry):
+    """Three small cherries in one 8 m/s turbulent wind, the second 20 m and the third 1 m across
+    it from the first: over 90 s their tops' downwind sway correlates at 0.03 at 20 m (held below 0.2;
+    the issue asks below 0.5), and at 0.41 at 1 m, where the wind is still partly coherent: the
+    measurement sees shared wind where there is some."""
+    scene = make_scene([cherry] * 3, positions=[(0.0, 0.0, 0.0), (0.0, 0.0, 20.0), (0.0, 0.0, 1.0)])
+    sim = ta.Simulation(scene, wind=ta.WindField(speed=8.0, seed=3), seed=0)
+    tops = [n[np.argmax(scene.rest_positions[n, 1])] for n in map(scene.tree_nodes, range(3))]
+    x = []
+    for _ in range(900):  # 90 s sampled at 10 Hz
+        for _ in range(6):
+            sim.step(1 / 60)
+        x.append(sim.positions[tops, 0])
+    x = np.array(x) - np.mean(x, axis=0)
+    r = np.corrcoef(x.T)
+    assert abs(r[0, 1]) < 0.2, r
+    assert r[0, 2] > abs(r[0, 1]) + 0.2, r
+
+
 def test_one_step_moves_every_tree_and_a_pull_only_its_own(cherry):
     scene = make_scene([cherry, cherry, grass_patch()], [(0, 0, 0), (8, 0, 0), (0, 0, 6)], [0, 120, 0])
     assert sum(len(scene.tree_nodes(k)) for k in range(3)) == scene.n_nodes

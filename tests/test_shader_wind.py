@@ -9,6 +9,7 @@ import pytest
 
 import treeanim as ta
 from browser import changed, frames, serve
+from gltf_readback import load
 from test_export import NODE_MODULES, export, validate
 from treeanim import scripted, shader_wind
 from treeanim.offline.trace import zero_crossing_frequency
@@ -100,6 +101,10 @@ def test_the_reference_shader_sways_the_mesh_in_three_js(tmp_path):
     assert "shader wind" in res.stdout
     report = validate(web / "tree.glb")
     assert (report["numErrors"], report["numWarnings"]) == (0, 0), report["messages"][:5]
+    doc, _ = load(web / "tree.glb")
+    attributes = vars(doc.meshes[0].primitives[0].attributes)
+    assert {k for k, v in attributes.items() if v is not None} == {"POSITION", "NORMAL", "COLOR_0", "_OBJECT"}, \
+        "a vertex carries its object's index, not its branches"
     shutil.copy(ROOT / "examples" / "shader_wind" / "index.html", web)
     shutil.copy(ROOT / "shaders" / "engine_wind.glsl", web)
     assert (NODE_MODULES / "three").is_dir(), f"three is not installed in {NODE_MODULES}: run scripts/test"
@@ -125,3 +130,26 @@ def test_shader_motion_refuses_keys_options_in_one_line(tmp_path):
     res = export("beam", "--motion", "shader", "--loop", "1", "--out", str(tmp_path / "x.glb"))
     assert res.returncode == 2
     assert res.stderr.strip().count("\n") == 0 and "--motion shader" in res.stderr
+
+
+def test_the_table_holds_each_objects_entry_once_where_the_shader_reads_it():
+    """Object o's row r is the texel (o mod W, 9·⌊o / W⌋ + r) that tree_wind_fetch reads, in
+    bands of W objects (here 100, so the small cherry's 876 objects take nine bands)."""
+    tree = ta.load_preset("small_cherry")
+    c = np.arange(1.0, tree.n_objects + 1.0)
+    table = shader_wind.BranchTable(np.arange(3.0 * tree.n_objects).reshape(-1, 3), np.ones((tree.n_objects, 3)), c, c / 7,
+                                    c / 3, 1.5)
+    rows = shader_wind.object_rows(tree, table)
+    tex = shader_wind.texture(rows, width=100)
+    assert tex.shape == (9 * shader_wind.ROWS, 100, 4)
+    o = np.arange(tree.n_objects)
+    for r in range(shader_wind.ROWS):
+        assert np.array_equal(tex[shader_wind.ROWS * (o // 100) + r, o % 100], rows[:, r])
+    levels, pivots = shader_wind.level_chains(tree)
+    leaf = int(np.flatnonzero(tree.kind == "leaf")[-1])
+    assert rows[leaf, :4, :3].tolist() == table.pivot[pivots[leaf]].astype(np.float32).tolist()
+    assert rows[leaf, :4, 3].tolist() == c[levels[leaf]].astype(np.float32).tolist()  # frequencies
+    assert rows[leaf, 8].tolist() == (c[levels[leaf]] / 7).astype(np.float32).tolist()  # damping ratios
+    assert np.allclose(rows[leaf, 4:8, 3], shader_wind.level_compliance(tree, table, levels)[leaf])
+    assert rows[0, 1:4, 3].tolist() == rows[0, 5:8, 3].tolist() == rows[0, 8, 1:].tolist() == [0.0] * 3, \
+        "the trunk has one level: no frequency (the shader skips the level), compliance or damping on the others"

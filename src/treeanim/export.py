@@ -19,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import json
 import re
+import struct
 import urllib.parse
 from dataclasses import dataclass
 from pathlib import Path
@@ -31,7 +32,7 @@ from .files import remove_stale, write_bytes
 from .model.tree import Tree
 from .physics.rotation import matrix_to_quat
 from .render import palette
-from .render.mesh import MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh, build_mesh
+from .render.mesh import MATERIAL_BLADE, MATERIAL_LAMINA, MATERIAL_PETIOLE, TreeMesh
 
 
 @dataclass(frozen=True)
@@ -312,14 +313,63 @@ def surface(tree: Tree, mesh: TreeMesh, used: np.ndarray, season: float) -> tupl
 
 
 def material() -> gl.Material:
-    """The one material of an exported tree: its colours are the vertices', both sides drawn."""
+    """The material of an exported tree: its colours are the vertices', both sides drawn."""
     return gl.Material(name="tree", doubleSided=True, pbrMetallicRoughness=gl.PbrMetallicRoughness(
         baseColorFactor=[1, 1, 1, 1], metallicFactor=0.0, roughnessFactor=0.8))
 
 
+def leaf_material(doc: gl.GLTF2, blob: "_Blob", lamina) -> int:
+    """Add the laminas' material to ``doc``: the tree's, cut to the leaf's shape by the alpha of
+    :func:`treeanim.compact.leaf_texture` (a PNG in the buffer; alpha mode MASK). Its index."""
+    doc.images.append(gl.Image(bufferView=blob.view(cp.leaf_texture(lamina)), mimeType="image/png"))
+    doc.samplers.append(gl.Sampler(magFilter=gl.LINEAR, minFilter=gl.LINEAR_MIPMAP_LINEAR, wrapS=gl.CLAMP_TO_EDGE,
+                                   wrapT=gl.CLAMP_TO_EDGE))
+    doc.textures.append(gl.Texture(sampler=len(doc.samplers) - 1, source=len(doc.images) - 1))
+    leaf = material()
+    leaf.name, leaf.alphaMode, leaf.alphaCutoff = "leaf", gl.MASK, 0.5
+    leaf.pbrMetallicRoughness.baseColorTexture = gl.TextureInfo(index=len(doc.textures) - 1)
+    doc.materials.append(leaf)
+    return len(doc.materials) - 1
+
+
+def primitives(doc: gl.GLTF2, blob: "_Blob", tree: Tree, mesh: TreeMesh, used: np.ndarray, index: np.ndarray,
+               columns: dict, short: bool) -> list[gl.Primitive]:
+    """The mesh's primitives: ``columns`` (name: (array, type, component, normalised), the
+    ``used`` vertices' attributes, each in a view of its own) and the triangles ``index`` (T, 3),
+    in runs of consecutive vertices of one material each (:func:`treeanim.compact.runs`), each
+    of at most 65,535 vertices where ``short`` (16-bit indices): the tree's material, or the
+    leaves' (:func:`leaf_material`), whose runs add ``TEXCOORD_0`` (the laminas' vertices are
+    consecutive: :func:`~treeanim.render.mesh.build_mesh` adds them together)."""
+    leaf = mesh.material[used] == MATERIAL_LAMINA
+    doc.materials.append(material())
+    kinds = [len(doc.materials) - 1] * 2  # the material of a run without and with laminas
+    views = {name: blob.view(a.tobytes(), gl.ARRAY_BUFFER, a.strides[0]) for name, (a, *_) in columns.items()}
+    if leaf.any():
+        kinds[1] = leaf_material(doc, blob, tree.lamina)
+        first = int(np.argmax(leaf))
+        uv = cp.leaf_uv(mesh.vertices["uv"][used][leaf], tree.lamina)
+        views["TEXCOORD_0"] = blob.view(uv.tobytes(), gl.ARRAY_BUFFER, uv.strides[0])
+    order, runs = cp.runs(index, 65535 if short else None, np.flatnonzero(np.diff(leaf)) + 1)
+    index = index[order]
+    out = []
+    for t0, t1, v0, v1 in runs:
+        attrs = {name: blob.accessor(a[v0:v1], kind, component, view=views[name], offset=v0 * a.strides[0],
+                                     normalized=norm, minmax=name == "POSITION")
+                 for name, (a, kind, component, norm) in columns.items()}
+        if leaf[v0]:
+            attrs["TEXCOORD_0"] = blob.accessor(uv[v0 - first:v1 - first], gl.VEC2, gl.UNSIGNED_SHORT,
+                                                view=views["TEXCOORD_0"], offset=(v0 - first) * uv.strides[0],
+                                                normalized=True)
+        local = (index[t0:t1] - v0).ravel().astype(np.uint16 if short else np.uint32)
+        indices = blob.accessor(local, gl.SCALAR, gl.UNSIGNED_SHORT if short else gl.UNSIGNED_INT,
+                                gl.ELEMENT_ARRAY_BUFFER, minmax=True)
+        out.append(gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices, material=kinds[int(leaf[v0])]))
+    return out
+
+
 def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, mesh: TreeMesh | None = None,
                present: np.ndarray | None = None, skel: Skeleton | None = None,
-               precision: str = "full") -> tuple[gl.GLTF2, bytes]:
+               precision: str = "full", encoded: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[gl.GLTF2, bytes]:
     """The glTF document and its binary buffer.
 
     Parameters
@@ -334,7 +384,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     season : float
         Leaf colour.
     mesh : TreeMesh, optional
-        The tree's mesh (:func:`~treeanim.render.mesh.build_mesh`), built if not given.
+        The tree's mesh, its leaves cards (:func:`treeanim.compact.card_mesh`), built if not given.
     present : (M,) bool, optional
         Objects on the tree: the others (fallen leaves) are left out of the mesh and the skin.
     skel : Skeleton, optional
@@ -343,13 +393,16 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     precision : {"full", "compact"}
         Float32 attributes and every key, or quantised attributes and keys with each joint's
         keys thinned within :data:`treeanim.compact.TOLERANCE` (:mod:`treeanim.compact`).
+    encoded : (keys, stride), optional
+        A compact file's keys and strides (:func:`treeanim.compact.encode` of ``keys``), if
+        already at hand.
 
     Raises
     ------
     ValueError
         If ``keys`` are not for the skeleton's joints.
     """
-    mesh = mesh if mesh is not None else build_mesh(tree)
+    mesh = mesh if mesh is not None else cp.card_mesh(tree)
     skel = skel if skel is not None else skeleton(tree, present)
     if keys.shape[1] != skel.count:
         raise ValueError(f"keys for {keys.shape[1]} joints, the skeleton has {skel.count}")
@@ -375,21 +428,7 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
                    JOINTS_0=(joints.astype(np.uint8), gl.VEC4, gl.UNSIGNED_BYTE, None) if byte_joints else
                    (joints, gl.VEC4, gl.UNSIGNED_SHORT, None),
                    WEIGHTS_0=(weights, gl.VEC4, gl.UNSIGNED_BYTE, True))
-    views = {name: blob.view(a.tobytes(), gl.ARRAY_BUFFER, a.strides[0]) for name, (a, *_) in columns.items()}
-    doc.materials.append(material())
-    # A compact file has one primitive per run of at most 65,535 vertices: 16-bit indices
-    order, runs = cp.runs(index) if compact else (slice(None), [(0, len(index), 0, len(pos))])
-    index = index[order]
-    primitives = []
-    for t0, t1, v0, v1 in runs:
-        attrs = {name: blob.accessor(a[v0:v1], kind, component, view=views[name], offset=v0 * a.strides[0],
-                                     normalized=norm, minmax=name == "POSITION")
-                 for name, (a, kind, component, norm) in columns.items()}
-        local = (index[t0:t1] - v0).ravel().astype(np.uint16 if compact else np.uint32)
-        indices = blob.accessor(local, gl.SCALAR, gl.UNSIGNED_SHORT if compact else gl.UNSIGNED_INT,
-                                gl.ELEMENT_ARRAY_BUFFER, minmax=True)
-        primitives.append(gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices, material=0))
-    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives))
+    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives(doc, blob, tree, mesh, used, index, columns, compact)))
 
     # --- joints: constant local translations, rotations animated
     J = skel.count
@@ -413,7 +452,10 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
 
     # --- animation: a joint's every s-th key (s = 1 at full precision), one time accessor per
     # stride, the rotation accessors in one view
-    keys, stride = cp.encode(tree, skel, keys, pos, joints) if compact else (keys, np.ones(J, np.int64))
+    if compact:
+        keys, stride = encoded if encoded is not None else cp.encode(tree, skel, keys, pos, joints)
+    else:
+        stride = np.ones(J, np.int64)
     times = (np.arange(len(keys)) / fps).astype(np.float32)
     t_acc = {s: blob.accessor(times[::s], gl.SCALAR, gl.FLOAT, minmax=True) for s in np.unique(stride[1:]).tolist()}
     kept = [keys[::stride[j], j] for j in range(1, J)]
@@ -432,6 +474,28 @@ def build_gltf(tree: Tree, keys: np.ndarray, fps: float, season: float = 0.0, me
     return doc, data
 
 
+def to_json(doc: gl.GLTF2, allow_nan: bool = True) -> bytes:
+    """``doc`` as compact JSON: what pygltflib's ``to_json`` writes (empty and None values left
+    out), without its deep copy of every value (11 s for the 17,048 joints' nodes, channels
+    and accessors of a large cherry)."""
+    return json.dumps(gl.delete_empty_keys(_plain(doc)), cls=gl.JsonEncoder, allow_nan=allow_nan,
+                      separators=(",", ":")).encode()
+
+
+def _plain(obj):
+    """Dataclasses, lists and dicts as plain dicts and lists (pygltflib's ``gltf_asdict``)."""
+    if obj is None or isinstance(obj, (int, float, str)):
+        return obj
+    if isinstance(obj, (list, tuple)):
+        return [_plain(v) for v in obj]
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in obj.items()}
+    if isinstance(obj, gl.Attributes):
+        return dict(obj.__dict__)
+    names = getattr(type(obj), "__dataclass_fields__", None)
+    return {name: _plain(getattr(obj, name)) for name in names} if names is not None else obj
+
+
 def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
     """Write ``.glb`` (one file) or ``.gltf`` + ``.bin`` atomically; returns the files written.
 
@@ -440,10 +504,12 @@ def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
     a run killed at any moment leaves a matching pair (at worst plus an unused ``.bin``).
     """
     path = Path(path)
-    if path.suffix.lower() == ".glb":
+    if path.suffix.lower() == ".glb":  # the header, the JSON chunk (space-padded), the buffer's chunk
         doc.buffers[0].uri = None
-        doc.set_binary_blob(data)
-        write_bytes(path, b"".join(doc.save_to_bytes()))
+        text = to_json(doc, allow_nan=False)
+        text += b" " * (-len(text) % 4)
+        write_bytes(path, b"".join([b"glTF", struct.pack("<III", 2, 28 + len(text) + len(data), len(text)), b"JSON",
+                                    text, struct.pack("<I", len(data)), b"BIN\0", data]))
         return [path]
     bin_path = path.with_name(f"{path.stem}-{hashlib.sha1(data).hexdigest()[:8]}.bin")
     doc.buffers[0].uri = urllib.parse.quote(bin_path.name)
@@ -451,7 +517,7 @@ def write_gltf(path: str | Path, doc: gl.GLTF2, data: bytes) -> list[Path]:
     # A killed export's buffer was named after other content: its stale temporary files too
     remove_stale(path.parent, re.compile(re.escape(path.stem) + r"-[0-9a-f]{8}\.bin"))
     write_bytes(bin_path, data)
-    write_bytes(path, doc.to_json(separators=(",", ":")).encode())
+    write_bytes(path, to_json(doc))
     if old_bin is not None and old_bin != bin_path:
         old_bin.unlink(missing_ok=True)
     return [path, bin_path]

@@ -174,7 +174,7 @@ def motion_error(tree, full: Skeleton, reduced: Skeleton, full_keys: np.ndarray,
                                                              pos, jr, wr8))
 
 
-def fit(tree, full: Skeleton, raw: np.ndarray, n: int, budget: int | None, present=None):
+def fit(tree, full: Skeleton, raw: np.ndarray, n: int, budget: int | None, present=None, mesh=None):
     """Fit baked keys to a joint budget: what ``export --joints`` does.
 
     Parameters
@@ -189,24 +189,27 @@ def fit(tree, full: Skeleton, raw: np.ndarray, n: int, budget: int | None, prese
         The most joints; None keeps them all.
     present : (M,) bool, optional
         Objects on the tree.
+    mesh : TreeMesh, optional
+        The mesh the file skins, whose vertices the merges and the error weigh (the tree's,
+        :func:`~treeanim.render.mesh.build_mesh`, by default).
 
     Returns
     -------
-    skel, keys, mesh, error
-        The reduced skeleton and its keys (F, Jr, 4); the mesh built on the way (None if
-        nothing was merged); :func:`motion_error` (None if nothing was merged).
+    skel, keys, error
+        The reduced skeleton and its keys (F, Jr, 4); :func:`motion_error` (None if nothing
+        was merged).
     """
     if budget is None or budget >= full.count:
-        return full, raw, None, None
+        return full, raw, None
     from .export import skin
     from .render.mesh import build_mesh
 
-    mesh = build_mesh(tree)
+    mesh = mesh if mesh is not None else build_mesh(tree)
     world, position = world_pose(tree, full, raw)
     _, _, pos, joint, _ = skin(tree, mesh, full, present)
     skel = reduce(tree, full, world, pos, joint[:, 0], budget)
     error = motion_error(tree, full, skel, raw[:n + 1], mesh, present, world=(world[:n + 1], position[:n + 1]))
-    return skel, rekey(full, skel, world), mesh, error
+    return skel, rekey(full, skel, world), error
 
 
 def report(full: Skeleton, skel: Skeleton, budget: int | None, error) -> str:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .loop import _mul
+from .physics.compiled import njit
 
 __all__ = ["displacement", "world_pose"]
 
@@ -26,11 +26,36 @@ def _levels(parent: np.ndarray) -> list[np.ndarray]:
     return np.split(order, np.flatnonzero(np.diff(depth[order])) + 1)
 
 
-def _rotate(q: np.ndarray, v: np.ndarray) -> np.ndarray:
-    """Vectors v (..., 3) rotated by unit quaternions q (..., 4), (x, y, z, w)."""
-    u, w = q[..., :3], q[..., 3:]
-    c = 2.0 * np.cross(u, v)
-    return v + w * c + np.cross(u, c)
+@njit(cache=True, inline="always")
+def _qmul(a, b):
+    """The Hamilton product a b of quaternions (x, y, z, w) as a tuple."""
+    return (a[3] * b[0] + a[0] * b[3] + a[1] * b[2] - a[2] * b[1],
+            a[3] * b[1] - a[0] * b[2] + a[1] * b[3] + a[2] * b[0],
+            a[3] * b[2] + a[0] * b[1] - a[1] * b[0] + a[2] * b[3],
+            a[3] * b[3] - a[0] * b[0] - a[1] * b[1] - a[2] * b[2])
+
+
+@njit(cache=True, inline="always")
+def _qrot(q, x, y, z):
+    """The vector (x, y, z) rotated by the unit quaternion q (x, y, z, w), as a tuple."""
+    cx, cy, cz = 2.0 * (q[1] * z - q[2] * y), 2.0 * (q[2] * x - q[0] * z), 2.0 * (q[0] * y - q[1] * x)
+    return (x + q[3] * cx + q[1] * cz - q[2] * cy,
+            y + q[3] * cy + q[2] * cx - q[0] * cz,
+            z + q[3] * cz + q[0] * cy - q[1] * cx)
+
+
+@njit(cache=True)
+def _compose(keys, parent, offset, order, world, pos):
+    """world[f, j] = world[f, parent] keys[f, j]; pos[f, j] = pos[f, parent] + world[f, parent]
+    offset[j]: the joints in ``order`` (parents before children), every frame."""
+    for f in range(keys.shape[0]):
+        for j in order:
+            p = parent[j]
+            world[f, j, 0], world[f, j, 1], world[f, j, 2], world[f, j, 3] = _qmul(world[f, p], keys[f, j])
+            x, y, z = _qrot(world[f, p], offset[j, 0], offset[j, 1], offset[j, 2])
+            pos[f, j, 0] = pos[f, p, 0] + x
+            pos[f, j, 1] = pos[f, p, 1] + y
+            pos[f, j, 2] = pos[f, p, 2] + z
 
 
 def _rest(tree, skel) -> np.ndarray:
@@ -56,7 +81,7 @@ def world_pose(tree, skel, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         Each joint's world position (m): its parent's, plus its constant rest offset turned
         by the parent's rotation.
     """
-    keys = np.asarray(keys, np.float64)
+    keys = np.ascontiguousarray(keys, np.float64)
     F, J = keys.shape[:2]
     rest = _rest(tree, skel)
     parent = skel.joint_parent
@@ -64,24 +89,40 @@ def world_pose(tree, skel, keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     world = np.zeros((F, J, 4))
     world[..., 3] = 1.0
     pos = np.zeros((F, J, 3))
-    for idx in _levels(parent)[1:]:  # one pass per depth, every joint of it and every frame at once
-        p = parent[idx]
-        world[:, idx] = _mul(world[:, p], keys[:, idx])
-        pos[:, idx] = pos[:, p] + _rotate(world[:, p], offset[idx])
+    _compose(keys, parent, offset, np.concatenate(_levels(parent)[1:]), world, pos)
     world /= np.linalg.norm(world, axis=-1, keepdims=True)
     return world, pos
 
 
-def _skinned(world, position, rest, pos, joints, weights) -> np.ndarray:
-    """(V, 3) vertex positions of one frame: Σ w (R_j (x − rest_j) + p_j)."""
-    out = np.zeros_like(pos)
+@njit(cache=True, inline="always")
+def _skin_vertex(world, position, rest, x, joints, weights, v):
+    """Vertex v of one frame, skinned: Σ w (R_j (x − rest_j) + p_j), as a tuple."""
+    ox = oy = oz = 0.0
     for slot in range(joints.shape[1]):
-        w = weights[:, slot]
-        if not np.any(w):
+        w = weights[v, slot]
+        if w == 0.0:
             continue
-        j = joints[:, slot]
-        out += w[:, None] * (_rotate(world[j], pos - rest[j]) + position[j])
-    return out
+        j = joints[v, slot]
+        rx, ry, rz = _qrot(world[j], x[v, 0] - rest[j, 0], x[v, 1] - rest[j, 1], x[v, 2] - rest[j, 2])
+        ox += w * (rx + position[j, 0])
+        oy += w * (ry + position[j, 1])
+        oz += w * (rz + position[j, 2])
+    return ox, oy, oz
+
+
+@njit(cache=True)
+def _distances(wa, pa, ra, xa, ja, wta, wb, pb, rb, xb, jb, wtb):
+    """The sum and the largest of the squared distances between the mesh skinned two ways,
+    over vertices and frames."""
+    sse, worst = 0.0, 0.0
+    for f in range(wa.shape[0]):
+        for v in range(xa.shape[0]):
+            ax, ay, az = _skin_vertex(wa[f], pa[f], ra, xa, ja, wta, v)
+            bx, by, bz = _skin_vertex(wb[f], pb[f], rb, xb, jb, wtb, v)
+            d2 = (ax - bx) ** 2 + (ay - by) ** 2 + (az - bz) ** 2
+            sse += d2
+            worst = max(worst, d2)
+    return sse, worst
 
 
 def displacement(tree, a, b) -> tuple[float, float, int]:
@@ -103,13 +144,8 @@ def displacement(tree, a, b) -> tuple[float, float, int]:
         F.
     """
     (sa, (wa, pa), xa, ja, wta), (sb, (wb, pb), xb, jb, wtb) = a, b
-    ra, rb = _rest(tree, sa), _rest(tree, sb)
-    xa, xb = np.asarray(xa, np.float64), np.asarray(xb, np.float64)
-    wta, wtb = wta / 255.0, wtb / 255.0
-    sse, worst = 0.0, 0.0
-    for f in range(len(wa)):  # a loop over frames; every vertex at once
-        d = _skinned(wa[f], pa[f], ra, xa, ja, wta) - _skinned(wb[f], pb[f], rb, xb, jb, wtb)
-        d2 = np.einsum("vi,vi->v", d, d)
-        sse += float(d2.sum())
-        worst = max(worst, float(d2.max()))
+    c = np.ascontiguousarray
+    args = [(c(w, np.float64), c(p, np.float64), _rest(tree, s), c(x, np.float64), c(j, np.int64), c(wt, np.float64) / 255.0)
+            for s, w, p, x, j, wt in ((sa, wa, pa, xa, ja, wta), (sb, wb, pb, xb, jb, wtb))]
+    sse, worst = _distances(*args[0], *args[1])  # every vertex at every frame, compiled
     return float(np.sqrt(sse / max(len(xa) * len(wa), 1))), float(np.sqrt(worst)), len(wa)

@@ -1,13 +1,19 @@
-"""Shader wind for engines: a static mesh whose vertices carry their branch hierarchy and each
-branch's physical parameters, for a vertex shader to sway it (``shaders/engine_wind.glsl``, the
-reference; ``examples/shader_wind/index.html`` runs it in three.js).
+"""Shader wind for engines: a static mesh (the glTF one, leaves as cards:
+:func:`treeanim.compact.card_mesh`), its vertices' branch hierarchy and each branch's physical
+parameters, for a vertex shader to sway it (``shaders/engine_wind.glsl``, the reference;
+``examples/shader_wind/index.html`` runs it in three.js).
 
-Each vertex carries up to :data:`LEVELS` levels of the branches it hangs from: the trunk and the
-three innermost (its own object, its parent, its grandparent; a leaf is its own level). Per
-level, attributes ``_PIVOT{l}`` (the branch's base at rest, xyz; its sway frequency in Hz, w;
-0 = no such level) and ``_AXIS{l}`` (the branch's rest direction, xyz; its compliance, w: the
-mean bend in rad is compliance·U^n in a wind of U m/s at the canopy top), and ``_DAMPING`` (the
-damping ratio of each level); the exponent n is the mesh's ``extras.treeanim_wind.exponent``.
+Each vertex hangs from up to :data:`LEVELS` levels of the branches it hangs from: the trunk and the
+three innermost (its own object, its parent, its grandparent; a leaf is its own level). These
+depend on the vertex's object only, so the file stores them once per object, in a table, and
+each vertex carries its object's index (attribute ``_OBJECT``, a float) besides its position,
+normal and colour. The table (:func:`object_rows`, laid out as a float texture by
+:func:`texture`) is an accessor of RGBA float texels named by the mesh's
+``extras.treeanim_wind.table`` (``accessor``, ``width``, ``height``); an object's entry is
+:data:`ROWS` texels: per level, the pivot (the branch's base at rest, xyz; its sway frequency in
+Hz, w; 0 = no such level), then per level the axis (the branch's rest direction, xyz; its
+compliance, w: the mean bend in rad is compliance·U^n in a wind of U m/s at the canopy top),
+then the damping ratio of each level; the exponent n is ``extras.treeanim_wind.exponent``.
 All come from the simulation of the tree (docs/design.md §16):
 
 - **compliance** and **exponent**: the mean bends of the branches against their parents in
@@ -27,14 +33,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import scripted
-from .export import material, skeleton, skin, surface
+from .compact import card_mesh
+from .export import primitives, skeleton, skin, surface
 from .model.tree import Tree
 from .physics.simulation import Simulation
 from .physics.wind.field import WindField
-from .render.mesh import TreeMesh, build_mesh
+from .render.mesh import TreeMesh
 
 __all__ = ["LEVELS", "CALIBRATION_WINDS", "BranchTable", "branch_table", "level_chains", "level_compliance",
-           "build_shader_gltf"]
+           "object_rows", "texture", "build_shader_gltf"]
 
 #: Levels of branches a vertex carries (Unreal's Pivot Painter and SpeedTree use 3–4).
 LEVELS = 4
@@ -46,6 +53,9 @@ SETTLE, RING = 5.0, 6.0
 #: step adds no damping of its own to a leaf's 10–15 Hz (at 1/60 s it doubles a beam's ζ). The
 #: ring-down is recorded at half this rate (float32: 0.1 GB for a 40,000-object scan).
 RATE = 240.0
+#: Rows of an object's entry in the table (4 pivots, 4 axes, the damping ratios) and the most
+#: objects a row band of the table's texture holds.
+ROWS, TABLE_WIDTH = 2 * LEVELS + 1, 1024
 
 
 @dataclass(frozen=True)
@@ -165,8 +175,39 @@ def level_compliance(tree: Tree, table: BranchTable, levels: np.ndarray) -> np.n
     return c
 
 
+def object_rows(tree: Tree, table: BranchTable) -> np.ndarray:
+    """(M, ROWS, 4) float32 each object's shader-wind entry: its levels' pivots (xyz, and the
+    level's frequency in w; 0 = no such level), rest axes (xyz, and the level's compliance in
+    w), and the levels' damping ratios; what ``shaders/engine_wind.glsl`` reads for a vertex of
+    that object (module docstring)."""
+    levels, pivots = level_chains(tree)
+    on = levels >= 0
+    o = np.maximum(levels, 0)
+    rows = np.zeros((tree.n_objects, ROWS, 4), np.float32)
+    rows[:, :LEVELS, :3] = table.pivot[np.maximum(pivots, 0)]
+    rows[:, :LEVELS, 3] = np.where(on, table.frequency[o], 0.0)
+    rows[:, LEVELS:2 * LEVELS, :3] = table.axis[o]
+    rows[:, LEVELS:2 * LEVELS, 3] = level_compliance(tree, table, levels)
+    rows[:, 2 * LEVELS] = np.where(on, table.damping[o], 0.0)
+    return rows
+
+
+def texture(rows: np.ndarray, width: int = TABLE_WIDTH) -> np.ndarray:
+    """(H, W, 4) the objects' entries (M, ROWS, 4) as a float texture: object o's row r at texel
+    (o mod W, ROWS·⌊o / W⌋ + r), W = min(M, ``width``): bands of ``width`` objects, so that at
+    1,024 a texture stays within the 2,048 texels a side WebGL 2 guarantees up to 232,448
+    objects."""
+    M = len(rows)
+    W = min(M, width)
+    bands = -(-M // W)
+    tex = np.zeros((bands * W, ROWS, 4), np.float32)
+    tex[:M] = rows
+    return tex.reshape(bands, W, ROWS, 4).transpose(0, 2, 1, 3).reshape(bands * ROWS, W, 4)
+
+
 def build_shader_gltf(tree: Tree, table: BranchTable, season: float = 0.0, mesh: TreeMesh | None = None):
-    """The static glTF of ``tree`` with the shader-wind attributes (module docstring).
+    """The static glTF of ``tree`` with the shader-wind table and each vertex's object index
+    (module docstring).
 
     Returns
     -------
@@ -177,39 +218,23 @@ def build_shader_gltf(tree: Tree, table: BranchTable, season: float = 0.0, mesh:
 
     from .export import _Blob
 
-    mesh = mesh if mesh is not None else build_mesh(tree)
+    mesh = mesh if mesh is not None else card_mesh(tree)
     present = tree.leaves_present(season)
     keep_tris, used, pos, _, _ = skin(tree, mesh, skeleton(tree, present), present)
-    levels, pivots = level_chains(tree)
-    compliance = level_compliance(tree, table, levels)[mesh.object[used]]  # (U, LEVELS)
-    lv, pv = levels[mesh.object[used]], pivots[mesh.object[used]]
-    on = lv >= 0
-    o = np.maximum(lv, 0)
     doc = gl.GLTF2(asset=gl.Asset(version="2.0", generator="treeanim (shader wind)"))
     blob = _Blob(doc)
     nrm, col = surface(tree, mesh, used, season)
-    attrs = {
-        "POSITION": blob.accessor(pos, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER, minmax=True),
-        "NORMAL": blob.accessor(nrm, gl.VEC3, gl.FLOAT, gl.ARRAY_BUFFER),
-        "COLOR_0": blob.accessor(col, gl.VEC4, gl.UNSIGNED_BYTE, gl.ARRAY_BUFFER, normalized=True),
-    }
-    for level in range(LEVELS):
-        f = np.where(on[:, level], table.frequency[o[:, level]], 0.0)
-        pivot = np.column_stack([table.pivot[np.maximum(pv[:, level], 0)], f])
-        axis = np.column_stack([table.axis[o[:, level]], compliance[:, level]])
-        for name, a in ((f"_PIVOT{level}", pivot), (f"_AXIS{level}", axis)):
-            attrs[name] = blob.accessor(a.astype(np.float32), gl.VEC4, gl.FLOAT, gl.ARRAY_BUFFER)
-    attrs["_DAMPING"] = blob.accessor(np.where(on, table.damping[o], 0.0).astype(np.float32), gl.VEC4, gl.FLOAT,
-                                      gl.ARRAY_BUFFER)
-    remap = np.cumsum(used) - 1
-    index = remap[mesh.indices[keep_tris]].astype(np.uint32).ravel()
-    indices = blob.accessor(index, gl.SCALAR, gl.UNSIGNED_INT, gl.ELEMENT_ARRAY_BUFFER, minmax=True)
-    doc.materials.append(material())
-    doc.meshes.append(gl.Mesh(name=tree.name, primitives=[gl.Primitive(attributes=gl.Attributes(**attrs), indices=indices,
-                                                                         material=0)],
-                              extras={"treeanim_wind": {"levels": LEVELS, "exponent": round(table.exponent, 4),
-                                                        "calibration_winds": list(CALIBRATION_WINDS),
-                                                        "shader": "shaders/engine_wind.glsl"}}))
+    tex = texture(object_rows(tree, table))
+    columns = {"POSITION": (pos, gl.VEC3, gl.FLOAT, None), "NORMAL": (nrm, gl.VEC3, gl.FLOAT, None),
+               "COLOR_0": (col, gl.VEC4, gl.UNSIGNED_BYTE, True),
+               "_OBJECT": (mesh.object[used].astype(np.float32), gl.SCALAR, gl.FLOAT, None)}
+    entries = blob.accessor(tex.reshape(-1, 4), gl.VEC4, gl.FLOAT)
+    index = (np.cumsum(used) - 1)[mesh.indices[keep_tris]]
+    wind = {"levels": LEVELS, "exponent": round(table.exponent, 4), "calibration_winds": list(CALIBRATION_WINDS),
+            "table": {"accessor": entries, "width": tex.shape[1], "height": tex.shape[0], "rows": ROWS},
+            "shader": "shaders/engine_wind.glsl"}
+    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives(doc, blob, tree, mesh, used, index, columns, True),
+                              extras={"treeanim_wind": wind}))
     doc.nodes.append(gl.Node(name=tree.name, mesh=0))
     doc.scenes.append(gl.Scene(name=tree.name, nodes=[0]))
     doc.scene = 0

@@ -44,22 +44,24 @@ def cmd_export(args) -> int:
     except ValueError as e:
         raise UsageError(str(e)) from None
     full = skel
-    skel, raw, mesh, error = joints.fit(tree, full, raw, n, budget, sim.present)
-    mesh = mesh if mesh is not None else build_mesh(tree)  # once, for the file and the compact error
+    mesh = build_mesh(tree) if usd else compact.card_mesh(tree)  # once, for the fit, the file and its error
+    skel, raw, error = joints.fit(tree, full, raw, n, budget, sim.present, mesh)
     keys = loop.close_loop(raw, n) if fade else raw
+    packed = args.precision == "compact" and not usd
+    skinned = export.skin(tree, mesh, skel, sim.present)[2:] if packed else None
+    encoded = compact.encode(tree, skel, keys, *skinned[:2]) if packed else None  # once, for the file and its error
     if usd:
         files = export_usd.write_usd(out, tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel)
     else:
         doc, data = export.build_gltf(tree, keys, args.fps, season=args.season, mesh=mesh, present=sim.present, skel=skel,
-                                      precision=args.precision)
+                                      precision=args.precision, encoded=encoded)
         files = export.write_gltf(out, doc, data)
     size = sum(f.stat().st_size for f in files)
     print(f"wrote {', '.join(map(str, files))}: {skel.count} joints, {n} frames at {args.fps:g} fps, "
           f"{n + 1} keys from 0 to {n / args.fps:.2f} s, {size / 1e6:.1f} MB")
     print(joints.report(full, skel, budget, error))
-    if args.precision == "compact" and not usd:
-        skinned = export.skin(tree, mesh, skel, sim.present)[2:]
-        print(compact.report(compact.error(tree, skel, keys, *skinned)))
+    if packed:
+        print(compact.report(compact.error(tree, skel, keys, *skinned, encoded=encoded)))
     if fade:
         print(loop.seam(keys, raw).line())
     return 0

@@ -10,12 +10,18 @@ from .compiled import njit
 
 __all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP", "FLUTTER_STROUHAL"]
 
-#: The most a leaf turns about one of its axes in one step (rad). The step takes the air's
-#: pull on a turning lamina linearised; in a gale a leaf settles in the flow within 10–20 ms
-#: (its lever over |U|), so a longer step's linear turn would overshoot the flow and flip the
-#: leaf from side to side. Capping the turn (and the speed with it: energy is only taken
-#: away) keeps each step where the linearisation holds.
+#: The most a petiole bends about either axis in one step (rad): a guard. The step takes the
+#: air's moment on the lamina linearised about the step's start (its slope near the flow, its
+#: chord to where the lamina lets go far from it, :func:`_secant_stiffness`), exact at both
+#: ends along the axis but not across the axes nor as the lamina's own speed changes the air
+#: on it; a turn this large leaves that model. In a 30 m/s wind it binds on 0.02–0.03 % of
+#: the large cherry's leaf steps at 1/60 s, each a lamina swinging round into the flow, 3 %
+#: at 1/10 s. The twist, linear (driven by the flutter, damped by the
+#: air against the lamina's roll), has no such limit.
 MAX_TURN = 0.4
+#: A bend whose Newton step (τ − kθ)/(k + k_air) would pass this (rad) takes the air's chord
+#: stiffness (:func:`_secant_stiffness`); below it the local slope is within a few per cent of it.
+SECANT_TURN = 0.3
 #: The most a petiole bends (rad): past a right angle, so a leaf whose petiole points upwind
 #: trails downwind of it in a gale instead of being held face-on to the flow.
 PETIOLE_STOP = 0.9 * np.pi
@@ -30,14 +36,79 @@ FLUTTER_SPEED = 4.0
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _leaf_theta(x2):
-    """A petiole joint's θ for x² = (ωh)²: ½ + ½·x⁴/(x⁴ + 10⁴), the trapezoidal rule up to a
-    few steps a period (a leaf's turns stay visible at 30 frames a second, at a turn per frame
-    proportional to the frame's length), toward backward Euler for swings ten times faster.
-    Defined here, not shared with the joints' (``articulated.theta_of``): numba's cache does
-    not see a change in another module's inlined function."""
-    x4 = x2 * x2
-    return 0.5 + 0.5 * x4 / (x4 + 1.0e4)
+def _axis_step(h, J, K, d, f0, f1, th, om):
+    """One step of J·θ̈ + d·θ̇ + K·θ = f0 + f1·t/h from (θ, θ̇) = (th, om): (θ, θ̇) after it.
+
+    The 2-stage Radau IIA method, in closed form. On this linear system it is the exact flow
+    with exp(Z) taken as its (1, 2) Padé approximant R(Z) = (1 − ⅔Z + Z²/6)⁻¹(1 + Z/3)
+    (Z = h·A, A the system's matrix): third order, exact for the forcing's ramp, A-stable (the
+    energy ½(Kθ² + Jθ̇²) never grows unforced, any h) and L-stable (a swing far faster than
+    the step settles in it, as backward Euler's, and never rings at the step rate, as the
+    trapezoidal rule's overdamped modes do). With a = Kh/J, q = dh/J, φ = hf/J:
+    x⁺ = D⁻¹[N·x + (1 − Z/6)φ₀e₂ + (½ − Z/6)φ₁e₂], N = 1 + Z/3, D = 1 − ⅔Z + Z²/6,
+    Z = [[0, h], [−a, −q]] (no division by h: a step of 10⁻³²⁰ s is a step).
+    """
+    hJ = h / J
+    a, q = K * hJ, d * hJ
+    ph0, ph1 = hJ * f0, hJ * f1
+    y0 = th + h * (om / 3.0 - (ph0 + ph1) / 6.0)
+    y1 = om - (a * th + q * om) / 3.0 + ph0 * (1.0 + q / 6.0) + ph1 * (0.5 + q / 6.0)
+    p = a * h
+    d00, d01 = 1.0 - p / 6.0, -h * (2.0 / 3.0 + q / 6.0)
+    d10, d11 = a * (2.0 / 3.0 + q / 6.0), 1.0 + 2.0 * q / 3.0 + (q * q - p) / 6.0
+    r = 1.0 / (1.0 + q * (2.0 / 3.0 + q / 6.0) + p * ((1.0 + q) / 9.0 + p / 36.0))  # det D, a sum of positives
+    return (d11 * y0 - d01 * y1) * r, (d00 * y1 - d10 * y0) * r
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _secant_stiffness(tau, alpha, beta, gamma):
+    """The air's stiffness against a lamina's bend far from the flow: its moment τ(0)/δ* over
+    the turn δ* to where it lets go, or 0 where it never does.
+
+    Turning the lamina by δ about an axis e carries its normal and its lever alike, so the
+    moment about e is τ(δ) = c|U|(e·p)·(α + β cos δ + γ sin δ), α = (e·U)(e·n), β = U·n − α,
+    γ = e·(n × U): a sinusoid. δ* is its first zero in the direction τ(0) turns the lamina,
+    where it comes to rest edge-on (stable: the moment turns back beyond). The local slope
+    −τ′(0) (Newton's step) always lands beyond δ*, from 67° off the flow on farther beyond
+    it than it started, and flipped laminas from side to side; the chord τ(0)/δ* is exact at
+    both ends, so a step long against the lamina's settling lands on δ*, a shorter one short
+    of it.
+    """
+    sg = 1.0 if tau > 0.0 else -1.0
+    rho = np.sqrt(beta * beta + gamma * gamma)
+    if rho <= abs(alpha):
+        return 0.0
+    # α + β cos t + σγ sin t = α + ρ cos(t − ψ) = 0 for the smallest t > 0
+    psi = np.arctan2(sg * gamma, beta)
+    a = np.arccos(-alpha / rho)
+    t = 4.0 * np.pi
+    for cand in (psi + a, psi - a):
+        cand = cand % (2.0 * np.pi)
+        if cand <= 1e-12:
+            cand += 2.0 * np.pi
+        t = min(t, cand)
+    return abs(tau) / t
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _sincos(x):
+    """(sin x, cos x) to round-off, two to four times faster than libm's pair for the
+    angles here: Taylor series on x/2ᵐ ≤ ½ (errors below 10⁻¹⁷), then m doublings (an ulp
+    each); libm's beyond |x| = 8."""
+    if abs(x) > 8.0:
+        return np.sin(x), np.cos(x)
+    m = 0
+    while abs(x) > 0.5:
+        x *= 0.5
+        m += 1
+    x2 = x * x
+    s = x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (
+        1.0 / 362880.0 + x2 * (-1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0)))))))
+    c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (
+        -1.0 / 3628800.0 + x2 * (1.0 / 479001600.0 + x2 * (-1.0 / 87178291200.0)))))))
+    for _ in range(m):
+        s, c = 2.0 * s * c, (c - s) * (c + s)
+    return s, c
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
@@ -63,8 +134,9 @@ def _leaf_rotation(E, th, G):
     vy = E[1, 1] * th[1] + E[1, 2] * th[2]
     vz = E[2, 1] * th[1] + E[2, 2] * th[2]
     beta = np.sqrt(vx * vx + vy * vy + vz * vz)
-    cb, ct, st = np.cos(0.5 * beta), np.cos(0.5 * th[0]), np.sin(0.5 * th[0])
-    sb = np.sin(0.5 * beta) / beta if beta > 1e-12 else 0.5  # times the unnormalised axis v
+    sb, cb = _sincos(0.5 * beta)
+    st, ct = _sincos(0.5 * th[0])
+    sb = sb / beta if beta > 1e-12 else 0.5  # times the unnormalised axis v
     qw = cb * ct - sb * st * (vx * ax + vy * ay + vz * az)
     cx, cy, cz = _cross(vx, vy, vz, ax, ay, az)
     qx = cb * st * ax + ct * sb * vx + sb * st * cx
@@ -73,9 +145,40 @@ def _leaf_rotation(E, th, G):
     _quat_matrix(qw, qx, qy, qz, G)
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _add_outer(C, b, w, a0, a1, a2, a3, a4, a5):
+    """C[b] += w·aaᵀ for a = (a0 … a5), its upper triangle only."""
+    a = (a0, a1, a2, a3, a4, a5)
+    for i in range(6):
+        wi = w * a[i]
+        for j in range(i, 6):
+            C[b, i, j] += wi * a[j]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _turn_stiffness(K, b, cs2, px, py, pz, nx, ny, nz, ex, ey, ez):
+    """K[b] += the symmetric part of Ka = −∂τ/∂φ made positive by Gershgorin's shift (as
+    :func:`~treeanim.physics.treestep._add_turn` takes a segment's), upper triangle only, for a
+    lamina's normal force F = c|U|²(Û·n)n at x on its twig, the twig turning by δφ
+    (δx = δφ × x, δn = δφ × n): the leaves' pull on a twig as it turns.
+    ∂τ/∂φ = c|U|²[(Û·n)(x nᵀ − n xᵀ) + p qᵀ] with p = x × n, q = n × Û (Û = (ex, ey, ez));
+    the first term is skew, so the symmetric part of Ka is −½c|U|²(p qᵀ + q pᵀ)."""
+    qx, qy, qz = _cross(nx, ny, nz, ex, ey, ez)
+    w = -0.5 * cs2
+    k00, k11, k22 = 2.0 * w * px * qx, 2.0 * w * py * qy, 2.0 * w * pz * qz
+    k01, k02, k12 = w * (px * qy + qx * py), w * (px * qz + qx * pz), w * (py * qz + qy * pz)
+    shift = max(0.0, abs(k01) + abs(k02) - k00, abs(k01) + abs(k12) - k11, abs(k02) + abs(k12) - k22)
+    K[b, 0, 0] += k00 + shift
+    K[b, 1, 1] += k11 + shift
+    K[b, 2, 2] += k22 + shift
+    K[b, 0, 1] += k01
+    K[b, 0, 2] += k02
+    K[b, 1, 2] += k12
+
+
 @njit(cache=True, fastmath=True, error_model="numpy")
 def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, cauchy, size, R, P, Om, V, U,
-              amp, phase, flutter, th, thd, F, X, Nrm, kap, Uh, kap2, speed):
+              amp, phase, twist, th, thd, LF, LC, LK):
     """Advance every leaf's petiole joint (bend about two axes and twist) over one step, and
     give the force it passes to its twig for the next.
 
@@ -83,8 +186,9 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
     own axes E = [a, b₁, b₂], a along the lever from the petiole's base to the lamina's
     centroid: θ_a twists it, θ_b bends it). Its inertia is small next to its twig's and rides
     on it rigidly in the articulated step; here it turns on top, driven by the normal force
-    ½ρC_nA|U_rel|(U_rel·n)n on the lamina and the twig's acceleration, held by its petiole's
-    spring and damped by the petiole and the air, by the same θ-method per axis.
+    ½ρC_nA|U_rel|(U_rel·n)n on the lamina (its twist by the flutter), held by its petiole's
+    spring and damped by the petiole and the air, each axis stepped by :func:`_axis_step`
+    (the air's moment linearised about the step's start, its restoring stiffness implicit).
 
     The lamina's inertia rides its twig rigidly, so the twig's acceleration is not passed to
     it (that would feed the leaf energy its twig never gives up): a leaf moves by the air
@@ -111,35 +215,37 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
     R, P, Om, V : the twigs' new kinematics.
     U : (B, 3) — the wind at each twig body (m/s); a leaf takes its twig's.
     amp : float — the largest flutter angle (rad), reached edge-on in a strong wind.
-    phase, flutter : (L,) — the flutter's phase (rad) and amplitude (rad), advanced in place:
-        a frequency St·|U|/ℓ (:data:`FLUTTER_STROUHAL`; at most :data:`MAX_FLUTTER_HZ` and a
-        quarter of the step rate), an amplitude ``amp``·U²/(U² + :data:`FLUTTER_SPEED`²). The
-        flutter's twist, flutter·sin(phase), drives the twist through its torque k_t·flutter.
+    phase, twist : (L,) — the flutter's phase and its twist φ (rad), advanced in place: a
+        frequency St·|U|/ℓ (:data:`FLUTTER_STROUHAL`; at most :data:`MAX_FLUTTER_HZ` and a
+        quarter of the step rate), an amplitude ``amp``·U²/(U² + :data:`FLUTTER_SPEED`²),
+        φ = amplitude·sin(phase). It drives the petiole's twist through its torque k_t·φ, a
+        ramp over the step from φ's value at its start to its value at its end.
     th, thd : (L, 3) — the state, advanced in place.
-    F : (L, 3) — written: the lamina's force (world, N) at X.
-    X : (L, 3) — written: the lamina's centroid (world) relative to its twig's joint.
-    Nrm : (L, 3) — written: the lamina's normal (world).
-    kap, Uh, kap2 : (L,), (L, 3), (L,) — written: the air's damping there, the force's
-        derivative against the velocity bounded by a symmetric one,
-        ½ρC_n·A·(|U_rel| n nᵀ + |U_rel·n| ÛÛᵀ) (N·s/m; the next step takes it implicitly).
-    speed : (L,) — written: |U_rel| at the lamina.
+    LF, LC, LK : (B, 6), (B, 6, 6), (B, 3, 3) — written: summed over each twig's leaves, the
+        laminas' spatial force (world, N, about the twig's joint), their air damping there as
+        point terms Pᵀ C P (C = ½ρC_n·A·(|U_rel| n nᵀ + |U_rel·n| ÛÛᵀ), N·s/m, the force's
+        derivative against the velocity bounded by a symmetric one) and their normal forces'
+        stiffness against the twig's turn (:func:`_turn_stiffness`, N·m); the last two
+        symmetric, their upper triangles written, for the next step to take implicitly.
     """
     G = np.empty((3, 3))
     RG = np.empty((3, 3))
+    LF[:] = 0.0
+    LC[:] = 0.0
+    LK[:] = 0.0
     f_max = min(MAX_FLUTTER_HZ, 0.25 / h)
     for l in range(body.shape[0]):
         b = body[l]
         # the flutter: its phase and amplitude in the wind at the twig
         u2 = U[b, 0] * U[b, 0] + U[b, 1] * U[b, 1] + U[b, 2] * U[b, 2]
         f = min(FLUTTER_STROUHAL * np.sqrt(u2) / max(size[l], 1e-3), f_max)
-        phase[l] = (phase[l] + 2.0 * np.pi * f * h) % (2.0 * np.pi)
+        ph = phase[l] + 2.0 * np.pi * f * h  # less than 4π: f ≤ 1/(4h)
+        phase[l] = ph - 2.0 * np.pi if ph >= 2.0 * np.pi else ph  # exact (Sterbenz)
+        twist0 = twist[l]
         if not on[l]:
-            flutter[l] = 0.0
-            F[l, 0] = F[l, 1] = F[l, 2] = 0.0
-            kap[l] = 0.0
+            twist[l] = 0.0
             continue
-        flutter[l] = amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED)
-        twist = flutter[l] * np.sin(phase[l])
+        twist[l] = amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED) * _sincos(phase[l])[0]
         _leaf_rotation(E[l], th[l], G)
         for i in range(3):
             for j in range(3):
@@ -154,8 +260,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
         ny = RG[1, 0] * n0[l, 0] + RG[1, 1] * n0[l, 1] + RG[1, 2] * n0[l, 2]
         nz = RG[2, 0] * n0[l, 0] + RG[2, 1] * n0[l, 1] + RG[2, 2] * n0[l, 2]
         xx, xy, xz = bx + cx, by + cy, bz + cz  # the centroid from the twig's joint
-        X[l, 0], X[l, 1], X[l, 2] = xx, xy, xz
-        # the twig's velocity and acceleration there
+        # the air relative to the lamina, its twig's motion taken away
         o = _cross(Om[b, 0], Om[b, 1], Om[b, 2], xx, xy, xz)
         ux, uy, uz = U[b, 0] - V[b, 0] - o[0], U[b, 1] - V[b, 1] - o[1], U[b, 2] - V[b, 2] - o[2]
         s = np.sqrt(ux * ux + uy * uy + uz * uz)
@@ -163,56 +268,63 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
         c = cna[l] / np.cbrt(1.0 + cauchy[l] * s * s)  # the folded lamina's
         fn = c * s * un
         fx, fy, fz = fn * nx, fn * ny, fn * nz
-        F[l, 0], F[l, 1], F[l, 2] = fx, fy, fz
-        Nrm[l, 0], Nrm[l, 1], Nrm[l, 2] = nx, ny, nz
-        kap[l] = c * s
-        if s > 0.0:
-            Uh[l, 0], Uh[l, 1], Uh[l, 2] = ux / s, uy / s, uz / s
-        else:
-            Uh[l, 0] = Uh[l, 1] = Uh[l, 2] = 0.0
-        kap2[l] = c * abs(un)
-        speed[l] = s
-        # torque about the petiole's base: the bends take its part about the rest axes b₁, b₂
-        # (in the twig's axes, Rᵀτ), the twist its part about the lamina's axis now (Ga): nil
-        # for a force at the centroid, which lies on that axis; the flutter drives it instead
-        t = _cross(cx, cy, cz, fx, fy, fz)
-        tl0 = R[b, 0, 0] * t[0] + R[b, 1, 0] * t[1] + R[b, 2, 0] * t[2]
-        tl1 = R[b, 0, 1] * t[0] + R[b, 1, 1] * t[1] + R[b, 2, 1] * t[2]
-        tl2 = R[b, 0, 2] * t[0] + R[b, 1, 2] * t[1] + R[b, 2, 2] * t[2]
+        # on the twig: the force's Plücker line a = (x × n, n) through the centroid x, and,
+        # the next step taking them implicitly, the point terms α·aaᵀ + β·bbᵀ (b = (x × Û, Û))
+        # and the force's stiffness against the twig's turn (:func:`_turn_stiffness`)
+        mx, my, mz = _cross(xx, xy, xz, nx, ny, nz)
+        LF[b, 0] += fn * mx
+        LF[b, 1] += fn * my
+        LF[b, 2] += fn * mz
+        LF[b, 3] += fx
+        LF[b, 4] += fy
+        LF[b, 5] += fz
+        if c * s > 0.0:
+            q = 1.0 / s
+            ex, ey, ez = ux * q, uy * q, uz * q
+            rx, ry, rz = _cross(xx, xy, xz, ex, ey, ez)
+            _add_outer(LC, b, c * s, mx, my, mz, nx, ny, nz)
+            _add_outer(LC, b, c * abs(un), rx, ry, rz, ex, ey, ez)
+            _turn_stiffness(LK, b, c * s * s, mx, my, mz, nx, ny, nz, ex, ey, ez)
+        # about the petiole's base the normal force's moment is fn·p (p = x_c × n, x_c the
+        # centroid from the base) and its stiffness against a turn about an axis e (δx_c = e × x_c,
+        # δn = e × n) is −c|U|(e·p)(e·w), w = n × U_rel; in the twig's axes, where E's are
+        px, py, pz = _cross(cx, cy, cz, nx, ny, nz)
+        pl0 = R[b, 0, 0] * px + R[b, 1, 0] * py + R[b, 2, 0] * pz
+        pl1 = R[b, 0, 1] * px + R[b, 1, 1] * py + R[b, 2, 1] * pz
+        pl2 = R[b, 0, 2] * px + R[b, 1, 2] * py + R[b, 2, 2] * pz
+        wx, wy, wz = _cross(nx, ny, nz, ux, uy, uz)
+        wl0 = R[b, 0, 0] * wx + R[b, 1, 0] * wy + R[b, 2, 0] * wz
+        wl1 = R[b, 0, 1] * wx + R[b, 1, 1] * wy + R[b, 2, 1] * wz
+        wl2 = R[b, 0, 2] * wx + R[b, 1, 2] * wy + R[b, 2, 2] * wz
         lever2 = rc0[l, 0] ** 2 + rc0[l, 1] ** 2 + rc0[l, 2] ** 2
         dair = max(cswing[l], c) * s * lever2  # the air against the lamina's own swing
         for i in range(3):
             kk = k[l, i]
-            ka = 0.0
-            if i == 0:  # the lamina rolling about its axis: its halves swing through the air
-                tau = kk * twist
+            if i == 0:
+                # the twist: nil for a force at the centroid, which lies on the lamina's axis;
+                # the flutter drives it (its torque a ramp over the step), the lamina's halves
+                # swinging through the air damp it
+                K, f0, f1 = kk, kk * twist0, kk * (twist[l] - twist0)
                 d = dstr[l, i] + cswing[l] * s * roll2[l]
             else:
-                tau = E[l, 0, i] * tl0 + E[l, 1, i] * tl1 + E[l, 2, i] * tl2
+                # a bend: the air's moment linearised about the step's start, its stiffness
+                # taken implicitly where it restores (a lamina weathervaning into the flow)
+                ep = E[l, 0, i] * pl0 + E[l, 1, i] * pl1 + E[l, 2, i] * pl2
+                ew = E[l, 0, i] * wl0 + E[l, 1, i] * wl1 + E[l, 2, i] * wl2
+                tau = fn * ep
+                ka = max(0.0, -c * s * ep * ew)
+                if abs(tau - kk * th[l, i]) > SECANT_TURN * (kk + ka):  # far from rest: the chord
+                    ex = R[b, 0, 0] * E[l, 0, i] + R[b, 0, 1] * E[l, 1, i] + R[b, 0, 2] * E[l, 2, i]
+                    ey = R[b, 1, 0] * E[l, 0, i] + R[b, 1, 1] * E[l, 1, i] + R[b, 1, 2] * E[l, 2, i]
+                    ez = R[b, 2, 0] * E[l, 0, i] + R[b, 2, 1] * E[l, 1, i] + R[b, 2, 2] * E[l, 2, i]
+                    eu = ex * ux + ey * uy + ez * uz
+                    en = ex * nx + ey * ny + ez * nz
+                    ka = max(ka, _secant_stiffness(tau, eu * en, un - eu * en, ew))
+                K, f0, f1 = kk + ka, tau + ka * th[l, i], 0.0
                 d = dstr[l, i] + dair
-                # the air's stiffness against a turn about this axis e (world), taken implicitly
-                # where it restores (a lamina weathervaning into the flow): −e·∂τ/∂θ with
-                # ∂r = e × r, ∂n = e × n
-                ex = R[b, 0, 0] * E[l, 0, i] + R[b, 0, 1] * E[l, 1, i] + R[b, 0, 2] * E[l, 2, i]
-                ey = R[b, 1, 0] * E[l, 0, i] + R[b, 1, 1] * E[l, 1, i] + R[b, 1, 2] * E[l, 2, i]
-                ez = R[b, 2, 0] * E[l, 0, i] + R[b, 2, 1] * E[l, 1, i] + R[b, 2, 2] * E[l, 2, i]
-                dr = _cross(ex, ey, ez, cx, cy, cz)
-                dn = _cross(ex, ey, ez, nx, ny, nz)
-                udn = ux * dn[0] + uy * dn[1] + uz * dn[2]
-                g0 = c * s * (udn * nx + un * dn[0])
-                g1 = c * s * (udn * ny + un * dn[1])
-                g2 = c * s * (udn * nz + un * dn[2])
-                t1 = _cross(dr[0], dr[1], dr[2], fx, fy, fz)
-                t2 = _cross(cx, cy, cz, g0, g1, g2)
-                ka = max(0.0, -(ex * (t1[0] + t2[0]) + ey * (t1[1] + t2[1]) + ez * (t1[2] + t2[2])))
-            kt = kk + ka
-            tl = _leaf_theta(h * h * kt / J[l, i])
-            hth = h * tl
-            num = h * (tau - kk * th[l, i] - (d + hth * kt) * thd[l, i])
-            dd = num / (J[l, i] + hth * d + hth * hth * kt)
-            turn = h * (thd[l, i] + tl * dd)
-            v = thd[l, i] + dd
-            if abs(turn) > MAX_TURN:
+            t1, v = _axis_step(h, J[l, i], K, d, f0, f1, th[l, i], thd[l, i])
+            turn = t1 - th[l, i]
+            if i > 0 and abs(turn) > MAX_TURN:  # the guard (see MAX_TURN): speed cut with it
                 v *= MAX_TURN / abs(turn)
                 turn = MAX_TURN if turn > 0.0 else -MAX_TURN
             th[l, i] += turn
@@ -227,6 +339,24 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
             thd[l, 2] *= sc
 
 
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _matrix_quat(M):
+    """The unit quaternion (w, x, y, z) of the rotation matrix M (Shepperd: from its largest
+    diagonal term)."""
+    t = M[0, 0] + M[1, 1] + M[2, 2]
+    if t > 0.0:
+        s = 2.0 * np.sqrt(t + 1.0)
+        return 0.25 * s, (M[2, 1] - M[1, 2]) / s, (M[0, 2] - M[2, 0]) / s, (M[1, 0] - M[0, 1]) / s
+    if M[0, 0] > M[1, 1] and M[0, 0] > M[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + M[0, 0] - M[1, 1] - M[2, 2])
+        return (M[2, 1] - M[1, 2]) / s, 0.25 * s, (M[0, 1] + M[1, 0]) / s, (M[0, 2] + M[2, 0]) / s
+    if M[1, 1] > M[2, 2]:
+        s = 2.0 * np.sqrt(1.0 + M[1, 1] - M[0, 0] - M[2, 2])
+        return (M[0, 2] - M[2, 0]) / s, (M[0, 1] + M[1, 0]) / s, 0.25 * s, (M[1, 2] + M[2, 1]) / s
+    s = 2.0 * np.sqrt(1.0 + M[2, 2] - M[0, 0] - M[1, 1])
+    return (M[1, 0] - M[0, 1]) / s, (M[0, 2] + M[2, 0]) / s, (M[1, 2] + M[2, 1]) / s, 0.25 * s
+
+
 @njit(cache=True, fastmath=True, error_model="numpy")
 def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, leaf_nodes, leaf_first, leaf_body,
                leaf_E, leaf_th, leaf_on, pos, rot):
@@ -238,7 +368,8 @@ def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, 
     segment i turning by (i + 1)/k of the leaf's bend and twist against its twig; its tip
     node (the lamina) the whole turn.
     """
-    G = np.empty((3, 3))
+    last = -1
+    Qw = Qx = Qy = Qz = 0.0
     for b in bodies:
         j = body_node[b]
         for i in range(3):
@@ -259,6 +390,9 @@ def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, 
         e = leaf_first[l + 1]
         k = e - a - 1
         jb = body_node[b]
+        if b != last:  # the twig's rotation as a quaternion (kept while its leaves follow)
+            last = b
+            Qw, Qx, Qy, Qz = _matrix_quat(R[b])
         # the petiole's base on its twig
         for i in range(3):
             s = P[b, i]
@@ -266,7 +400,8 @@ def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, 
                 s += R[b, i, c] * (Xrest[leaf_nodes[a], c] - Xrest[jb, c])
             pos[leaf_nodes[a], i] = s
         # segment q turns by G_q = B^((q+1)/k)·T^((q+1)/k), the bend B and twist T each about
-        # one axis: as quaternions whose half angles grow by one k-th a segment (angle addition)
+        # one axis: as quaternions whose half angles grow by one k-th a segment (angle addition),
+        # then the twig's turn on top (R·G_q, the quaternions' product)
         on = 1.0 if leaf_on[l] else 0.0
         ax, ay, az = leaf_E[l, 0, 0], leaf_E[l, 1, 0], leaf_E[l, 2, 0]
         vx = on * (leaf_E[l, 0, 1] * leaf_th[l, 1] + leaf_E[l, 0, 2] * leaf_th[l, 2])
@@ -277,9 +412,8 @@ def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, 
             bx, by, bz = vx / beta, vy / beta, vz / beta
         else:
             bx, by, bz = 1.0, 0.0, 0.0
-        cb1, sb1 = np.cos(0.5 * beta / k), np.sin(0.5 * beta / k)
-        psi = on * leaf_th[l, 0]
-        ct1, st1 = np.cos(0.5 * psi / k), np.sin(0.5 * psi / k)
+        sb1, cb1 = _sincos(0.5 * beta / k)
+        st1, ct1 = _sincos(0.5 * on * leaf_th[l, 0] / k)
         cb, sb, ct, st = cb1, sb1, ct1, st1
         ba = bx * ax + by * ay + bz * az
         cx_, cy_, cz_ = _cross(bx, by, bz, ax, ay, az)
@@ -291,12 +425,10 @@ def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, 
             qx = cb * st * ax + ct * sb * bx + sb * st * cx_
             qy = cb * st * ay + ct * sb * by + sb * st * cy_
             qz = cb * st * az + ct * sb * bz + sb * st * cz_
-            _quat_matrix(qw, qx, qy, qz, G)
             n0 = leaf_nodes[a + q]
             n1 = leaf_nodes[a + q + 1]
-            for i in range(3):
-                for c in range(3):
-                    rot[n0, i, c] = R[b, i, 0] * G[0, c] + R[b, i, 1] * G[1, c] + R[b, i, 2] * G[2, c]
+            _quat_matrix(Qw * qw - Qx * qx - Qy * qy - Qz * qz, Qw * qx + Qx * qw + Qy * qz - Qz * qy,
+                         Qw * qy - Qx * qz + Qy * qw + Qz * qx, Qw * qz + Qx * qy - Qy * qx + Qz * qw, rot[n0])
             for i in range(3):
                 s = pos[n0, i]
                 for c in range(3):

@@ -50,7 +50,8 @@ HYSTERESIS = 0.15
 SEGMENT_DRAG = 3.0 * np.pi / 16.0
 #: The same of a lamina's normal force, ⟨cos²⟩ over the sphere.
 LEAF_DRAG = 1.0 / 3.0
-_BODY_STATE = ("Q", "w", "R", "P", "Om", "V")  # TreeState's per-body arrays (the others are per leaf)
+_BODY_STATE = ("Q", "w", "R", "P", "Om", "V", "leaf_F", "leaf_C", "leaf_K")  # TreeState's per-body arrays (the
+# others are per leaf)
 
 
 def object_trees(tree) -> np.ndarray:
@@ -132,19 +133,19 @@ def carry(bodies, parent, r0, Q, w, R, P, Om, V):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _freeze(bodies, leaves, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V, thd, leaf_F, leaf_kap, leaf_kap2):
-    """Freeze the ``bodies`` (bool: no relative velocity, placed on their parents) and the
-    ``leaves`` (bool: at rest, passing no force)."""
+def _freeze(bodies, leaves, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V, leaf_F, leaf_C, leaf_K, thd):
+    """Freeze the ``bodies`` (bool: no relative velocity, placed on their parents; their
+    leaves pass them no force) and the ``leaves`` (bool: at rest)."""
     for b in range(len(bodies)):
         if bodies[b]:
             st_w[b, :] = 0.0
+            leaf_F[b, :] = 0.0
+            leaf_C[b, :, :] = 0.0
+            leaf_K[b, :, :] = 0.0
             _place(b, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V)
     for q in range(len(leaves)):
         if leaves[q]:
             thd[q, :] = 0.0
-            leaf_F[q, :] = 0.0
-            leaf_kap[q] = 0.0
-            leaf_kap2[q] = 0.0
 
 
 @njit(cache=True, error_model="numpy")
@@ -270,7 +271,7 @@ class Reduced:
         changed = np.ones(len(levels), bool) if was is None else levels != was
         todo = changed[parts.body_tree]
         _freeze(~on & todo, ~leaf_on & changed[parts.leaf_tree], s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om,
-                st.V, st.thd, st.leaf_F, st.leaf_kap, st.leaf_kap2)
+                st.V, st.leaf_F, st.leaf_C, st.leaf_K, st.thd)
         anc = _anchors(s.parent, on)
         self.carried = self.frozen[anc[self.frozen] >= 0]  # (the rest stands still from now on)
         moving = anc >= 0

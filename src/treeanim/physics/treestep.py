@@ -6,12 +6,13 @@ and writes the next one. One step:
 
 1. the wind at every segment's middle (the pose at the start), a leaf taking its twig's;
 2. the air's force on every segment, ½ρC_d·d·ℓ|U⊥|U⊥ of the wind normal to it relative to the
-   segment's own motion, and the leaves' forces of the last step, with the damping of both
-   implicit; pulls (constant forces) and grabs (stiff springs to targets, implicit);
+   segment's own motion, and the leaves' forces of the last step (summed per twig), with the
+   damping and turn stiffness of both implicit; pulls (constant forces) and grabs (stiff
+   springs to targets, implicit);
 3. the articulated-body step (:func:`~treeanim.physics.articulated.articulated_step`);
 4. the new pose of every body, kept above the ground (:func:`~treeanim.physics.kinematics.ground_contact`);
 5. every leaf's flutter and petiole joint (:func:`~treeanim.physics.leafjoint.leaf_step`), its
-   force kept for the twig's next step.
+   force, air damping and turn stiffness summed per twig for the twig's next step.
 """
 
 from __future__ import annotations
@@ -43,15 +44,11 @@ class TreeState:
     V: np.ndarray       # (B, 3) joint-point velocities
     th: np.ndarray      # (L, 3) petiole joints (twist, bend, bend)
     thd: np.ndarray     # (L, 3)
-    leaf_F: np.ndarray  # (L, 3) the laminas' forces of the last step (world)
-    leaf_X: np.ndarray  # (L, 3) the laminas' centroids from their twig's joint (world axes)
-    leaf_N: np.ndarray  # (L, 3) the laminas' normals (world)
-    leaf_kap: np.ndarray  # (L,) the laminas' air damping rates c|U| (N·s/m), along their normals
-    leaf_U: np.ndarray  # (L, 3) unit air-relative wind at the laminas
-    leaf_kap2: np.ndarray  # (L,)
-    leaf_speed: np.ndarray  # (L,) |U_rel| at the laminas
+    leaf_F: np.ndarray  # (B, 6) the leaves' spatial force of the last step on each twig
+    leaf_C: np.ndarray  # (B, 6, 6) their air damping there, Σ PᵀCP (N·s/m; times h in the step)
+    leaf_K: np.ndarray  # (B, 3, 3) their stiffness against the twig's turn (N·m; times h²)
     phase: np.ndarray   # (L,) flutter phase (rad)
-    flutter: np.ndarray  # (L,) flutter amplitude (rad)
+    twist: np.ndarray   # (L,) the flutter's twist (rad)
 
     @classmethod
     def rest(cls, s: Structure, seed: int = 0) -> "TreeState":
@@ -59,12 +56,10 @@ class TreeState:
         B, L = len(s.parent), len(s.leaf_body)
         st = cls(time=0.0, Q=np.tile(np.eye(3), (B, 1, 1)), w=np.zeros((B, 3)), R=np.empty((B, 3, 3)),
                  P=np.empty((B, 3)), Om=np.empty((B, 3)), V=np.empty((B, 3)),
-                 th=np.zeros((L, 3)), thd=np.zeros((L, 3)), leaf_F=np.zeros((L, 3)),
-                 leaf_X=np.zeros((L, 3)), leaf_N=np.zeros((L, 3)), leaf_kap=np.zeros(L),
-                 leaf_U=np.zeros((L, 3)), leaf_kap2=np.zeros(L), leaf_speed=np.zeros(L),
-                 phase=np.random.default_rng([int(seed), 0x1EAF]).uniform(0, 2 * np.pi, L), flutter=np.zeros(L))
+                 th=np.zeros((L, 3)), thd=np.zeros((L, 3)), leaf_F=np.zeros((B, 6)),
+                 leaf_C=np.zeros((B, 6, 6)), leaf_K=np.zeros((B, 3, 3)),
+                 phase=np.random.default_rng([int(seed), 0x1EAF]).uniform(0, 2 * np.pi, L), twist=np.zeros(L))
         forward_kinematics(s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
-        st.leaf_X[:] = s.leaf_base0 + s.leaf_rc0
         return st
 
     def copy(self) -> "TreeState":
@@ -104,16 +99,26 @@ def sample_points(s: Structure, st: TreeState) -> np.ndarray:
     """(B, 3) world points where the wind is sampled: the segments' middles. A leaf takes its
     twig segment's wind: the wind varies over metres (its integral scale is the canopy's
     height), a leaf sits centimetres from its twig."""
-    return st.P + np.einsum("bij,bj->bi", st.R, s.mid0)
+    out = np.empty_like(st.P)
+    _midpoints(st.P, st.R, s.mid0, out)
+    return out
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf_N, leaf_kap, leaf_U, leaf_kap2,
-                leaf_speed, lump_cd, lump_cl, lump_cauchy, lump_x0, F, kap):
+def _midpoints(P, R, mid0, out):
+    for b in range(P.shape[0]):
+        for i in range(3):
+            out[b, i] = P[b, i] + R[b, i, 0] * mid0[b, 0] + R[b, i, 1] * mid0[b, 1] + R[b, i, 2] * mid0[b, 2]
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _air_forces(h, R, Om, V, mid0, axis, cda, U, lump_cd, lump_cl, lump_cauchy, lump_x0, leaf_F, leaf_C, leaf_K, F,
+                kap):
     """The air's force on every segment (across it), on what rides rigidly on it at a coarser
-    level of detail (:func:`_lump_force`) and the leaves' forces, with their implicit damping
-    terms κ as points (see :func:`~treeanim.physics.articulated.articulated_step`) and the
-    segments' turn stiffness (:func:`_turn_stiffness`)."""
+    level of detail (:func:`_lump_force`) and the leaves' forces, with their implicit
+    damping terms κ as points (see :func:`~treeanim.physics.articulated.articulated_step`) and
+    the segments' and leaves' turn stiffness (:func:`_turn_stiffness`; the leaves' summed per
+    twig by :func:`~treeanim.physics.leafjoint.leaf_step`)."""
     B = R.shape[0]
     Ka = np.empty((3, 3))
     for b in range(B):
@@ -145,22 +150,18 @@ def _air_forces(h, R, Om, V, mid0, axis, cda, U, leaf_body, leaf_F, leaf_X, leaf
             _turn_stiffness(b, h, cda[b], un, ux, uy, uz, d, ax, ay, az, rx, ry, rz, fx, fy, fz, Om, F, kap, Ka)
         if lump_cd[b] > 0.0 or lump_cl[b] > 0.0:
             _lump_force(b, h, R, Om, V, U, lump_cd[b], lump_cl[b], lump_cauchy[b], lump_x0[b], F, kap, Ka)
-    for l in range(leaf_body.shape[0]):
-        b = leaf_body[l]
-        rx, ry, rz = leaf_X[l, 0], leaf_X[l, 1], leaf_X[l, 2]
-        fx, fy, fz = leaf_F[l, 0], leaf_F[l, 1], leaf_F[l, 2]
-        F[b, 0] += ry * fz - rz * fy
-        F[b, 1] += rz * fx - rx * fz
-        F[b, 2] += rx * fy - ry * fx
-        F[b, 3] += fx
-        F[b, 4] += fy
-        F[b, 5] += fz
-        if leaf_kap[l] > 0.0:
-            add_point(kap, b, 0.0, h * leaf_kap[l], leaf_N[l, 0], leaf_N[l, 1], leaf_N[l, 2],
-                      h * leaf_kap2[l], leaf_U[l, 0], leaf_U[l, 1], leaf_U[l, 2], rx, ry, rz)
-            _leaf_turn_stiffness(b, h, leaf_kap[l] * leaf_speed[l], leaf_U[l], leaf_N[l], rx, ry, rz,
-                                 fx, fy, fz, Ka)
-            _add_turn(b, h, Ka, Om, F, kap)
+        # the leaves' force, damping and turn stiffness (backward Euler, as _add_turn's;
+        # symmetric, their upper triangles kept)
+        for i in range(3):
+            F[b, i] += leaf_F[b, i]
+            F[b, 3 + i] += leaf_F[b, 3 + i]
+            for j in range(3):
+                k = leaf_K[b, min(i, j), max(i, j)]
+                F[b, i] -= h * k * Om[b, j]
+                kap[b, i, j] += h * h * k
+        for i in range(6):
+            for j in range(6):
+                kap[b, i, j] += h * leaf_C[b, min(i, j), max(i, j)]
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -217,24 +218,6 @@ def _turn_stiffness(b, h, cda, un, ux, uy, uz, ua, ax, ay, az, rx, ry, rz, fx, f
         Ka[1, k] = -((drz * fx - drx * fz) + (rz * dfx - rx * dfz))
         Ka[2, k] = -((drx * fy - dry * fx) + (rx * dfy - ry * dfx))
     _add_turn(b, h, Ka, Om, F, kap)
-
-
-@njit(cache=True, fastmath=True, error_model="numpy")
-def _leaf_turn_stiffness(b, h, cs2, Uh, n, rx, ry, rz, fx, fy, fz, Ka):
-    """Ka = −∂τ/∂φ of a lamina's normal force F = c|U|²(Û·n)n at r on its twig, the twig
-    turning by δφ (δr = δφ × r, δn = δφ × n): the leaves' pull on a twig as it turns."""
-    un = Uh[0] * n[0] + Uh[1] * n[1] + Uh[2] * n[2]
-    for k in range(3):
-        dx, dy, dz = (1.0 if k == 0 else 0.0), (1.0 if k == 1 else 0.0), (1.0 if k == 2 else 0.0)
-        drx, dry, drz = dy * rz - dz * ry, dz * rx - dx * rz, dx * ry - dy * rx
-        dnx, dny, dnz = dy * n[2] - dz * n[1], dz * n[0] - dx * n[2], dx * n[1] - dy * n[0]
-        udn = Uh[0] * dnx + Uh[1] * dny + Uh[2] * dnz
-        dfx = cs2 * (udn * n[0] + un * dnx)
-        dfy = cs2 * (udn * n[1] + un * dny)
-        dfz = cs2 * (udn * n[2] + un * dnz)
-        Ka[0, k] = -((dry * fz - drz * fy) + (ry * dfz - rz * dfy))
-        Ka[1, k] = -((drz * fx - drx * fz) + (rz * dfx - rx * dfz))
-        Ka[2, k] = -((drx * fy - dry * fx) + (rx * dfy - ry * dfx))
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -313,9 +296,8 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     w.F[:] = 0.0
     w.kap[:] = 0.0
     Ub = np.ascontiguousarray(wind)
-    _air_forces(dt, out.R, out.Om, out.V, s.mid0, s.axis, s.cda, Ub, s.leaf_body,
-                out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, out.leaf_speed,
-                s.lump_cd, s.lump_cl, s.lump_cauchy, s.lump_x0, w.F, w.kap)
+    _air_forces(dt, out.R, out.Om, out.V, s.mid0, s.axis, s.cda, Ub, s.lump_cd, s.lump_cl, s.lump_cauchy, s.lump_x0,
+                out.leaf_F, out.leaf_C, out.leaf_K, w.F, w.kap)
     for b, ofs, f in pulls:
         _point_force(b, out.R[b] @ ofs, np.asarray(f, float), dt, out, w)
     for g in grabs:
@@ -326,8 +308,8 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     ground_contact(s.parent, s.r0, s.seg0, s.floor, out.Q, out.w, out.R, out.P, out.Om, out.V)
     leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
               s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, s.leaf_cauchy, s.leaf_size,
-              out.R, out.P, out.Om, out.V, Ub, float(leaf_flutter), out.phase, out.flutter, out.th, out.thd,
-              out.leaf_F, out.leaf_X, out.leaf_N, out.leaf_kap, out.leaf_U, out.leaf_kap2, out.leaf_speed)
+              out.R, out.P, out.Om, out.V, Ub, float(leaf_flutter), out.phase, out.twist, out.th, out.thd,
+              out.leaf_F, out.leaf_C, out.leaf_K)
     out.time = st.time + dt
 
 

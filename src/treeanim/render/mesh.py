@@ -86,7 +86,7 @@ import numpy as np
 from ..model.geometry import arc_length, lamina_frames
 from ..model.geometry import perpendicular as _perpendicular
 from ..model.geometry import unit as _unit
-from ..model.tree import BRANCH_SIDES, Tree, curve_bands
+from ..model.tree import BRANCH_SIDES, Lamina, Tree, curve_bands
 from .collars import collars, leaders, outward
 from .occlusion import crown_occlusion
 from .skinning import hermite, skin_points
@@ -401,8 +401,7 @@ def _tubes(parts: _Parts, tree: Tree, objs: np.ndarray, sides: int, curved: bool
                                   ring[it, None] + s0, ring[it, None] + s1], -1), ring_obj[it, None])
 
 
-def _laminas(parts: _Parts, tree: Tree, leaves: np.ndarray, jitter: np.ndarray, key: np.ndarray) -> None:
-    lam = tree.lamina
+def _laminas(parts: _Parts, tree: Tree, leaves: np.ndarray, jitter: np.ndarray, key: np.ndarray, lam) -> None:
     if lam is None or len(leaves) == 0 or len(lam.triangles) == 0:
         return
     x, y = lam.outline[:, 0], lam.outline[:, 1]
@@ -467,14 +466,15 @@ def drawn_triangles(tree: Tree) -> np.ndarray:
     return tree.triangles_per_object() * np.where(tree.kind == "blade", BLADE_CLUMP, 1)
 
 
-def _ambient_occlusion(tree: Tree, verts: np.ndarray) -> np.ndarray:
+def _ambient_occlusion(tree: Tree, verts: np.ndarray, drawn: int) -> np.ndarray:
     """A static occlusion term (1 = open): the crown's leaves' (:mod:`~.occlusion`, the laminas'
-    vertices sampling their area) and contact with the ground; a blade darker at its base."""
+    ``drawn`` vertices each sampling their area) and contact with the ground; a blade darker at
+    its base."""
     ids = verts["ids"]
     rest = tree.rest_positions[ids[:, 0]] + verts["offset"]
     mat = ids[:, 3]
     lam = np.flatnonzero(mat == MATERIAL_LAMINA)
-    area = tree.lamina.area * tree.lamina_length[ids[lam, 2]] ** 2 / len(tree.lamina.outline) if len(lam) else []
+    area = tree.lamina.area * tree.lamina_length[ids[lam, 2]] ** 2 / drawn if len(lam) else []
     ao = crown_occlusion(rest, rest[lam], area)
     height = max(float(np.ptp(tree.rest_positions[:, 1])), 1e-6)
     ao *= 0.7 + 0.3 * np.clip(rest[:, 1] / (0.04 * height), 0.0, 1.0)  # contact with the ground
@@ -483,7 +483,7 @@ def _ambient_occlusion(tree: Tree, verts: np.ndarray) -> np.ndarray:
     return np.clip(ao, 0.05, 1.0)
 
 
-def build_mesh(tree: Tree, seed: int | None = None) -> TreeMesh:
+def build_mesh(tree: Tree, seed: int | None = None, lamina: Lamina | None = None) -> TreeMesh:
     """Build the static skinnable mesh of ``tree`` (vectorised; no loop over objects).
 
     Parameters
@@ -491,7 +491,11 @@ def build_mesh(tree: Tree, seed: int | None = None) -> TreeMesh:
     tree : Tree
     seed : int or None
         Seed of the per-object colour jitter; None uses ``tree.seed``.
+    lamina : Lamina, optional
+        The leaf blade to draw on each leaf: ``tree.lamina`` by default (a glTF file draws a
+        card instead: :func:`treeanim.compact.card`).
     """
+    lamina = lamina if lamina is not None else tree.lamina
     M = tree.n_objects
     rng = np.random.default_rng([int(tree.seed if seed is None else seed), 0x7E11])
     jitter = rng.random(M)
@@ -504,12 +508,12 @@ def build_mesh(tree: Tree, seed: int | None = None) -> TreeMesh:
     parts = _Parts()
     _tubes(parts, tree, np.flatnonzero(kind == "branch"), BRANCH_SIDES, True, MATERIAL_BARK, jitter, key)
     _tubes(parts, tree, leaves, int(tree.petiole_sides), False, MATERIAL_PETIOLE, jitter, key)
-    _laminas(parts, tree, leaves, jitter, key)
+    _laminas(parts, tree, leaves, jitter, key, lamina)
     _blades(parts, tree, np.flatnonzero(kind == "blade"), jitter, rng)
 
     verts = np.concatenate(parts.verts) if parts.verts else np.zeros(0, VERTEX_DTYPE)
     tris = np.concatenate(parts.tris).astype(np.uint32) if parts.tris else np.zeros((0, 3), np.uint32)
     tri_obj = np.concatenate(parts.tri_obj) if parts.tri_obj else np.zeros(0, np.int64)
-    verts["extra"][:, 2] = _ambient_occlusion(tree, verts)
+    verts["extra"][:, 2] = _ambient_occlusion(tree, verts, len(lamina.outline) if lamina is not None else 1)
     order = np.argsort(tri_obj, kind="stable")  # group triangles by object
     return TreeMesh(verts, np.ascontiguousarray(tris[order]), np.bincount(tri_obj, minlength=M))
