@@ -36,8 +36,8 @@ from .kinematics import _place
 from .structure import Structure
 from .treestep import TreeState, Work
 
-__all__ = ["MAX_DETAIL", "DETAIL_PIXELS", "Reduced", "active_parts", "carry", "check_levels", "choose_detail",
-           "object_trees", "tree_extents"]
+__all__ = ["MAX_DETAIL", "DETAIL_PIXELS", "Parts", "Reduced", "carry", "check_levels", "choose_detail", "object_trees",
+           "tree_extents"]
 
 #: The coarsest detail level.
 MAX_DETAIL = 3
@@ -52,7 +52,6 @@ SEGMENT_DRAG = 3.0 * np.pi / 16.0
 LEAF_DRAG = 1.0 / 3.0
 _BODY_STATE = ("Q", "w", "R", "P", "Om", "V", "leaf_F", "leaf_C", "leaf_K")  # TreeState's per-body arrays (the
 # others are per leaf)
-_LEAF_POSE = ("leaf_nodes", "leaf_first")  # Structure's leaf arrays that only the pose reads
 
 
 def object_trees(tree) -> np.ndarray:
@@ -81,37 +80,48 @@ def _brief(x) -> str:
     return s if len(s) <= 60 else s[:57] + "..."
 
 
-def active_parts(tree, s: Structure, levels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(B,) bool bodies and (L,) bool leaves that move at the trees' detail ``levels``: a
-    body's parent is always among them when it is."""
-    lv = levels[object_trees(tree)]
-    kind = np.asarray(tree.kind)
-    par = np.asarray(tree.parent)
-    bears = np.zeros(tree.n_objects, bool)  # bears a branch
-    grows = (par >= 0) & (kind != "leaf")
-    bears[par[grows]] = True
-    limb = (kind == "branch") & (np.asarray(tree.level) <= 2)
-    keep = (lv == 0) | ((lv == 1) & bears) | ((lv == 2) & limb) | ((lv < MAX_DETAIL) & (kind == "blade"))
-    o = s.obj
-    first = s.body_of_obj[o] == np.arange(len(o))  # (a blade's base joint)
-    bodies = keep[o] & ((lv[o] == 0) | (kind[o] != "blade") | first)
-    return bodies, lv[s.leaf_obj] == 0
+class Parts:
+    """Which bodies and leaves of a structure move at each detail level, worked out once (a
+    level change then costs a gather and a few compiled passes over the bodies and leaves).
+
+    Attributes
+    ----------
+    body_tree, leaf_tree : (B,) and (L,) int
+        The tree of each body and leaf.
+    body_levels : (B,) uint8
+        Bit ``l`` set where the body moves at level ``l`` (a leaf moves at level 0 only).
+    """
+
+    def __init__(self, tree, s: Structure):
+        trees = object_trees(tree)
+        self.body_tree, self.leaf_tree = trees[s.obj], trees[s.leaf_obj]
+        kind = np.asarray(tree.kind)
+        par = np.asarray(tree.parent)
+        bears = np.zeros(tree.n_objects, bool)  # bears a branch
+        grows = (par >= 0) & (kind != "leaf")
+        bears[par[grows]] = True
+        blade = kind == "blade"
+        limb = (kind == "branch") & (np.asarray(tree.level) <= 2)
+        o = s.obj
+        first = s.body_of_obj[o] == np.arange(len(o))  # (a blade's base joint)
+        coarse = (bears | blade)[o] & (~blade[o] | first), (limb | blade)[o] & (~blade[o] | first)
+        self.body_levels = (1 + 2 * coarse[0] + 4 * coarse[1]).astype(np.uint8)
+
+    def active(self, levels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(B,) bool bodies and (L,) bool leaves that move at the trees' detail ``levels``: a
+        body's parent is always among them when it is."""
+        return (self.body_levels >> levels[self.body_tree].astype(np.uint8)) & 1 == 1, levels[self.leaf_tree] == 0
 
 
-def _anchors(parent: np.ndarray, active: np.ndarray) -> np.ndarray:
+@njit(cache=True, error_model="numpy")
+def _anchors(parent, active):
     """(B,) each body's nearest active body on the way to the root, itself if active (−1:
-    none, it stands on the ground), by pointer jumping."""
-    anc = np.where(active, np.arange(len(parent)), -2)
-    up = parent.copy()
-    while True:
-        u = np.flatnonzero(anc == -2)
-        if not len(u):
-            return anc
-        p = up[u]
-        a = np.where(p < 0, -1, anc[np.maximum(p, 0)])
-        anc[u] = a
-        still = a == -2
-        up[u[still]] = up[p[still]]
+    none, it stands on the ground); parents come first."""
+    anc = np.empty(len(parent), np.int64)
+    for b in range(len(parent)):
+        p = parent[b]
+        anc[b] = b if active[b] else (anc[p] if p >= 0 else -1)
+    return anc
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -122,13 +132,116 @@ def carry(bodies, parent, r0, Q, w, R, P, Om, V):
         _place(b, parent, r0, Q, w, R, P, Om, V)
 
 
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _freeze(bodies, leaves, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V, leaf_F, leaf_C, leaf_K, thd):
+    """Freeze the ``bodies`` (bool: no relative velocity, placed on their parents; their
+    leaves pass them no force) and the ``leaves`` (bool: at rest)."""
+    for b in range(len(bodies)):
+        if bodies[b]:
+            st_w[b, :] = 0.0
+            leaf_F[b, :] = 0.0
+            leaf_C[b, :, :] = 0.0
+            leaf_K[b, :, :] = 0.0
+            _place(b, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V)
+    for q in range(len(leaves)):
+        if leaves[q]:
+            thd[q, :] = 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _start(bodies, rows, s_m0, s_h0, s_J0, p_m0, p_h0, p_J0, p_lump, m0, h0, J0, lump):
+    """Each active body's inertia and the drag of what rides on it, to start from: as it was
+    (``rows``: its row in the previous reduced structure, −1: none) or its own alone."""
+    for r in range(len(bodies)):
+        b, p = bodies[r], rows[r]
+        if p >= 0:
+            m0[r], h0[r], J0[r], lump[r] = p_m0[p], p_h0[p], p_J0[p], p_lump[p]
+        else:
+            m0[r], h0[r], J0[r], lump[r] = s_m0[b], s_h0[b], s_J0[b], 0.0
+
+
+@njit(cache=True, error_model="numpy")
+def _lump(todo, anc, index, parent, r0, Q, s_m0, s_h0, s_J0, mid0, cda, leaf_body, leaf_on, leaf_base0, leaf_rc0,
+          leaf_cna, leaf_cauchy, C, d, m0, h0, J0, lump):
+    """Lump what rides on each active body (``index``: its row in ``m0`` … ``lump``) into it,
+    over the bodies ``todo`` and their leaves: a carried body's inertia into ``m0``, ``h0``,
+    ``J0`` where its joints hold it (``C``, ``d``: each body's rotation and joint in its
+    anchor's rest axes, by its joints from the anchor's — fixed while it rides, as its joints
+    are), its drag and the riding leaves' (``leaf_on``: those that ride, present) into
+    ``lump``: cd, cl, cl·cauchy, (cd + cl)·x."""
+    CJ, hf = np.empty((3, 3)), np.empty(3)
+    for f in range(len(parent)):
+        a = anc[f]
+        if not todo[f] or a < 0:  # (what stands on the ground holds nothing up)
+            continue
+        if a == f:
+            C[f] = np.eye(3)
+            d[f] = 0.0
+            continue
+        p, r = parent[f], index[a]
+        for i in range(3):
+            d[f, i] = d[p, i] + (C[p, i, 0] * r0[f, 0] + C[p, i, 1] * r0[f, 1] + C[p, i, 2] * r0[f, 2])
+            for j in range(3):
+                C[f, i, j] = C[p, i, 0] * Q[f, 0, j] + C[p, i, 1] * Q[f, 1, j] + C[p, i, 2] * Q[f, 2, j]
+        for i in range(3):
+            hf[i] = C[f, i, 0] * s_h0[f, 0] + C[f, i, 1] * s_h0[f, 1] + C[f, i, 2] * s_h0[f, 2]
+            for j in range(3):
+                CJ[i, j] = C[f, i, 0] * s_J0[f, 0, j] + C[f, i, 1] * s_J0[f, 1, j] + C[f, i, 2] * s_J0[f, 2, j]
+        m, x = s_m0[f], d[f]
+        cd = SEGMENT_DRAG * cda[f]
+        shift = 2.0 * (x[0] * hf[0] + x[1] * hf[1] + x[2] * hf[2]) + m * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2])
+        m0[r] += m
+        lump[r, 0] += cd
+        for i in range(3):
+            h0[r, i] += hf[i] + m * x[i]
+            lump[r, 3 + i] += cd * (x[i] + (C[f, i, 0] * mid0[f, 0] + C[f, i, 1] * mid0[f, 1] + C[f, i, 2] * mid0[f, 2]))
+            for n in range(3):  # C J Cᵀ about the anchor's joint
+                Jf = CJ[i, 0] * C[f, n, 0] + CJ[i, 1] * C[f, n, 1] + CJ[i, 2] * C[f, n, 2]
+                if i == n:
+                    Jf += shift
+                J0[r, i, n] += Jf - (x[i] * hf[n] + hf[i] * x[n] + m * x[i] * x[n])
+    for q in range(len(leaf_body)):  # the leaves at their laminas
+        t = leaf_body[q]
+        a = anc[t]
+        if not todo[t] or not leaf_on[q] or a < 0:
+            continue
+        r = index[a]
+        cl = LEAF_DRAG * leaf_cna[q]
+        lump[r, 1] += cl
+        lump[r, 2] += cl * leaf_cauchy[q]
+        for i in range(3):
+            lump[r, 3 + i] += cl * (d[t, i] + (C[t, i, 0] * (leaf_base0[q, 0] + leaf_rc0[q, 0])
+                                               + C[t, i, 1] * (leaf_base0[q, 1] + leaf_rc0[q, 1])
+                                               + C[t, i, 2] * (leaf_base0[q, 2] + leaf_rc0[q, 2])))
+
+
 class Reduced:
     """The active part of a tree (or scene) at its detail levels, and the state it steps.
 
     Building it freezes the rest in ``st`` (no relative velocity; the frozen leaves pass no
-    force); it steps in the first rows of the whole structure's ``work``. :meth:`gather`
-    copies the active part of a full state into :attr:`state`; :meth:`scatter` writes it back
-    and carries the frozen part along.
+    force) and lumps what rides into the active bodies, in a few compiled passes over the
+    bodies and leaves. It steps in the first rows of the whole structure's ``work``.
+    :meth:`gather` copies the active part of a full state into :attr:`state`; :meth:`scatter`
+    writes it back and carries the frozen part along.
+
+    Parameters
+    ----------
+    parts : Parts
+        Of ``s``.
+    s : Structure
+        The whole structure.
+    st : TreeState
+        The whole state (frozen where it does not move).
+    levels : (T,) int
+        The trees' detail levels.
+    work : Work
+        The whole structure's scratch.
+    was : (T,) int or None
+        The levels ``st`` was last stepped at (None: unknown). Only the trees whose level
+        changed are frozen and lumped anew: the others' frozen parts are as a freeze leaves them
+        (:meth:`scatter` carries them) and what rides on them is lumped as in ``prev``.
+    prev : Reduced or None
+        The one ``st`` was stepped with at ``was`` (None: every tree at level 0).
 
     Attributes
     ----------
@@ -140,87 +253,64 @@ class Reduced:
         A body's index in :attr:`s` (−1: frozen).
     carried : (F,) int
         The frozen bodies that ride on an active one (the others stand still).
+    lump : (B', 6) float
+        The drag of what rides on each active body: cd, cl, cl·cauchy, (cd + cl)·x.
     moving : ((B″,) int, (L″,) int)
         The bodies and leaves that move: their nodes are all a pose after the first rewrites.
     last : (pos, rot) or None
         The last whole pose, kept by the simulation.
     """
 
-    def __init__(self, tree, s: Structure, st: TreeState, levels: np.ndarray, work: Work):
-        on, leaf_on = active_parts(tree, s, levels)
+    def __init__(self, parts: Parts, s: Structure, st: TreeState, levels: np.ndarray, work: Work,
+                 was: np.ndarray | None = None, prev: Reduced | None = None):
+        on, leaf_on = parts.active(levels)
         self.bodies, self.leaves = np.flatnonzero(on), np.flatnonzero(leaf_on)
         self.frozen = np.flatnonzero(~on)
         self.body_index = np.full(len(on), -1, np.int64)
         self.body_index[self.bodies] = np.arange(len(self.bodies))
-        resting = np.flatnonzero(~leaf_on)
-        st.thd[resting] = 0.0
-        for a in (st.leaf_F, st.leaf_C, st.leaf_K):  # (a frozen twig's leaves pass it no force)
-            a[self.frozen] = 0.0
-        st.w[self.frozen] = 0.0
-        carry(self.frozen, s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
+        changed = np.ones(len(levels), bool) if was is None else levels != was
+        todo = changed[parts.body_tree]
+        _freeze(~on & todo, ~leaf_on & changed[parts.leaf_tree], s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om,
+                st.V, st.leaf_F, st.leaf_C, st.leaf_K, st.thd)
         anc = _anchors(s.parent, on)
         self.carried = self.frozen[anc[self.frozen] >= 0]  # (the rest stands still from now on)
         moving = anc >= 0
         self.moving = np.flatnonzero(moving), np.flatnonzero(moving[s.leaf_body])
-        self.last = None  # the last pose of the whole tree (set by its simulation)
-        self.s = self._structure(s, st, anc, resting)
-        self.work = work.head(len(self.bodies))
-        self.state = TreeState(time=st.time, **{f.name: getattr(st, f.name)[self._rows(f.name)]
+        self.last = None  # the last whole pose (set by its simulation)
+        n = len(self.bodies)
+        m0, h0, J0, self.lump = np.empty(n), np.empty((n, 3)), np.empty((n, 3, 3)), np.empty((n, 6))
+        new = m0, h0, J0, self.lump
+        if was is None or prev is None:
+            rows, old = np.full(n, -1), new
+        else:  # what rides on the trees that kept their level, as it was
+            rows, old = np.where(todo[self.bodies], -1, prev.body_index[self.bodies]), (prev.s.m0, prev.s.h0, prev.s.J0, prev.lump)
+        _start(self.bodies, rows, s.m0, s.h0, s.J0, *old, *new)
+        _lump(todo, anc, self.body_index, s.parent, s.r0, st.Q, s.m0, s.h0, s.J0, s.mid0, s.cda, s.leaf_body,
+              s.leaf_on & ~leaf_on, s.leaf_base0, s.leaf_rc0, s.leaf_cna, s.leaf_cauchy, np.empty_like(st.Q),
+              np.empty_like(st.P), *new)
+        self.s = self._structure(s, m0, h0, J0)
+        self.work = work.head(n)
+        self.state = TreeState(time=st.time, **{f.name: np.empty((len(self._rows(f.name)),) + getattr(st, f.name).shape[1:])
                                                   for f in fields(TreeState) if f.name != "time"})
 
     def _rows(self, name: str) -> np.ndarray:
         return self.bodies if name in _BODY_STATE else self.leaves
 
-    def _structure(self, s: Structure, st: TreeState, anc: np.ndarray, resting: np.ndarray) -> Structure:
-        """The active part of ``s``, what rides on each body (``anc``: its anchor) lumped into
-        it; ``resting``: the frozen leaves."""
-        B = len(s.parent)
-        m0, h0, J0 = s.m0.copy(), s.h0.copy(), s.J0.copy()
-        f = self.carried  # (what stands on the ground holds nothing up)
-        a = anc[f]
-        Ra = st.R[a]
-        C = np.einsum("kji,kjl->kil", Ra, st.R[f])  # the frozen body in its anchor's rest axes
-        d = np.einsum("kji,kj->ki", Ra, st.P[f] - st.P[a])
-        m = s.m0[f]
-        hf = np.einsum("kij,kj->ki", C, s.h0[f])
-        Jf = np.einsum("kij,kjl,kml->kim", C, s.J0[f], C)
-        eye = np.eye(3)
-        Jf += (2.0 * np.einsum("ki,ki->k", d, hf) + m * np.einsum("ki,ki->k", d, d))[:, None, None] * eye
-        Jf -= d[:, :, None] * hf[:, None, :] + hf[:, :, None] * d[:, None, :] + m[:, None, None] * d[:, :, None] * d[:, None, :]
-        np.add.at(m0, a, m)
-        np.add.at(h0, a, hf + m[:, None] * d)
-        np.add.at(J0, a, Jf)
-        # the drag of what rides: segments at their middles, leaves at their laminas
-        ride = resting[anc[s.leaf_body[resting]] >= 0]
-        t = s.leaf_body[ride]
-        la = anc[t]
-        lx = st.P[t] + np.einsum("kij,kj->ki", st.R[t], s.leaf_base0[ride] + s.leaf_rc0[ride]) - st.P[la]
-        xs = d + np.einsum("kij,kj->ki", C, s.mid0[f])  # (anchor's rest axes)
-        xl = np.einsum("kji,kj->ki", st.R[la], lx)
-        cd = SEGMENT_DRAG * s.cda[f]
-        cl = LEAF_DRAG * s.leaf_cna[ride] * s.leaf_on[ride]
-        lump = np.zeros((B, 6))  # cd, cl, cl·cauchy, (cd + cl)·x
-        np.add.at(lump, a, np.column_stack([cd, 0 * cd, 0 * cd, cd[:, None] * xs]))
-        np.add.at(lump, la, np.column_stack([0 * cl, cl, cl * s.leaf_cauchy[ride], cl[:, None] * xl]))
-        lump = lump[self.bodies]
-        weight = np.maximum(lump[:, 0] + lump[:, 1], 1e-300)
-        out = {}
-        for fl in fields(Structure):
-            v = getattr(s, fl.name)
-            if fl.name in _LEAF_POSE:
-                v = np.zeros(len(self.leaves) + 1, np.int64) if fl.name == "leaf_first" else v[:0]
-            elif fl.name == "body_of_obj":
-                v = np.where(v >= 0, self.body_index[np.maximum(v, 0)], -1)
-            elif fl.name.startswith("leaf_"):
-                v = v[self.leaves]
-            else:
-                v = {"m0": m0, "h0": h0, "J0": J0}.get(fl.name, v)[self.bodies]
-            out[fl.name] = np.ascontiguousarray(v)
-        out["parent"] = np.where(out["parent"] >= 0, self.body_index[np.maximum(out["parent"], 0)], -1)
-        out["leaf_body"] = np.ascontiguousarray(self.body_index[out["leaf_body"]])
-        out.update(lump_cd=np.ascontiguousarray(lump[:, 0]), lump_cl=np.ascontiguousarray(lump[:, 1]),
+    def _structure(self, s: Structure, m0: np.ndarray, h0: np.ndarray, J0: np.ndarray) -> Structure:
+        """The active part of ``s``, with the inertia ``m0``, ``h0``, ``J0`` and the drag
+        :attr:`lump` of what rides on each body."""
+        bodies, lump = self.bodies, self.lump
+        renumber = np.append(self.body_index, -1)  # (−1 stays −1)
+        out = dict(m0=m0, h0=h0, J0=J0, parent=renumber[s.parent[bodies]], body_of_obj=renumber[s.body_of_obj],
+                   leaf_body=self.body_index[s.leaf_body[self.leaves]],
+                   leaf_nodes=s.leaf_nodes[:0], leaf_first=np.zeros(len(self.leaves) + 1, np.int64),
+                   lump_cd=lump[:, 0].copy(), lump_cl=lump[:, 1].copy(),
                    lump_cauchy=lump[:, 2] / np.maximum(lump[:, 1], 1e-300),
-                   lump_x0=np.ascontiguousarray(lump[:, 3:] / weight[:, None]))
+                   lump_x0=lump[:, 3:] / np.maximum(lump[:, 0] + lump[:, 1], 1e-300)[:, None])
+        for fl in fields(Structure):
+            if fl.name not in out:
+                out[fl.name] = np.take(getattr(s, fl.name), self.leaves if fl.name.startswith("leaf_") else bodies,
+                                       axis=0)
         return Structure(**out)
 
     @property

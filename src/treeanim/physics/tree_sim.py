@@ -15,7 +15,7 @@ from ..model.params import PhysicsParams, check_physics
 from ..model.tree import KINDS, Tree
 from . import treestep
 from .falling import FallingLeaves
-from .lod import Reduced, object_trees
+from .lod import Parts, Reduced, object_trees
 from .structure import Structure
 from .treestep import Grab, TreeState, Work
 
@@ -78,6 +78,7 @@ class TreeSim:
         self._pos = self._rot = None
         self._levels = np.zeros(int(object_trees(tree).max(initial=0)) + 1, np.int64)  # asked
         self._detail = self._levels.copy()  # stepped: the held trees at full detail
+        self._parts = Parts(tree, self._s)
         self._lod: Reduced | None = None
 
     # ------------------------------------------------------------------ model
@@ -88,6 +89,7 @@ class TreeSim:
 
     def _rebuild(self) -> None:
         self._s = Structure.build(self._tree, self._physics, self._present)
+        self._parts = Parts(self._tree, self._s)
         self._work.theta_h = None  # the joints' θ follow their frequencies
         for i, (g, s, stiffness) in list(self._grabs.items()):  # their springs follow the stiffness
             self.drag(i, g.target, s, stiffness)
@@ -195,8 +197,8 @@ class TreeSim:
         detail[object_trees(self._tree)[held]] = 0
         if not force and np.array_equal(detail, self._detail):
             return
-        self._detail = detail
-        self._lod = Reduced(self._tree, self._s, self._st, detail, self._work) if detail.any() else None
+        was, self._detail = None if force else self._detail, detail  # (force: a new state or structure)
+        self._lod = Reduced(self._parts, self._s, self._st, detail, self._work, was, self._lod) if detail.any() else None
         self._pos = self._rot = None
 
     # ------------------------------------------------------------------ stepping
