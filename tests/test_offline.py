@@ -559,3 +559,15 @@ def test_a_trace_too_short_for_zero_crossings_says_so(tmp_path, capsys):
     assert cli.main(["trace", "beam", "--pull", "1,0,0", "--seconds", "0.05", "--out", str(tmp_path / "t.csv")]) == 0
     out = capsys.readouterr().out
     assert "too few to tell" in out and "nan" not in out
+
+
+def test_bench_measures_a_scene_as_a_row(tmp_path):
+    """`--presets` takes the shipped scenes too: the orchard's row counts all its trees."""
+    res = treeanim("bench", "--presets", "orchard", "--size", "32x24", "--frames", 1, "--steps", 1, "--json", "b.json",
+                   "--quiet", cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    (row,) = json.loads((tmp_path / "b.json").read_text())["rows"]
+    stats = ta.load_scene("orchard").stats(0.0)
+    assert row["key"] == "orchard" and row["paper_objects"] is None
+    assert (row["objects"], row["nodes"], row["triangles"]) == (stats["objects"], stats["nodes"], stats["triangles"])
+    assert math.isfinite(row["fps"]) and row["fps"] > 0

@@ -132,7 +132,7 @@ def cmd_bench(args) -> int:
     from treeanim.offline import bench
 
     keys = args.presets or list(ROWS)
-    known = list(ROWS) + [p for p in ta.list_presets() if p not in ROWS]
+    known = list(ROWS) + [p for p in ta.list_presets() + ta.list_scenes() if p not in ROWS]
     for k in keys:
         if k not in known:
             raise UsageError(f"--presets {k}: unknown; expected some of {', '.join(known)}")
@@ -342,8 +342,8 @@ def build_parser() -> argparse.ArgumentParser:
         "simulation time per step (wind on), the median offscreen render time per frame (pixels read back), "
         "and the frame rate they allow, with this machine's CPU and GL renderer.")
     p.add_argument("--presets", nargs="+", metavar="NAME",
-                   help="rows to measure (default: small_cherry large_cherry large_cherry@winter tulip_poplar "
-                   "grassland)")
+                   help="rows to measure: presets or scenes (default: small_cherry large_cherry "
+                   "large_cherry@winter tulip_poplar grassland)")
     p.add_argument("--size", type=opt.size, default=(1280, 720), metavar="WxH", help="render size (default 1280x720)")
     p.add_argument("--frames", type=opt.positive(int), default=20, help="frames rendered per preset (default 20)")
     p.add_argument("--steps", type=opt.positive(int), default=200,

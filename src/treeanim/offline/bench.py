@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..model.load import load_named
 from ..render.camera import framed_camera
 from ..table1 import ROWS, TABLE1, TABLE1_FPS
 from ..validate import float_within
@@ -48,7 +49,7 @@ def bench_row(key: str, off, width: int, height: int, frames: int, steps: int, w
     from ..driver import STEP, FrameDriver
 
     preset, season = ROWS.get(key, (key, 0.0))
-    tree = ta.load_preset(preset)
+    tree = load_named(preset)  # a preset or a scene
     stats = tree.stats(season)
     try:
         wind_field = ta.WindField(speed=wind, seed=0)
