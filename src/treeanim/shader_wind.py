@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import scripted
-from .compact import card_mesh
+from .compact import card_mesh, runs
 from .export import primitives, skeleton, skin, surface
 from .model.tree import Tree
 from .physics.simulation import Simulation
@@ -223,7 +223,12 @@ def _wind_mesh(doc, blob, tree: Tree, table: BranchTable, season: float, mesh: T
     wind = {"levels": LEVELS, "exponent": round(table.exponent, 4), "calibration_winds": list(CALIBRATION_WINDS),
             "table": {"accessor": entries, "width": tex.shape[1], "height": tex.shape[0], "rows": ROWS},
             "shader": "shaders/engine_wind.glsl"}
-    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives(doc, blob, tree, mesh, used, index, columns, True),
+    try:
+        runs(index, 65535)
+        short = True
+    except ValueError:  # a scene's trees interleave their vertices (objects sort by level): 32-bit indices
+        short = False
+    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives(doc, blob, tree, mesh, used, index, columns, short),
                               extras={"treeanim_wind": wind}))
     return len(doc.meshes) - 1
 

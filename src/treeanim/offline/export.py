@@ -91,12 +91,13 @@ def _shader_export(args) -> int:
     return 0
 
 
-def template_seeds(placements, k: int) -> dict[str, list[int]]:
-    """Per tree source (a preset or file) of a scene's ``placements``: the seeds of its ``k``
-    templates, the first ``k`` distinct seeds of its trees in scene order."""
-    seeds: dict[str, list[int]] = {}
+def template_seeds(placements, k: int) -> dict[tuple, list[int]]:
+    """Per tree source (a preset or file, and a TreeQSM model's leaves) of a scene's
+    ``placements``: the seeds of its ``k`` templates, the first ``k`` distinct seeds of its
+    trees in scene order."""
+    seeds: dict[tuple, list[int]] = {}
     for p in placements:
-        own = seeds.setdefault(p.tree, [])
+        own = seeds.setdefault((p.tree, p.leaves), [])
         if len(own) < k and p.seed not in own:
             own.append(p.seed)
     return seeds
@@ -118,7 +119,7 @@ def _instanced_export(args, out, scene) -> int:
         raise UsageError(f"--instances: {args.preset} is a single tree; instances are for scenes")
     templates, where = [], []
     for source, seeds in template_seeds(scene.placements, args.instances).items():
-        placed = [p for p in scene.placements if p.tree == source]
+        placed = [p for p in scene.placements if (p.tree, p.leaves) == source]
         for j, seed in enumerate(seeds):
             first = next(p for p in placed if p.seed == seed)
             tree = opt.with_settings(grow_placed(scene, first), args)
