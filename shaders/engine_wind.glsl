@@ -17,6 +17,12 @@
 // so a gust front crosses a forest) and the resonant sway at the branch's own frequency, whose
 // share grows as its damping falls (Davenport's gust factor). Levels apply innermost first,
 // so each branch carries what grows on it.
+//
+// An instanced mesh (`export --instances`: EXT_mesh_gpu_instancing, one template drawn at many
+// trees) passes each instance's placement (model and instance matrix, turn and uniform scale;
+// the identity for a lone tree): the wind turns into the template's frame, and the gusts' travel
+// and the branches' phases follow the world position of each pivot, so the trees of a forest
+// do not sway in unison.
 
 const float TREE_WIND_TAU = 6.283185307;
 
@@ -39,17 +45,18 @@ vec3 tree_wind_rotate(vec3 p, vec3 c, vec3 k, float a) {
 }
 
 // The bend of one level, and its axis, in a wind of `speed` m/s along the unit horizontal
-// `dir` with turbulence intensity `turb` at time `t` s; the tree's bends grow as speed^n.
+// `dir` (in the mesh's frame) with turbulence intensity `turb` at time `t` s; the tree's bends
+// grow as speed^n. `travel` (s) is how long the gusts took from x = 0 to the pivot and `world`
+// the pivot's world position.
 float tree_wind_bend(vec4 pivot, vec4 axis, float zeta, vec3 dir, float speed, float n, float turb, float t,
-                     out vec3 k) {
+                     float travel, vec3 world, out vec3 k) {
     k = cross(axis.xyz, dir);
     float len_k = length(k);
     k = len_k > 1e-3 ? k / len_k : normalize(cross(vec3(0.0, 1.0, 0.0), dir));  // along the wind: bend as a stem
     float load = axis.w * pow(max(speed, 0.0), n);
-    float travel = dot(pivot.xyz, dir) / max(speed, 0.1);
     float resonant = 0.28 / sqrt(max(zeta, 0.01));
     return load * (1.0 + 2.0 * turb * tree_wind_gust(t - travel)
-                   + 2.0 * turb * resonant * sin(TREE_WIND_TAU * pivot.w * t + tree_wind_phase(pivot.xyz)));
+                   + 2.0 * turb * resonant * sin(TREE_WIND_TAU * pivot.w * t + tree_wind_phase(world)));
 }
 
 // Object o's entry: texels (o mod width, 9 floor(o / width) + r), r = 0..8.
@@ -63,13 +70,16 @@ void tree_wind_fetch(highp sampler2D table, int width, int object, out vec4 pivo
     damping = texelFetch(table, at + ivec2(0, 8), 0);
 }
 
-// The swayed position of a vertex at rest position p (and its normal, turned alike).
-void tree_wind(inout vec3 p, inout vec3 normal, vec4 pivot[4], vec4 axis[4], vec4 damping,
+// The swayed position of a vertex at rest position p (and its normal, turned alike), in the
+// mesh's frame; `place` puts the mesh in the world, `dir` is the wind's world direction.
+void tree_wind(inout vec3 p, inout vec3 normal, vec4 pivot[4], vec4 axis[4], vec4 damping, mat4 place,
                vec3 dir, float speed, float exponent, float turb, float t) {
+    vec3 local = normalize(transpose(mat3(place)) * dir);  // a turn and a uniform scale
     for (int l = 3; l >= 0; --l) {
         if (pivot[l].w <= 0.0) continue;
-        vec3 k;
-        float a = tree_wind_bend(pivot[l], axis[l], damping[l], dir, speed, exponent, turb, t, k);
+        vec3 k, world = (place * vec4(pivot[l].xyz, 1.0)).xyz;
+        float a = tree_wind_bend(pivot[l], axis[l], damping[l], local, speed, exponent, turb, t,
+                                 dot(world, dir) / max(speed, 0.1), world, k);
         p = tree_wind_rotate(p, pivot[l].xyz, k, a);
         normal = tree_wind_rotate(normal, vec3(0.0), k, a);
     }

@@ -267,6 +267,10 @@ def build_parser() -> argparse.ArgumentParser:
                    help="keys (default): the simulated motion as rotation keys on a skeleton; shader: a static mesh "
                    "whose vertices carry their branches' pivots, axes and measured frequency, damping and compliance, "
                    "for the reference shader wind (shaders/engine_wind.glsl; .glb or .gltf)")
+    p.add_argument("--instances", type=opt.positive(int, 1000), default=None, metavar="K",
+                   help="with --motion shader, write a scene as instances (EXT_mesh_gpu_instancing) of K template "
+                   "trees per tree source (preset or file), each measured once; a tree takes the template of its "
+                   "seed (default: every tree its own mesh)")
     p.add_argument("--loop", type=opt.non_negative, default=0.0, metavar="SECONDS",
                    help="make the clip loop: the simulation runs this many seconds past the end and cross-fades into the "
                    "clip's start; the last key repeats the first (default 0: no loop)")

@@ -346,12 +346,16 @@ def output_path(text: str, suffixes: tuple[str, ...], option: str = "--out"):
 def load_any(name_or_path: str, args=None):
     """A preset or a scene by name, a preset or scene TOML file or a TreeQSM model (.txt, .csv,
     .mat) by path, with ``args``' --leaves (QSM only), --modes and --physics."""
-    import dataclasses
-
     from treeanim.model.load import load_named
 
-    leaves, modes = getattr(args, "leaves", None), getattr(args, "modes", None)
-    tree = load_named(name_or_path, leaves=leaves)
+    return with_settings(load_named(name_or_path, leaves=getattr(args, "leaves", None)), args)
+
+
+def with_settings(tree, args=None):
+    """``tree`` with ``args``' --modes and --physics."""
+    import dataclasses
+
+    modes = getattr(args, "modes", None)
     if modes is not None:
         tree.modes = modes
     settings = dict(getattr(args, "physics", None) or ())

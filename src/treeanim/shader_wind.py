@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import scripted
-from .compact import card_mesh
+from .compact import card_mesh, runs
 from .export import primitives, skeleton, skin, surface
 from .model.tree import Tree
 from .physics.simulation import Simulation
@@ -41,7 +41,7 @@ from .physics.wind.field import WindField
 from .render.mesh import TreeMesh
 
 __all__ = ["LEVELS", "CALIBRATION_WINDS", "BranchTable", "branch_table", "level_chains", "level_compliance",
-           "object_rows", "texture", "build_shader_gltf"]
+           "object_rows", "texture", "build_shader_gltf", "build_instanced_gltf"]
 
 #: Levels of branches a vertex carries (Unreal's Pivot Painter and SpeedTree use 3–4).
 LEVELS = 4
@@ -205,6 +205,53 @@ def texture(rows: np.ndarray, width: int = TABLE_WIDTH) -> np.ndarray:
     return tex.reshape(bands, W, ROWS, 4).transpose(0, 2, 1, 3).reshape(bands * ROWS, W, 4)
 
 
+def _wind_mesh(doc, blob, tree: Tree, table: BranchTable, season: float, mesh: TreeMesh | None = None) -> int:
+    """Add ``tree``'s static mesh with its shader-wind table and vertex object indices to
+    ``doc`` (module docstring); its mesh index."""
+    import pygltflib as gl
+
+    mesh = mesh if mesh is not None else card_mesh(tree)
+    present = tree.leaves_present(season)
+    keep_tris, used, pos, _, _ = skin(tree, mesh, skeleton(tree, present), present)
+    nrm, col = surface(tree, mesh, used, season)
+    tex = texture(object_rows(tree, table))
+    columns = {"POSITION": (pos, gl.VEC3, gl.FLOAT, None), "NORMAL": (nrm, gl.VEC3, gl.FLOAT, None),
+               "COLOR_0": (col, gl.VEC4, gl.UNSIGNED_BYTE, True),
+               "_OBJECT": (mesh.object[used].astype(np.float32), gl.SCALAR, gl.FLOAT, None)}
+    entries = blob.accessor(tex.reshape(-1, 4), gl.VEC4, gl.FLOAT)
+    index = (np.cumsum(used) - 1)[mesh.indices[keep_tris]]
+    wind = {"levels": LEVELS, "exponent": round(table.exponent, 4), "calibration_winds": list(CALIBRATION_WINDS),
+            "table": {"accessor": entries, "width": tex.shape[1], "height": tex.shape[0], "rows": ROWS},
+            "shader": "shaders/engine_wind.glsl"}
+    try:
+        runs(index, 65535)
+        short = True
+    except ValueError:  # a scene's trees interleave their vertices (objects sort by level): 32-bit indices
+        short = False
+    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives(doc, blob, tree, mesh, used, index, columns, short),
+                              extras={"treeanim_wind": wind}))
+    return len(doc.meshes) - 1
+
+
+def _document():
+    import pygltflib as gl
+
+    from .export import _Blob
+
+    doc = gl.GLTF2(asset=gl.Asset(version="2.0", generator="treeanim (shader wind)"))
+    return doc, _Blob(doc)
+
+
+def _finish(doc, blob, name: str):
+    import pygltflib as gl
+
+    doc.scenes.append(gl.Scene(name=name, nodes=list(range(len(doc.nodes)))))
+    doc.scene = 0
+    data = blob.bytes()
+    doc.buffers.append(gl.Buffer(byteLength=len(data)))
+    return doc, data
+
+
 def build_shader_gltf(tree: Tree, table: BranchTable, season: float = 0.0, mesh: TreeMesh | None = None):
     """The static glTF of ``tree`` with the shader-wind table and each vertex's object index
     (module docstring).
@@ -216,28 +263,42 @@ def build_shader_gltf(tree: Tree, table: BranchTable, season: float = 0.0, mesh:
     """
     import pygltflib as gl
 
-    from .export import _Blob
+    doc, blob = _document()
+    doc.nodes.append(gl.Node(name=tree.name, mesh=_wind_mesh(doc, blob, tree, table, season, mesh)))
+    return _finish(doc, blob, tree.name)
 
-    mesh = mesh if mesh is not None else card_mesh(tree)
-    present = tree.leaves_present(season)
-    keep_tris, used, pos, _, _ = skin(tree, mesh, skeleton(tree, present), present)
-    doc = gl.GLTF2(asset=gl.Asset(version="2.0", generator="treeanim (shader wind)"))
-    blob = _Blob(doc)
-    nrm, col = surface(tree, mesh, used, season)
-    tex = texture(object_rows(tree, table))
-    columns = {"POSITION": (pos, gl.VEC3, gl.FLOAT, None), "NORMAL": (nrm, gl.VEC3, gl.FLOAT, None),
-               "COLOR_0": (col, gl.VEC4, gl.UNSIGNED_BYTE, True),
-               "_OBJECT": (mesh.object[used].astype(np.float32), gl.SCALAR, gl.FLOAT, None)}
-    entries = blob.accessor(tex.reshape(-1, 4), gl.VEC4, gl.FLOAT)
-    index = (np.cumsum(used) - 1)[mesh.indices[keep_tris]]
-    wind = {"levels": LEVELS, "exponent": round(table.exponent, 4), "calibration_winds": list(CALIBRATION_WINDS),
-            "table": {"accessor": entries, "width": tex.shape[1], "height": tex.shape[0], "rows": ROWS},
-            "shader": "shaders/engine_wind.glsl"}
-    doc.meshes.append(gl.Mesh(name=tree.name, primitives=primitives(doc, blob, tree, mesh, used, index, columns, True),
-                              extras={"treeanim_wind": wind}))
-    doc.nodes.append(gl.Node(name=tree.name, mesh=0))
-    doc.scenes.append(gl.Scene(name=tree.name, nodes=[0]))
-    doc.scene = 0
-    data = blob.bytes()
-    doc.buffers.append(gl.Buffer(byteLength=len(data)))
-    return doc, data
+
+def build_instanced_gltf(name: str, templates: list[tuple[Tree, BranchTable]], placements: list[list],
+                         season: float = 0.0):
+    """A scene as instances of template trees: each template's static shader-wind mesh (as
+    :func:`build_shader_gltf` writes it, at the origin) in a node whose
+    ``EXT_mesh_gpu_instancing`` places it at every tree of the scene that takes it.
+
+    Parameters
+    ----------
+    name : str
+        The scene's name.
+    templates : list of (Tree, BranchTable)
+        The trees as generated (at the origin, heading 0, scale 1) and their measured tables.
+    placements : list of lists of Placement
+        Per template, the scene's trees that take it (their position, heading and scale).
+    season : float
+
+    Returns
+    -------
+    (pygltflib.GLTF2, bytes)
+    """
+    import pygltflib as gl
+
+    doc, blob = _document()
+    for (tree, table), where in zip(templates, placements):
+        half = np.radians([p.heading for p in where]) / 2  # the turn about +y (scene.heading_matrix)
+        rotation = np.zeros((len(where), 4), np.float32)
+        rotation[:, 1], rotation[:, 3] = np.sin(half), np.cos(half)
+        columns = {"TRANSLATION": np.array([p.position for p in where], np.float32), "ROTATION": rotation,
+                   "SCALE": np.repeat(np.array([[p.scale] for p in where], np.float32), 3, axis=1)}
+        attributes = {k: blob.accessor(a, gl.VEC4 if k == "ROTATION" else gl.VEC3, gl.FLOAT) for k, a in columns.items()}
+        doc.nodes.append(gl.Node(name=tree.name, mesh=_wind_mesh(doc, blob, tree, table, season),
+                                 extensions={"EXT_mesh_gpu_instancing": {"attributes": attributes}}))
+    doc.extensionsUsed = ["EXT_mesh_gpu_instancing"]
+    return _finish(doc, blob, name)

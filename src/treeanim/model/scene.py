@@ -59,6 +59,8 @@ class Placement:
         Its size relative to the tree as generated.
     seed : int
         The seed it was generated with (a TreeQSM model: its leaves' seed).
+    leaves : str or None
+        A TreeQSM model's leaves (None: a preset, or the model as scanned).
     """
 
     tree: str
@@ -66,6 +68,7 @@ class Placement:
     heading: float = 0.0
     scale: float = 1.0
     seed: int = 0
+    leaves: str | None = None
 
 
 @dataclass(eq=False)

@@ -33,7 +33,7 @@ from .qsm.read import QSM_SUFFIXES
 from .scene import MAX_COORDINATE, MAX_SCALE, MIN_SCALE, MergeError, Placement, Scene, merge_trees, place_tree
 from .tree import Tree
 
-__all__ = ["list_scenes", "load_scene", "read_scene", "scene_summary", "MAX_TREES", "SCENE_BUDGET", "MIN_SPACING"]
+__all__ = ["list_scenes", "load_scene", "read_scene", "scene_summary", "grow_placed", "MAX_TREES", "SCENE_BUDGET", "MIN_SPACING"]
 
 #: Most trees one scene may place.
 MAX_TREES = 5000
@@ -345,6 +345,23 @@ def _grow(kind: _Kind, base, seed: int | None) -> Tree:
     return tree_of(base if seed is None else dataclasses.replace(base, seed=seed), kind.path or kind.tree)
 
 
+def grow_placed(scene: Scene, placement: Placement) -> Tree:
+    """The tree a scene file's ``placement`` placed, as generated: at the origin, heading 0,
+    scale 1 (a file is found beside ``scene.source``).
+
+    Raises
+    ------
+    SceneError
+        The tree's source can no longer be read.
+    """
+    table = {"tree": placement.tree} | ({"leaves": placement.leaves} if placement.leaves else {})
+    try:
+        kind = _kind(table, "tree", Path(scene.source).parent)
+        return _grow(kind, _base(kind, "tree"), placement.seed)
+    except _Bad as e:
+        raise SceneError(f"{scene.source}: {placement.tree}: {e.expected}") from None
+
+
 def _table(label: str) -> str:
     """The table a tree's label names ('scatter[2] tree 17' -> 'scatter[2]')."""
     return label.split(" ")[0]
@@ -402,7 +419,7 @@ def read_scene(path: str | Path, data: dict | None = None) -> Scene:
                 trees.append(place_tree(tree, pos, heading, scale))
             except ValueError as e:
                 raise _Bad(_table(label), f"{label}: {e}") from None
-            placements.append(Placement(kind.tree, pos, heading, scale, int(tree.seed)))
+            placements.append(Placement(kind.tree, pos, heading, scale, int(tree.seed), kind.leaves))
         try:  # (it refuses leaves of another outline than the first leafy tree's)
             scene = merge_trees(trees, placements, name=data["name"], seed=int(data.get("seed", 0)),
                                 source=str(path), description=" ".join(str(data.get("description", "")).split()),

@@ -28,6 +28,8 @@ def cmd_export(args) -> int:
 
     if args.motion == "shader":
         return _shader_export(args)
+    if args.instances is not None:
+        raise UsageError("--instances: only a shader-wind mesh is instanced (add --motion shader)")
     out = opt.output_path(args.out, (".glb", ".gltf", *export_usd.USD_SUFFIXES))
     usd = out.suffix.lower() in export_usd.USD_SUFFIXES
     if usd:
@@ -77,6 +79,8 @@ def _shader_export(args) -> int:
     if clashing:
         raise UsageError(f"{', '.join(clashing)}: a shader-wind mesh has no keys or joints (--motion shader)")
     tree = opt.load_any(args.preset, args)
+    if args.instances is not None:
+        return _instanced_export(args, out, tree)
     table = shader_wind.branch_table(tree, season=args.season)
     doc, data = shader_wind.build_shader_gltf(tree, table, season=args.season)
     files = export.write_gltf(out, doc, data)
@@ -84,4 +88,47 @@ def _shader_export(args) -> int:
     print(f"wrote {', '.join(map(str, files))}: a static mesh for shader wind, {shader_wind.LEVELS} levels of "
           f"branches per vertex, measured in {2 * shader_wind.SETTLE + shader_wind.RING:g} s of simulation (bends grow "
           f"as U^{table.exponent:.2f}); {size / 1e6:.1f} MB (sway it with shaders/engine_wind.glsl)")
+    return 0
+
+
+def template_seeds(placements, k: int) -> dict[tuple, list[int]]:
+    """Per tree source (a preset or file, and a TreeQSM model's leaves) of a scene's
+    ``placements``: the seeds of its ``k`` templates, the first ``k`` distinct seeds of its
+    trees in scene order."""
+    seeds: dict[tuple, list[int]] = {}
+    for p in placements:
+        own = seeds.setdefault((p.tree, p.leaves), [])
+        if len(own) < k and p.seed not in own:
+            own.append(p.seed)
+    return seeds
+
+
+def template_of(seeds: list[int], seed: int) -> int:
+    """The template a tree of ``seed`` takes among its source's template ``seeds``: its own
+    where it is one, else seed mod their count."""
+    return seeds.index(seed) if seed in seeds else seed % len(seeds)
+
+
+def _instanced_export(args, out, scene) -> int:
+    """``--motion shader --instances K``: a scene as instances of K templates per tree source."""
+    from .. import export, shader_wind
+    from ..model.scene import Scene
+    from ..model.scene_file import grow_placed
+
+    if not isinstance(scene, Scene) or scene.n_trees < 2:
+        raise UsageError(f"--instances: {args.preset} is a single tree; instances are for scenes")
+    templates, where = [], []
+    for source, seeds in template_seeds(scene.placements, args.instances).items():
+        placed = [p for p in scene.placements if (p.tree, p.leaves) == source]
+        for j, seed in enumerate(seeds):
+            first = next(p for p in placed if p.seed == seed)
+            tree = opt.with_settings(grow_placed(scene, first), args)
+            templates.append((tree, shader_wind.branch_table(tree, season=args.season)))
+            where.append([p for p in placed if template_of(seeds, p.seed) == j])
+    doc, data = shader_wind.build_instanced_gltf(scene.name, templates, where, season=args.season)
+    files = export.write_gltf(out, doc, data)
+    size = sum(f.stat().st_size for f in files)
+    print(f"wrote {', '.join(map(str, files))}: {scene.n_trees} trees as instances of {len(templates)} shader-wind "
+          f"templates ({', '.join(sorted({p.tree for p in scene.placements}))}); {size / 1e6:.1f} MB (sway them "
+          "with shaders/engine_wind.glsl)")
     return 0
