@@ -31,6 +31,12 @@ def serve(folder: Path):
         server.shutdown()
 
 
+#: The virtual time (ms) for a page that draws one still frame once it has loaded: idle, its
+#: clock runs ahead of the decoding of the glb's leaf texture, which does not hold it back, and
+#: with a tenth of this some pages were dumped before their frame under load.
+STILL_MS = 600_000
+
+
 def frames(url: str, profile: Path, virtual_ms: int = 60000) -> list[np.ndarray]:
     """The RGB frames (H, W, 3) float the page at ``url`` hands out, in order."""
     chromium = shutil.which("chromium") or shutil.which("chromium-browser")

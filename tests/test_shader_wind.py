@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import treeanim as ta
-from browser import changed, frames, serve
+from browser import STILL_MS, changed, frames, serve
 from gltf_readback import load
 from test_export import NODE_MODULES, export, validate
 from treeanim import scripted, shader_wind
@@ -111,7 +111,7 @@ def test_the_reference_shader_sways_the_mesh_in_three_js(tmp_path):
     (web / "three").symlink_to(NODE_MODULES / "three")
     with serve(web) as port:
         calm0, calm3, gale2, gale3 = (
-            frames(f"http://127.0.0.1:{port}/index.html?{q}", tmp_path / f"profile{i}")[0]
+            frames(f"http://127.0.0.1:{port}/index.html?{q}", tmp_path / f"profile{i}", STILL_MS)[0]
             for i, q in enumerate(["t=0&wind=0", "t=3&wind=0", "t=2&wind=20", "t=2.4&wind=20"]))
     sky = calm0[0, 0]
     tree = np.abs(calm0 - sky).sum(axis=2) > 30
