@@ -25,8 +25,9 @@ from pathlib import Path
 import numpy as np
 
 from ..driver import MAX_FRAME_DT, FrameDriver
+from ..model.scene import object_trees
 from ..model.tree import Tree
-from ..physics.lod import choose_detail, object_trees, tree_extents
+from ..physics.lod import choose_detail, tree_extents
 from ..physics.pull import SpringPull, TreeDrag
 from ..physics.pull import grab as grab_object
 from ..physics.simulation import Simulation

@@ -25,7 +25,7 @@ from .build import KIND_ORDER
 from .params import PhysicsParams, SeasonModes
 from .tree import KINDS, Tree
 
-__all__ = ["Placement", "Scene", "MergeError", "place_tree", "merge_trees", "make_scene", "heading_matrix",
+__all__ = ["Placement", "Scene", "MergeError", "object_trees", "place_tree", "merge_trees", "make_scene", "heading_matrix",
            "same_lamina", "MAX_SCALE", "MIN_SCALE", "MAX_COORDINATE"]
 
 #: The least and largest scale a tree may be placed at (a seedling of a preset to a giant).
@@ -146,6 +146,12 @@ class Scene(Tree):
         has = self.parent >= 0
         if np.any(ot[has] != ot[self.parent[has]]):
             raise ValueError("an object's parent belongs to another tree")
+
+
+def object_trees(tree: Tree) -> np.ndarray:
+    """(M,) int: the placed tree each object belongs to (:attr:`Scene.object_tree`; all 0 for a
+    single tree)."""
+    return tree.object_tree if isinstance(tree, Scene) else np.zeros(tree.n_objects, np.int64)
 
 
 def heading_matrix(heading: float) -> np.ndarray:

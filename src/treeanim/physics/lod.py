@@ -30,13 +30,13 @@ from dataclasses import fields
 
 import numpy as np
 
-from ..model.scene import Scene
+from ..model.scene import object_trees
 from .compiled import njit
 from .kinematics import _place
 from .structure import Structure
 from .treestep import TreeState, Work
 
-__all__ = ["MAX_DETAIL", "DETAIL_PIXELS", "Parts", "Reduced", "carry", "check_levels", "choose_detail", "object_trees",
+__all__ = ["MAX_DETAIL", "DETAIL_PIXELS", "Parts", "Reduced", "carry", "check_levels", "choose_detail",
            "tree_extents"]
 
 #: The coarsest detail level.
@@ -52,11 +52,6 @@ SEGMENT_DRAG = 3.0 * np.pi / 16.0
 LEAF_DRAG = 1.0 / 3.0
 _BODY_STATE = ("Q", "w", "R", "P", "Om", "V", "leaf_F", "leaf_C", "leaf_K")  # TreeState's per-body arrays (the
 # others are per leaf)
-
-
-def object_trees(tree) -> np.ndarray:
-    """(M,) the tree each object belongs to (all 0 for a single tree)."""
-    return tree.object_tree if isinstance(tree, Scene) else np.zeros(tree.n_objects, np.int64)
 
 
 def check_levels(levels, n_trees: int) -> np.ndarray:

@@ -17,9 +17,10 @@ import numbers
 
 import numpy as np
 
+from ..model.scene import object_trees
 from ..model.tree import Tree
 from ..validate import finite_float, finite_vector3, float_within, object_index
-from .lod import check_levels, object_trees
+from .lod import check_levels
 from .paper_sim import MAX_FREQUENCY, MAX_PULL, MAX_STEP, MAX_ZETA, PaperSim
 from .tree_sim import GRAB_STIFFNESS, MAX_GRAB_STIFFNESS, TreeSim
 from .wind import fit_to_tree

@@ -12,10 +12,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..model.params import PhysicsParams, check_physics
+from ..model.scene import object_trees
 from ..model.tree import KINDS, Tree
 from . import treestep
 from .falling import FallingLeaves
-from .lod import Parts, Reduced, object_trees
+from .lod import Parts, Reduced
 from .structure import Structure
 from .treestep import Grab, TreeState, Work
 

@@ -11,17 +11,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.scene import object_trees
 from ..model.tree import Tree
 
 #: A tree's sphere grows by this fraction of its height for sway, and the shadow map's box round
 #: a lone tree by this fraction of its size (:meth:`~.shadow.ShadowMap.fit`).
 SWAY_MARGIN = 0.15
-
-
-def tree_of_objects(tree: Tree) -> np.ndarray:
-    """(M,) int: the placed tree of each object (all 0 for a lone tree)."""
-    ot = getattr(tree, "object_tree", None)
-    return np.asarray(ot, np.int64) if ot is not None and len(ot) == tree.n_objects else np.zeros(tree.n_objects, np.int64)
 
 
 def morton_order(xz: np.ndarray) -> np.ndarray:
@@ -56,7 +51,7 @@ def tree_spheres(tree: Tree, pad: float) -> tuple[np.ndarray, np.ndarray]:
         :data:`SWAY_MARGIN` of the tree's height.
     """
     P = np.asarray(tree.rest_positions, float)
-    owner = np.repeat(tree_of_objects(tree), tree.object_count)
+    owner = np.repeat(object_trees(tree), tree.object_count)
     K = int(owner.max(initial=-1)) + 1
     lo = np.full((K, 3), np.inf)
     hi = np.full((K, 3), -np.inf)
@@ -167,7 +162,7 @@ class TreeOrder:
         self.centres, self.radii = centres[order], radii[order]
         self.rank = np.empty(len(order), np.int64)
         self.rank[order] = np.arange(len(order))
-        self._vertex_tree = tree_of_objects(tree)[mesh.object]
+        self._vertex_tree = object_trees(tree)[mesh.object]
 
     @property
     def n_trees(self) -> int:
