@@ -51,15 +51,18 @@ STOP_TRACE = 1.0 + 2.0 * np.cos(JOINT_STOP)
 def theta_of(x):
     """The θ-method's weight for a joint whose swing of frequency ω makes x = ωh a step.
 
-    θ = ½ + ½·x⁴/(x⁴ + π⁴): the trapezoidal rule (no numerical damping; θ − ½ < 0.003 for
-    x < 1) for a swing the step resolves, ¾ at x = π (two steps a period, the step's Nyquist
-    limit) and toward 1 (backward Euler) for swings far faster than the step, which then
-    shrink by (1 − θ)/θ a step instead of ringing at the step rate. ω is the joint's lowest
-    swing with everything beyond it flexible (:func:`~treeanim.physics.structure._flexible_frequency`)
-    for its bends, its own segment's twist for its twist.
+    θ = ½ + ½·x⁴/(x⁴ + (2π)⁴): the trapezoidal rule (no numerical damping; θ − ½ < 0.03 for
+    x < π) for every swing up to the step's Nyquist limit (two steps a period), ¾ at one step
+    a period (x = 2π) and toward 1 (backward Euler) for swings far faster than the step, which
+    then shrink by (1 − θ)/θ a step instead of ringing at the step rate. A limb's release at
+    1/10 s steps (x ≈ 2–3 for its joints) thus keeps swinging as at 1/120 s, slower (the
+    trapezoidal rule's frequency 2·atan(x/2)/h) but no more damped. ω is the joint's lowest
+    swing with everything beyond it flexible
+    (:func:`~treeanim.physics.structure._flexible_frequency`) for its bends, its own segment's
+    twist for its twist.
     """
     x4 = (x * x) ** 2
-    return 0.5 + 0.5 * x4 / (x4 + 97.40909103400242)
+    return 0.5 + 0.5 * x4 / (x4 + 1558.5454565440389)
 
 
 @njit(cache=True, inline="always", fastmath=True, error_model="numpy")
@@ -142,6 +145,18 @@ def _inv3(A, out):
     out[0, 2] = (b * f - c * e) * r
     out[1, 2] = (c * d - a * f) * r
     out[2, 2] = (a * e - b * d) * r
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _whirl_theta(h, w, t1, t2):
+    """A joint's θ for its bends and twist this step: its swing's (:func:`theta_of`), raised
+    to ½ + ½·y⁴/(y⁴ + 1) if more, y = h·|w| the radians it turns in the step. A whirl of a
+    radian or more a step (a grass blade's tip whipping in a gust's wake at 1/30 s) leaves
+    the step's linearisation, which then gains energy on the trapezoidal rule; a swing the
+    step resolves turns far less."""
+    y2 = h * h * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+    tw = 0.5 + 0.5 * y2 * y2 / (y2 * y2 + 1.0)
+    return max(t1, tw), max(t2, tw)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -251,7 +266,7 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
         az = Rm[2, 0] * axis[b, 0] + Rm[2, 1] * axis[b, 1] + Rm[2, 2] * axis[b, 2]
         aw = (ax, ay, az)
         k1, k2, dk = kb[b], kt[b], dkk[b]
-        t1, t2 = theta[b], theta_t[b]
+        t1, t2 = _whirl_theta(h, w[b], theta[b], theta_t[b])
         tw0 = Rm[0, 0] * th[0] + Rm[0, 1] * th[1] + Rm[0, 2] * th[2]
         tw1 = Rm[1, 0] * th[0] + Rm[1, 1] * th[1] + Rm[1, 2] * th[2]
         tw2 = Rm[2, 0] * th[0] + Rm[2, 1] * th[1] + Rm[2, 2] * th[2]
@@ -290,6 +305,20 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
             pa[i] = pA[b, i] + UD[i, 0] * u[b, 0] + UD[i, 1] * u[b, 1] + UD[i, 2] * u[b, 2]
         # to the parent's joint: r = P_b − P_p
         rx, ry, rz = P[b, 0] - P[p, 0], P[b, 1] - P[p, 1], P[b, 2] - P[p, 2]
+        # the joint's velocity-product acceleration over the step, h·c = h·ν_b ×ₘ S·ω_rel
+        # (kept in acc until the outward pass): (ω_p × ω_rel, v_b × ω_rel); pa += Ia·h·c.
+        # Explicit, so weighted as _add_bias's by (1 + x⁴)⁻¹, x = h·|ω| (a whirl of a radian
+        # or more a step it would overshoot)
+        o0, o1, o2 = Om[p, 0], Om[p, 1], Om[p, 2]
+        c0, c1, c2 = _cross(o0, o1, o2, wr0, wr1, wr2)
+        c3, c4, c5 = _cross(V[b, 0], V[b, 1], V[b, 2], wr0, wr1, wr2)
+        x2 = h * h * (o0 * o0 + o1 * o1 + o2 * o2 + wr0 * wr0 + wr1 * wr1 + wr2 * wr2)
+        hc = h / (1.0 + x2 * x2)
+        acc[b, 0], acc[b, 1], acc[b, 2] = hc * c0, hc * c1, hc * c2
+        acc[b, 3], acc[b, 4], acc[b, 5] = hc * c3, hc * c4, hc * c5
+        for i in range(6):
+            pa[i] += (Ia[i, 0] * acc[b, 0] + Ia[i, 1] * acc[b, 1] + Ia[i, 2] * acc[b, 2]
+                      + Ia[i, 3] * acc[b, 3] + Ia[i, 4] * acc[b, 4] + Ia[i, 5] * acc[b, 5])
         _add_translated(Ia, pa, rx, ry, rz, IA[p], pA[p], wk)
     # --- 3. outward: the joints' velocity changes and the bodies' spatial ones
     for b in range(B):
@@ -299,7 +328,8 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
             rx, ry, rz = P[b, 0] - P[p, 0], P[b, 1] - P[p, 1], P[b, 2] - P[p, 2]
             a0, a1, a2 = acc[p, 0], acc[p, 1], acc[p, 2]
             cx, cy, cz = _cross(a0, a1, a2, rx, ry, rz)
-            a3, a4, a5 = acc[p, 3] + cx, acc[p, 4] + cy, acc[p, 5] + cz
+            a3, a4, a5 = acc[p, 3] + cx + acc[b, 3], acc[p, 4] + cy + acc[b, 4], acc[p, 5] + cz + acc[b, 5]
+            a0, a1, a2 = a0 + acc[b, 0], a1 + acc[b, 1], a2 + acc[b, 2]
         # Δ = D⁻¹ (u − Uᵀ a')
         r_0 = u[b, 0] - (Urow[b, 0, 0] * a0 + Urow[b, 0, 1] * a1 + Urow[b, 0, 2] * a2
                          + Urow[b, 0, 3] * a3 + Urow[b, 0, 4] * a4 + Urow[b, 0, 5] * a5)
@@ -324,10 +354,11 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
         else:
             l0, l1, l2 = d0, d1, d2
         # Θ in the parent's rest axes: θ_b + (θ_t − θ_b)·a aᵀ
-        al = (axis[b, 0] * l0 + axis[b, 1] * l1 + axis[b, 2] * l2) * (theta_t[b] - theta[b])
-        e0 = h * (w[b, 0] + theta[b] * l0 + al * axis[b, 0])
-        e1 = h * (w[b, 1] + theta[b] * l1 + al * axis[b, 1])
-        e2 = h * (w[b, 2] + theta[b] * l2 + al * axis[b, 2])
+        t1, t2 = _whirl_theta(h, w[b], theta[b], theta_t[b])
+        al = (axis[b, 0] * l0 + axis[b, 1] * l1 + axis[b, 2] * l2) * (t2 - t1)
+        e0 = h * (w[b, 0] + t1 * l0 + al * axis[b, 0])
+        e1 = h * (w[b, 1] + t1 * l1 + al * axis[b, 1])
+        e2 = h * (w[b, 2] + t1 * l2 + al * axis[b, 2])
         w[b, 0] += l0
         w[b, 1] += l1
         w[b, 2] += l2
