@@ -124,7 +124,8 @@ def test_a_gust_front_takes_d_over_u_to_cross_the_scene(speed):
 def test_far_across_the_wind_other_gusts_come():
     """Gusts alone (no turbulence): points 1 km apart across the wind see gusts of their own
     (correlation 0.07–0.09; before, every gust was one front across the whole landscape:
-    1.000), while points 5 m apart inside one lane (lanes 3 L wide) see the same gusts."""
+    1.000), while points 5 m apart inside one lane (lanes 1.5 L_g = 60 m wide) see the same
+    gusts."""
     fs = 4.0
     wind = WindField(speed=8.0, seed=9, turbulence=0.0, gust_strength=1.0, gust_rate=6.0)
     pts = [[0.0, H, 11.0], [0.0, H, 1011.0], [0.0, H, -1489.0], [0.0, H, 16.0]]
