@@ -236,8 +236,9 @@ def _sample_points(p, out, frame, cell, travel, evolution, table, inv_top, sigma
     (:func:`~.turbulence._eddies`). The gusts read the along-wind one and the across-wind
     one's lane: gusts are fronts across their lane, so each lane's sum is a function of the
     along-wind coordinate only, evaluated on a 1-D lattice of spacing an eighth of the rise
-    width fixed in space over the points' span and interpolated (relative error < 0.5 %), or directly at
-    each point where the lanes' lattices would cost more than the points (:func:`_gust`).
+    width fixed in space over the points' span and interpolated (relative error < 0.5 %), or
+    directly at each point where the lanes' lattices would cost more than the points
+    (:func:`_gust`).
     """
     m = frame * (1.0 / cell)
     strength, _, _, _, _, step, lane = gusts
