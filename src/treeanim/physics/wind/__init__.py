@@ -42,11 +42,16 @@ shows how to add one.
   1 : 0.75 : 0.5 with σ_u = ``turbulence``·``speed`` at and above h, decaying as
   exp(y/h − 1) inside the canopy (the intensity rises towards the ground).
 * **Gusts.** ``gust_rate`` gusts a minute, each a front across the wind with a sharp rise
-  (0.5 L) and a slower decay (1.5 L) of peak ``gust_strength``·U·A (A uniform in
+  (0.5 L_g) and a slower decay (1.5 L_g) of peak ``gust_strength``·U·A (A uniform in
   [0.5, 1.5]), carried at the wind speed; their mean is subtracted, so they are gusts and
-  lulls about the set mean. They come in lanes 3 L wide across the wind, each lane its own
-  gusts, blended with the next lane's over a ramp L wide (as the turbulence's blocks are):
-  a gust reaches about 4 L across, as far as it is long.
+  lulls about the set mean. L_g (``gust_length``) is the atmospheric surface layer's
+  along-wind integral scale at the canopy top (EN 1991-1-4, Annex B: 22 m over a 2.5 m
+  canopy, 40 m over a 10 m one), not the canopy's: gusts are the large eddies that sweep
+  down into the canopy, several trees long. Where gusts come faster than that allows, a
+  gust's rise and decay shrink to fit the interval between gusts. They come in lanes
+  1.5 L_g wide across the wind (half the length across as along, as in isotropic
+  turbulence), each lane its own gusts, blended with the next lane's over a ramp L_g/2
+  wide (as the turbulence's blocks are).
 * **Mean direction.** Every fluctuation across the wind has zero mean by construction
   (symmetric Gaussian noise, no rescaling), so the long-run mean wind points along
   ``direction``.

@@ -32,7 +32,6 @@ from .settings import (
 )
 from .turbulence import (
     _CELLS_PER_L,
-    RAMP,
     _blocks,
     _eddies,
     _evolution,
@@ -52,16 +51,31 @@ ROUGHNESS = 0.1
 _LOG_TOP = math.log((1.0 - DISPLACEMENT) / ROUGHNESS)
 CANOPY_ATTENUATION = 1.0 / ((1.0 - DISPLACEMENT) * _LOG_TOP)
 SIGMA_ATTENUATION = 1.0
-#: Gust shape: rise and decay widths (Gaussian σ) in length scales; jitter of the gust
-#: times (fraction of the mean interval); widths are capped at this many intervals.
+#: Gust shape: rise and decay widths (Gaussian σ) in the gusts' length scale L_g; jitter of
+#: the gust times (fraction of the mean interval).
 GUST_RISE = 0.5
 GUST_DECAY = 1.5
 _GUST_JITTER = 0.7
-_GUST_MAX_WIDTH = (1.0, 3.0)
-#: Lanes of gusts across the wind, each its own gusts: blocks GUST_LANE L wide that share a
-#: ramp L wide with each neighbour (as the turbulence's blocks do), so a lane's gusts reach
-#: 4 L across, a gust's length along the wind (its rise and decay, two widths each).
+#: The gusts' length scale L_g is the atmospheric surface layer's along-wind integral scale at
+#: the canopy top z = h over its roughness z0 = ROUGHNESS·h: L = L_t·(z/z_t)^α with
+#: α = 0.67 + 0.05·ln(z0 / 1 m), L_t = 300 m, z_t = 200 m (EN 1991-1-4, Annex B; z at most
+#: z_t), not the canopy's: (L_t, z_t, α at z0 = 1 m, α's slope in ln z0).
+SURFACE_SCALE = (300.0, 200.0, 0.67, 0.05)
+#: The gusts' lateral scale over their along-wind one: isotropic (von Kármán) turbulence's,
+#: whose along-wind component's integral scale across the wind is half that along it.
+GUST_ASPECT = 0.5
+#: Lanes of gusts across the wind, each its own gusts: blocks GUST_LANE lateral scales wide
+#: that share a ramp one lateral scale wide with each neighbour (as the turbulence's blocks
+#: do), so a lane's gusts reach 4 lateral scales across, as a gust's length along the wind
+#: (its rise and decay, two widths each) is 4 L_g.
 GUST_LANE = 2.0 * (GUST_RISE + GUST_DECAY) - 1.0
+
+
+def _surface_scale(h: float) -> float:
+    """The surface layer's along-wind integral scale (m) at the top of a canopy ``h`` m tall
+    (:data:`SURFACE_SCALE`)."""
+    top, z_top, alpha, slope = SURFACE_SCALE
+    return top * (min(h, z_top) / z_top) ** (alpha + slope * math.log(ROUGHNESS * h))
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
@@ -112,18 +126,20 @@ def _gust_sum(base: np.uint64, gam: float, sr: float, sd: float) -> float:
     return total - math.sqrt(0.5 * math.pi) * (sr + sd)  # mean of A (1) × area per gust
 
 
-def _gust_params(wind: PhysicalWind, g: float) -> tuple[float, float, float, float, float, float]:
+def _gust_params(wind: PhysicalWind, g: float) -> tuple[float, float, float, float, float, float, float]:
     """The gusts of one call: (strength, gust clock g, gusts per metre, rise and decay
-    widths in gusts, lattice step in metres); strength 0 where there are none."""
+    widths in gusts, lattice step and lane width in metres); strength 0 where there are none."""
     rg = wind.gust_rate / 60.0
     per_m = rg / max(wind.speed, 1e-6)  # gust count per metre (still air carries no gusts)
-    length = wind.length_scale
+    length = wind.gust_length
     if not (wind.gust_strength > 0.0 and rg > 0.0 and GUST_RISE * length * per_m > 1e-12):
-        return (0.0, 0.0, 0.0, 1.0, 1.0, 1.0)  # none, or so rare they never come
-    sr = min(GUST_RISE * length * per_m, _GUST_MAX_WIDTH[0])
-    sd = min(GUST_DECAY * length * per_m, _GUST_MAX_WIDTH[1])
+        return (0.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0)  # none, or so rare they never come
+    # A gust's rise and decay (two widths each) fit in the interval between gusts: they come
+    # at their rate, however long.
+    fit = min(length * per_m, 0.5 / (GUST_RISE + GUST_DECAY))
+    sr, sd = GUST_RISE * fit, GUST_DECAY * fit
     step = 0.125 * sr / per_m  # metres, on a lattice fixed in space (whatever the points)
-    return (wind.gust_strength, g, per_m, sr, sd, step)
+    return (wind.gust_strength, g, per_m, sr, sd, step, GUST_LANE * GUST_ASPECT * length)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -141,7 +157,7 @@ def _gust_lattice(lo: float, hi: float, lanes: tuple, budget: int, gusts: tuple,
     n = np.int64(math.floor(hi)) - first + 2
     if float(n) * float(n_lanes) > budget:  # (in float: no int64 overflow for lanes far apart)
         return 0, empty
-    _, g, per_m, sr, sd, step = gusts
+    _, g, per_m, sr, sd, step, _ = gusts
     ys = np.empty((n_lanes, n))
     for k in range(n_lanes):
         stream = _substream(base, lanes[0] + k)
@@ -157,8 +173,8 @@ def _gust(qa: float, qc: float, cell: float, lane: float, gusts: tuple, base: np
     sum (lanes ``lane`` cells wide), blended with the next lane's in a ramp between them (as
     the turbulence's blocks are), each read from the lattice ``ys`` (:func:`_gust_lattice`)
     where there is one, else summed here."""
-    _, g, per_m, sr, sd, step = gusts
-    k0, k1, w0, w1 = _blocks(qc / lane, 0.5 * RAMP / lane)
+    _, g, per_m, sr, sd, step, _ = gusts
+    k0, k1, w0, w1 = _blocks(qc / lane, 0.5 / GUST_LANE)
     if ys.shape[0]:
         f = qa * (cell / step)
         # (within the lattice even where the span's ends round otherwise here)
@@ -219,13 +235,14 @@ def _sample_points(p, out, frame, cell, travel, evolution, table, inv_top, sigma
     frame, over the cell size. The turbulence reads them through its blocks
     (:func:`~.turbulence._eddies`). The gusts read the along-wind one and the across-wind
     one's lane: gusts are fronts across their lane, so each lane's sum is a function of the
-    along-wind coordinate only, evaluated on a 1-D lattice of spacing GUST_RISE·L/8 fixed in
-    space over the points' span and interpolated (relative error < 0.5 %), or directly at
-    each point where the lanes' lattices would cost more than the points (:func:`_gust`).
+    along-wind coordinate only, evaluated on a 1-D lattice of spacing an eighth of the rise
+    width fixed in space over the points' span and interpolated (relative error < 0.5 %), or
+    directly at each point where the lanes' lattices would cost more than the points
+    (:func:`_gust`).
     """
     m = frame * (1.0 / cell)
-    strength, _, _, _, _, step = gusts
-    lane = GUST_LANE * _CELLS_PER_L
+    strength, _, _, _, _, step, lane = gusts
+    lane /= cell
     lanes, first, ys = (0, 0), 0, np.empty((0, 0))
     if strength > 0.0 and p.shape[0]:
         lo = hi = _along(p, 0, m)
@@ -339,8 +356,9 @@ class PhysicalWind(WindField):
     of ``t`` between changes. The turbulence reads one tile of 16 L × 3 L × 4 L (along, up,
     across the wind) through blocks that give each part of the landscape its own place in it
     (``turbulence.py``): it never repeats across the ground or in time (up it repeats every
-    3 L). Gusts come in lanes 3 L wide across the wind, each lane its own. Turning the wind
-    rotates the field about the world origin.
+    3 L). Gusts are the surface layer's eddies, not the canopy's: tens of metres long
+    (``gust_length``) and in lanes 1.5 times that wide across the wind, each lane its own.
+    Turning the wind rotates the field about the world origin.
     """
 
     Params = PhysicalParams
@@ -361,6 +379,14 @@ class PhysicalWind(WindField):
     @length_scale.setter
     def length_scale(self, value) -> None:
         self._set(length_scale=value)
+
+    @property
+    def gust_length(self) -> float:
+        """The gusts' along-wind length scale L_g, m: the atmospheric surface layer's integral
+        scale at the canopy top (:data:`SURFACE_SCALE`; 22 m over a 2.5 m canopy, 40 m over a
+        10 m one), at least ``length_scale``. A gust rises over 0.5 L_g and decays over
+        1.5 L_g (Gaussian widths) and its lane is 1.5 L_g wide."""
+        return max(self.length_scale, _surface_scale(self.canopy_height))
 
     @property
     def canopy_height(self) -> float:
