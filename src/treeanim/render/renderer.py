@@ -305,10 +305,9 @@ class Renderer:
         fitted to the view and drawn with the trees in the sun's view of it, less twigs far
         thinner than its texel. A lone tree is drawn whole, its shadow map fitted to it."""
         self._shadow_runs = None
-        if not self.tree_pass.many:
-            self.tree_pass.view()  # the frame's counts start afresh
-            return
         self.tree_pass.view(vp, camera.eye, pixels_per_metre)
+        if not self.tree_pass.many:
+            return
         if self.scene.shadow:
             reach = max(VIEW_REACH * camera.distance, MIN_REACH)
             self.shadow.follow(view_slice(vp, camera.eye, camera.forward, reach))

@@ -16,11 +16,9 @@ from scipy.spatial import ConvexHull, QhullError
 
 from ..model.tree import Tree
 from .culling import SWAY_MARGIN
-from .lod import coarse_laminas, coarse_tubes
+from .lod import clump_copies, coarse_laminas, coarse_tubes
 from .mesh import (
-    BLADE_CLUMP,
     MATERIAL_BARK,
-    MATERIAL_BLADE,
     MATERIAL_LAMINA,
     MATERIAL_PETIOLE,
     VERTEX_ATTRIBUTES,
@@ -68,13 +66,9 @@ def shadow_indices(mesh: TreeMesh, tree: Tree, coarse_bark: bool = False) -> np.
     (T', 3) uint32
         Indices into ``mesh.vertices``.
     """
-    material = mesh.material
-    first = material[mesh.indices[:, 0]]
-    obj = np.repeat(np.arange(len(mesh.object_triangles)), mesh.object_triangles)
-    copy = (first == MATERIAL_BLADE) & (np.arange(len(first)) - mesh.object_triangle_start[obj]
-                                        >= mesh.object_triangles[obj] // BLADE_CLUMP)
+    first = mesh.material[mesh.indices[:, 0]]
     bark = coarse_bark & (first == MATERIAL_BARK)
-    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA) & ~copy & ~bark],
+    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA) & ~clump_copies(mesh) & ~bark],
             coarse_laminas(mesh, tree, SHADOW_LAMINA_CORNERS), coarse_tubes(mesh) if coarse_bark else np.zeros((0, 3), np.uint32)]
     return np.ascontiguousarray(np.concatenate(keep), dtype=np.uint32)
 
