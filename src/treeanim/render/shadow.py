@@ -27,7 +27,7 @@ from .mesh import (
     TreeMesh,
 )
 from .shaders import load_program
-from .shadow_view import EDGE_FADE, clip_convex, view_window, window_on_ground
+from .shadow_view import EDGE_FADE, clip_convex, seen_corners, view_window, window_on_ground
 from .uniforms import UniformBlock
 
 #: Attributes the shadow pass reads; the rest of each vertex is skipped.
@@ -235,6 +235,7 @@ class ShadowMap:
         self.texel = 1.0
         self.footprint = np.zeros((0, 2))
         self.window: tuple | None = None  # :meth:`follow`'s window; None: the whole tree's map
+        self.seen = True  # whether the view sees anything the map can shade (:meth:`follow`)
         self._fitted: tuple | None = None
         self.block.set(light_view_proj=self.matrix, shadow_texel=self.texel, shadow_on=1, shadow_edge=0.0)
         self.clear()
@@ -257,7 +258,7 @@ class ShadowMap:
         reach = grow + pad + FOOTPRINT_TEXELS * texel / self._sun[1]  # texels long on the ground
         self._whole = matrix, texel, ground_footprint(sun, points, reach)
         self._receivers = _receivers(self._sun, *self._box)
-        self.window = None
+        self.window, self.seen = None, True
         self._show(*self._whole, edge=0.0)
 
     def _show(self, matrix: np.ndarray, texel: float, footprint: np.ndarray, edge: float) -> None:
@@ -268,9 +269,12 @@ class ShadowMap:
         """Fit the map to what a view sees (after :meth:`fit`): the receivers inside
         ``slice_planes`` (:func:`~.shadow_view.view_slice`), snapped to the texel grid
         (:func:`~.shadow_view.view_window`), shadows fading out at its border; or the whole
-        tree's map where that is no larger."""
+        tree's map where that is no larger. Where the view sees none of the receivers,
+        :attr:`seen` is False: no caster need be drawn."""
         basis = sun_basis(self._sun)
-        window = view_window(basis, self._receivers, slice_planes, self.size, self._extent)
+        corners = seen_corners(self._receivers, slice_planes)
+        self.seen = bool(len(corners))
+        window = view_window(basis, corners, self.size, self._extent) if self.seen else self.window
         if window == self.window:
             return
         self.window = window
