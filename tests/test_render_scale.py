@@ -225,7 +225,7 @@ def test_far_grass_is_drawn_one_blade_a_clump_and_keeps_its_look(offscreen, mead
     blades together: the meadow's colour, block by block, stays far closer to the full clumps'
     than the grass's own mark on the ground is large."""
     r = load(offscreen, meadow)
-    cam = OrbitCamera(target=(0.0, 0.0, 0.0), distance=12.0, elevation=60.0)
+    cam = OrbitCamera(target=(0.0, 0.0, 0.0), distance=12.0, elevation=35.0)
     assert passes_module.blade_band(r.tree_pass.blade, pixels_per_metre(cam))[1] < 12.0 - 4.0  # all beyond it
     far = render(offscreen, cam)
     one = r.drawn["triangles"]
@@ -234,7 +234,7 @@ def test_far_grass_is_drawn_one_blade_a_clump_and_keeps_its_look(offscreen, mead
     assert 3 * one == r.drawn["triangles"]  # a clump is three blades
     ground = render_background(offscreen, r, cam)
     mark, err = np.abs(blocks(full) - blocks(ground)).mean(), np.abs(blocks(far) - blocks(full)).mean()
-    assert mark > 0.1 and err < 0.5 * mark
+    assert mark > 0.1 and err < 0.45 * mark  # copies dropped, the blade not widened: 0.57
 
 
 def test_the_switch_to_one_blade_a_clump_does_not_pop(offscreen, meadow, monkeypatch):
