@@ -48,9 +48,10 @@ def shader_source(name: str) -> str:
 
 def constants_glsl() -> str:
     """GLSL constants generated from Python: the materials and parts of
-    :mod:`treeanim.render.mesh` (``PART_`` + name, numbered in order), ``DEPTH_THIN``, ``CLUMP_WIDTH`` (:mod:`treeanim.render.lod`),
-    ``LEAF_ALBEDO_SCALE`` (:mod:`treeanim.render.leaf_maps`) and
-    the colours of :mod:`treeanim.render.palette` (sRGB, as ``C_`` + name)."""
+    :mod:`treeanim.render.mesh` (``PART_`` + name, numbered in order), ``DEPTH_THIN``,
+    ``CLUMP_WIDTH`` (:mod:`treeanim.render.lod`), ``LEAF_ALBEDO_SCALE``
+    (:mod:`treeanim.render.leaf_maps`) and the colours of :mod:`treeanim.render.palette` (sRGB,
+    as ``C_`` + name)."""
     from . import leaf_maps, lod, mesh, palette
 
     names = ("BARK", "PETIOLE", "LAMINA", "BLADE")
