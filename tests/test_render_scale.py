@@ -284,6 +284,20 @@ def test_a_view_that_sees_nothing_the_map_shades_draws_no_casters(offscreen, nea
     assert r.shadow.seen and r.drawn["shadow_triangles"] > 0
 
 
+def test_a_lone_tree_behind_the_camera_casts_nothing(offscreen, tree):
+    r = load(offscreen, tree)
+    render(offscreen, OrbitCamera(target=(0.0, 1.0, 0.0), distance=6.0, elevation=10.0))
+    assert r.drawn["shadow_triangles"] > 0
+    cam = OrbitCamera(target=(0.0, 1.5, 40.0), distance=8.0, azimuth=180.0, elevation=5.0)  # looking away
+    img = render(offscreen, cam)
+    assert r.drawn["shadow_triangles"] == 0
+    r.scene.shadow = False
+    try:
+        assert np.array_equal(img, render(offscreen, cam))
+    finally:
+        r.scene.shadow = True
+
+
 def test_an_offline_render_simulates_a_scene_at_the_viewers_detail(tmp_path, near_grove):
     """The trees of a scene far from the camera step coarse, as the viewer steps them (the
     picture is drawn by the same renderer: culled, far trees coarse)."""

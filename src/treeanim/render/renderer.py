@@ -35,6 +35,7 @@ import numpy as np
 
 from ..model.tree import Tree
 from .camera import OrbitCamera
+from .culling import frustum_planes
 from .lod import THIN_CASTER_TEXELS, caster_classes
 from .mesh import TreeMesh, build_mesh
 from .passes import BackgroundCache, GroundPass, OverlayPass, SkyPass, TreePass, release_all
@@ -305,10 +306,12 @@ class Renderer:
         fitted to the view and drawn with the trees in the sun's view of it, less twigs far
         thinner than its texel (none where the view sees nothing the map shades). A lone tree is
         drawn whole (its grass: the squares in view, far clumps one blade), its shadow map
-        fitted to it."""
+        fitted to it, and drawn where the view sees anything it shades."""
         self._shadow_runs = None
         self.tree_pass.view(vp, camera.eye, pixels_per_metre)
         if not self.tree_pass.many:
+            if self.scene.shadow and not self.shadow.sees(frustum_planes(vp)):
+                self._shadow_runs = []
             return
         if self.scene.shadow:
             reach = max(VIEW_REACH * camera.distance, MIN_REACH)

@@ -285,6 +285,11 @@ class ShadowMap:
         footprint = clip_convex(self._whole[2], window_on_ground(basis, window))
         self._show(matrix, side / self.size, footprint, edge=EDGE_FADE)
 
+    def sees(self, planes: np.ndarray) -> bool:
+        """Whether the volume ``planes`` (6, 4) keep (a view's :func:`~.culling.frustum_planes`)
+        holds any of what the map shades (after :meth:`fit`)."""
+        return bool(len(seen_corners(self._receivers, planes)))
+
     def enable(self, on: bool) -> None:
         """Shadows on (the map drawn each frame by :meth:`draw`) or off (the map cleared, its
         lookups everything lit)."""
