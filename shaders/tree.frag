@@ -70,8 +70,9 @@ float dither4(vec2 pixel) {
 void main() {
 #if LOD_FADE != 0
     // A leaf or branch in the hand-over band: its full mesh keeps the pixels whose threshold is
-    // at least its fade, its coarse mesh the others, so between them it is whole.
-    if ((dither4(gl_FragCoord.xy) >= v_fade) != (LOD_FADE == 1)) discard;
+    // at least its fade, its coarse mesh the others, so between them it is whole. (Blades hand
+    // over by weight: below.)
+    if (PART != PART_BLADES && (dither4(gl_FragCoord.xy) >= v_fade) != (LOD_FADE == 1)) discard;
 #endif
     if (PART == PART_BARK && !gl_FrontFacing) discard;  // a closed tube's far side; a thin twig's, flat
     vec3 n = normalize(v_normal);
@@ -97,6 +98,11 @@ void main() {
     // A thin twig or blade: its true width filtered by a tent one pixel either side (pixels
     // a column apart then sum to its width, wherever it falls between them).
     float cover = PART == PART_LEAVES || v_half < 0.0 ? 1.0 : tent_integral(v_edge + v_half) - tent_integral(v_edge - v_half);
+    // A far clump's copies fade out as its simulated blade widens (tree.vert).
+    if (PART == PART_BLADES && LOD_FADE == 1) {
+        cover *= 1.0 - v_fade;
+        if (cover <= 0.0) discard;
+    }
     float air = PART == PART_BLADES ? v_haze : haze(v_world);
     f_color = vec4(to_display(apply_haze(c, v_world, air)).rgb, cover);
 }

@@ -4,6 +4,8 @@
 // with only its own code: a software rasteriser runs both sides of every branch. LOD_FADE
 // (leaves and bark of a scene): 0 drawn whole; 1 the full mesh and 2 the coarse one, each
 // keeping its share of the pixels of a leaf or branch in the hand-over band (tree.frag).
+// Blades: 1 a clump's copies, fading out across the grass's band; 2 its simulated blade,
+// widening to stand for the clump (render/lod.py).
 
 #include "uniforms.glsl"
 #include "skin.glsl"
@@ -69,9 +71,11 @@ void main() {
         return;
     }
     // A scene's leaf or branch in the band where its tree hands over from the full mesh to the
-    // coarse one (render/lod.py): how far in, from its node's distance (one for a whole leaf).
-    v_fade = LOD_FADE == 0 ? 0.0 : clamp((distance(node_position(in_ids.x), u_camera_pos) - u_lod_band.x)
-                                         / (u_lod_band.y - u_lod_band.x), 0.0, 1.0);
+    // coarse one, a blade in the grass's (render/lod.py): how far in, from its node's distance
+    // (one for a whole leaf).
+    vec2 band = PART == PART_BLADES ? u_blade_band : u_lod_band;
+    v_fade = LOD_FADE == 0 ? 0.0 : clamp((distance(node_position(in_ids.x), u_camera_pos) - band.x)
+                                         / (band.y - band.x), 0.0, 1.0);
     mat3 R;
     vec3 centre;
     skin_transform(in_ids.x, in_ids.y, in_extra.x, in_curve, in_offset, in_tangent0, in_tangent1, v_world, R, centre);
@@ -98,6 +102,8 @@ void main() {
             vec3 side = cross(axis, u_camera_pos - centre);
             float k = dot(across, side) / max(metres * length(side), 1e-30);  // -1 .. 1 across the axis
             float half_px = PART == PART_BARK ? px : abs(k) * px;            // a blade: as seen
+            // a far clump's simulated blade: as wide as its clump's blades together
+            if (PART == PART_BLADES && LOD_FADE == 2) half_px *= mix(1.0, CLUMP_WIDTH, v_fade);
             float edge = PART == PART_BARK ? k * (px + 1.0) : sign(k) * (half_px + 1.0);
             if (px > 0.0 && length(side) > 0.0) {
                 v_world = centre + normalize(side) * (edge * metres / px);

@@ -1,6 +1,6 @@
-"""A scene drawn at scale (docs/design.md §17, Drawing): trees out of view not drawn, far trees
-with fewer triangles and no pop, the sun's shadow map fitted to the view. Real renders through
-EGL."""
+"""A scene drawn at scale (docs/design.md §17, Drawing): trees and grass out of view not drawn,
+far trees and grass with fewer triangles and no pop, the sun's shadow map fitted to the view and
+drawn with the casters it needs; the offline render as the viewer. Real renders through EGL."""
 
 from __future__ import annotations
 
@@ -8,17 +8,21 @@ import numpy as np
 import pytest
 from scipy.ndimage import uniform_filter
 
-from conftest import rest_pose, small_tree
+import treeanim as ta
+from conftest import grass_patch, rest_pose, small_tree
 from treeanim.model.scene import make_scene
+from treeanim.offline.render import RenderJob, run_render
+from treeanim.offline.target import Target
+from treeanim.physics.lod import choose_detail, tree_extents
 from treeanim.render import passes as passes_module
 from treeanim.render import renderer as renderer_module
 from treeanim.render import shadow as shadow_module
-from treeanim.render.camera import OrbitCamera
+from treeanim.render.camera import OrbitCamera, framed_camera
 from treeanim.render.culling import TreeOrder, frustum_planes
 from treeanim.render.lod import coarse_tubes
 from treeanim.render.mesh import build_mesh
 from treeanim.render.shadow import sun_basis
-from treeanim.render.shadow_view import view_slice, view_window
+from treeanim.render.shadow_view import seen_corners, view_slice, view_window
 
 W, H = 320, 180
 
@@ -28,6 +32,19 @@ def grove(pitch: float) -> "Scene":  # noqa: F821
     tree = small_tree()
     where = [(pitch * (i - 2), 0.0, pitch * (j - 2)) for i in range(5) for j in range(5)]
     return make_scene([tree] * 25, where, [37.0 * k for k in range(25)])
+
+
+def blocks(img: np.ndarray, n: int = 10) -> np.ndarray:
+    """The mean colour of each n × n block of pixels."""
+    h, w = img.shape[0] // n * n, img.shape[1] // n * n
+    return img[:h, :w].reshape(h // n, n, w // n, n, 3).mean(axis=(1, 3))
+
+
+@pytest.fixture(scope="module")
+def meadow():
+    """25 grass patches of 60 blades, 1 m apart: a 5 m meadow."""
+    where = [(1.0 * (i - 2), 0.0, 1.0 * (j - 2)) for i in range(5) for j in range(5)]
+    return make_scene([grass_patch()] * 25, where, [37.0 * k for k in range(25)])
 
 
 @pytest.fixture(scope="module")
@@ -57,6 +74,10 @@ def all_visible(monkeypatch):
 
 def no_lod(monkeypatch):
     monkeypatch.setattr(passes_module, "lod_band", lambda leaf, ppm: (1e30, 2e30))
+
+
+def pixels_per_metre(cam):
+    return 0.5 * H / np.tan(np.radians(cam.fov_y / 2))
 
 
 def test_trees_out_of_view_are_not_drawn(offscreen, near_grove):
@@ -175,7 +196,7 @@ def test_the_view_window_holds_what_the_view_sees_of_the_receivers():
     cam = OrbitCamera(target=(3.0, 1.2, -2.0), distance=9.0, azimuth=130.0, elevation=3.0)
     vp = cam.view_projection(W, H)
     planes = view_slice(vp, cam.eye, cam.forward, 14.0)
-    x0, x1, y0, y1 = view_window(basis, (lo, hi), planes, 1024, 200.0)
+    x0, x1, y0, y1 = view_window(basis, seen_corners((lo, hi), planes), 1024, 200.0)
     assert x1 - x0 < 30.0
     p = lo + (hi - lo) * rng.random((200_000, 3))
     seen = p[np.all(p @ planes[:, :3].T + planes[:, 3] >= 0, axis=1)]
@@ -197,3 +218,95 @@ def test_twigs_far_thinner_than_a_shadow_texel_cast_no_shadow_and_are_not_missed
     every = render(offscreen, cam)
     assert cast < 0.7 * r.drawn["shadow_triangles"]
     assert np.abs(img - every).mean() < 0.05 and np.percentile(np.abs(img - every).max(axis=2), 99.9) < 16
+
+
+def test_far_grass_is_drawn_one_blade_a_clump_and_keeps_its_look(offscreen, meadow, monkeypatch):
+    """Beyond the grass's band a clump is its simulated blade alone, drawn as wide as the clump's
+    blades together: the meadow's colour, block by block, stays far closer to the full clumps'
+    than the grass's own mark on the ground is large."""
+    r = load(offscreen, meadow)
+    cam = OrbitCamera(target=(0.0, 0.0, 0.0), distance=12.0, elevation=35.0)
+    assert passes_module.blade_band(r.tree_pass.blade, pixels_per_metre(cam))[1] < 12.0 - 4.0  # all beyond it
+    far = render(offscreen, cam)
+    one = r.drawn["triangles"]
+    monkeypatch.setattr(passes_module, "blade_band", lambda width, ppm: (1e30, 2e30))
+    full = render(offscreen, cam)
+    assert 3 * one == r.drawn["triangles"]  # a clump is three blades
+    ground = render_background(offscreen, r, cam)
+    mark, err = np.abs(blocks(full) - blocks(ground)).mean(), np.abs(blocks(far) - blocks(full)).mean()
+    assert mark > 0.1 and err < 0.45 * mark  # copies dropped, the blade not widened: 0.57
+
+
+def test_the_switch_to_one_blade_a_clump_does_not_pop(offscreen, meadow, monkeypatch):
+    """The grass's band swept over the meadow from a still camera: each step fades the copies a
+    little and widens the simulated blades a little, where a switch without the band drops two
+    blades of three at once."""
+    r = load(offscreen, meadow)
+    cam = OrbitCamera(target=(0.0, 0.2, 0.0), distance=5.0, elevation=10.0)
+    near, far = passes_module.blade_band(r.tree_pass.blade, pixels_per_metre(cam))
+
+    def sweep(band):
+        frames, triangles = [], []
+        for s in np.linspace(0.3, 2.0, 35):
+            monkeypatch.setattr(passes_module, "blade_band", lambda width, ppm: band(s))
+            frames.append(render(offscreen, cam))
+            triangles.append(r.drawn["triangles"])
+        return max(uniform_filter(np.abs(b - a).max(axis=2), 7).max() for a, b in zip(frames, frames[1:])), triangles
+
+    faded, triangles = sweep(lambda s: (near * s, far * s))
+    switched, _ = sweep(lambda s: (far * s - 1e-3, far * s))
+    assert triangles[0] < 0.5 * triangles[-1]  # the band swept past the meadow
+    assert faded < 0.5 * switched and faded < 12.0
+
+
+def test_a_lone_meadow_out_of_view_is_not_drawn(offscreen, grass):
+    """A lone tree is drawn whole, but its grass square by square of the ground, those in view."""
+    r = load(offscreen, grass)
+    render(offscreen, OrbitCamera(target=(0.0, 0.2, 0.0), distance=3.0, elevation=20.0))
+    assert r.drawn["triangles"] == r.tree_pass.ranges["BLADES"].total // 3 + r.tree_pass.ranges["BLADE_COPIES"].total // 3
+    render(offscreen, OrbitCamera(target=(0.0, 0.5, 6.0), distance=3.0, azimuth=180.0, elevation=5.0))  # looking away
+    assert r.drawn["triangles"] == 0
+
+
+def test_a_view_that_sees_nothing_the_map_shades_draws_no_casters(offscreen, near_grove):
+    r = load(offscreen, near_grove)
+    cam = OrbitCamera(target=(0.0, 1.5, 26.0), distance=8.0, azimuth=180.0, elevation=5.0)  # from its edge, looking out
+    img = render(offscreen, cam)
+    assert r.drawn["trees"] == 0 and r.drawn["shadow_triangles"] == 0 and not r.shadow.seen
+    r.scene.shadow = False
+    try:
+        lit = render(offscreen, cam)
+    finally:
+        r.scene.shadow = True
+    assert np.array_equal(img, lit)
+    # Turned round to face the grove: the casters in the sun's view of what it sees, again.
+    render(offscreen, OrbitCamera(target=(0.0, 1.5, 4.0), distance=8.0, azimuth=0.0, elevation=5.0))
+    assert r.shadow.seen and r.drawn["shadow_triangles"] > 0
+
+
+def test_a_lone_tree_behind_the_camera_casts_nothing(offscreen, tree):
+    r = load(offscreen, tree)
+    render(offscreen, OrbitCamera(target=(0.0, 1.0, 0.0), distance=6.0, elevation=10.0))
+    assert r.drawn["shadow_triangles"] > 0
+    cam = OrbitCamera(target=(0.0, 1.5, 40.0), distance=8.0, azimuth=180.0, elevation=5.0)  # looking away
+    img = render(offscreen, cam)
+    assert r.drawn["shadow_triangles"] == 0
+    r.scene.shadow = False
+    try:
+        assert np.array_equal(img, render(offscreen, cam))
+    finally:
+        r.scene.shadow = True
+
+
+def test_an_offline_render_simulates_a_scene_at_the_viewers_detail(tmp_path, near_grove):
+    """The trees of a scene far from the camera step coarse, as the viewer steps them (the
+    picture is drawn by the same renderer: culled, far trees coarse)."""
+    w, h = W, H
+    sim = ta.Simulation(near_grove)
+    job = RenderJob(Target("still", tmp_path / "grove.png"), w, h, fps=10.0, seconds=0.1, distance=120.0,
+                    samples=0, quiet=True)
+    run_render(job, near_grove, sim)
+    cam = framed_camera(near_grove, w, h, distance=120.0)
+    focal = h / (2.0 * np.tan(np.radians(cam.fov_y) / 2.0))
+    expected = choose_detail(cam.eye, *tree_extents(near_grove), focal)
+    assert expected.min() > 0 and np.array_equal(sim.detail, expected)

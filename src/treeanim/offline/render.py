@@ -2,8 +2,11 @@
 frames or one PNG still (:func:`run_render`).
 
 Everything renders through :class:`treeanim.render.offscreen.OffscreenRenderer` (EGL, Mesa
-llvmpipe where there is no GPU). Ctrl-C stops after the current frame and keeps what was
-rendered (:class:`StopRequest`); the sinks (:mod:`.sinks`) write every file safely.
+llvmpipe where there is no GPU), as the viewer draws: a scene's trees out of view culled, far
+ones coarse (docs/design.md §17, Drawing), and simulated at the detail the viewer would step
+them at from the same camera (:func:`viewer_detail`). Ctrl-C stops after the current frame and
+keeps what was rendered (:class:`StopRequest`); the sinks (:mod:`.sinks`) write every file
+safely.
 """
 
 from __future__ import annotations
@@ -17,7 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import GLUnavailable
-from ..render.camera import framed_camera
+from ..model.scene import object_trees
+from ..physics.lod import choose_detail, tree_extents
+from ..render.camera import OrbitCamera, framed_camera
 from .sinks import FRAME_NAME, SINKS, write_png
 from .target import Target
 
@@ -106,6 +111,16 @@ class RenderJob:
         return first, int(round(self.seconds * self.fps))
 
 
+def viewer_detail(sim, tree, camera: OrbitCamera, height: int) -> None:
+    """Simulate a scene's trees at the detail the viewer steps them at from ``camera`` in a
+    picture ``height`` pixels high (:func:`~treeanim.physics.lod.choose_detail`: by each tree's
+    height on the screen; a tree holding a pull stays whole); a lone tree, or the paper's
+    model, is left whole."""
+    if int(object_trees(tree).max(initial=0)) > 0 and sim.model == "tree":
+        focal = height / (2.0 * np.tan(np.radians(camera.fov_y) / 2.0))
+        sim.set_detail(choose_detail(camera.eye, *tree_extents(tree), focal))
+
+
 @dataclass
 class RenderResult:
     """What :func:`run_render` did.
@@ -154,6 +169,7 @@ def run_render(job: RenderJob, tree, sim, log=print) -> RenderResult:
         off.load(tree)
         cam = framed_camera(tree, job.width, job.height, job.azimuth, job.elevation, job.distance,
                             present=sim.shown)
+        viewer_detail(sim, tree, cam, job.height)
 
         def shoot() -> np.ndarray:
             off.update(sim.positions, sim.rotations, sim.shown)

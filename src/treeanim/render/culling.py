@@ -17,6 +17,8 @@ from ..model.tree import Tree
 #: A tree's sphere grows by this fraction of its height for sway, and the shadow map's box round
 #: a lone tree by this fraction of its size (:meth:`~.shadow.ShadowMap.fit`).
 SWAY_MARGIN = 0.15
+#: The grass is drawn in squares of the ground this many metres a side (:func:`blade_cells`).
+BLADE_CELL = 2.0
 
 
 def morton_order(xz: np.ndarray) -> np.ndarray:
@@ -33,7 +35,7 @@ def morton_order(xz: np.ndarray) -> np.ndarray:
     return np.argsort(code, kind="stable")
 
 
-def tree_spheres(tree: Tree, pad: float) -> tuple[np.ndarray, np.ndarray]:
+def tree_spheres(tree: Tree, pad: float, groups: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Each placed tree's bounding sphere at rest, grown for its surface and its sway.
 
     Parameters
@@ -42,16 +44,20 @@ def tree_spheres(tree: Tree, pad: float) -> tuple[np.ndarray, np.ndarray]:
         A scene (or one tree: one sphere).
     pad : float
         How far the surface reaches beyond the nodes (metres).
+    groups : (M,) int or None
+        The group of each object, when not its tree (:func:`~treeanim.model.scene.object_trees`):
+        a sphere a group, round its objects' nodes; objects in group -1 belong to none.
 
     Returns
     -------
     centres : (K, 3) float
     radii : (K,) float
-        The sphere round tree k's nodes at rest (about its box's centre), grown by ``pad`` and by
-        :data:`SWAY_MARGIN` of the tree's height.
+        The sphere round group k's nodes at rest (about its box's centre), grown by ``pad`` and
+        by :data:`SWAY_MARGIN` of the group's height.
     """
-    P = np.asarray(tree.rest_positions, float)
-    owner = np.repeat(object_trees(tree), tree.object_count)
+    owner = np.repeat(object_trees(tree) if groups is None else groups, tree.object_count)
+    P = np.asarray(tree.rest_positions, float)[owner >= 0]
+    owner = owner[owner >= 0]
     K = int(owner.max(initial=-1)) + 1
     lo = np.full((K, 3), np.inf)
     hi = np.full((K, 3), -np.inf)
@@ -61,6 +67,17 @@ def tree_spheres(tree: Tree, pad: float) -> tuple[np.ndarray, np.ndarray]:
     radii = np.zeros(K)
     np.maximum.at(radii, owner, np.linalg.norm(P - centres[owner], axis=1))
     return centres, radii + pad + SWAY_MARGIN * (hi[:, 1] - lo[:, 1])
+
+
+def blade_cells(tree: Tree, side: float = BLADE_CELL) -> np.ndarray:
+    """(M,) int: the square of the ground, ``side`` metres a side, each grass blade roots in,
+    numbered 0, 1, ... over the squares with blades; -1 for every other object."""
+    blade = np.asarray(tree.kind) == "blade"
+    cells = np.full(tree.n_objects, -1, np.int64)
+    if blade.any():
+        root = np.floor(np.asarray(tree.rest_positions)[tree.object_start[blade]][:, [0, 2]] / side)
+        cells[blade] = np.unique(root, axis=0, return_inverse=True)[1].reshape(-1)
+    return cells
 
 
 def frustum_planes(view_proj: np.ndarray) -> np.ndarray:
@@ -148,21 +165,24 @@ class TreeOrder:
         The tree's mesh.
     pad : float
         How far the surface reaches beyond the nodes (:func:`tree_spheres`).
+    groups : (M,) int or None
+        Groups of objects to order in place of the trees (:func:`tree_spheres`; the grass's
+        :func:`blade_cells`): then only their objects' triangles can be regrouped.
 
     Attributes
     ----------
     centres : (K, 3) float
     radii : (K,) float
-        The trees' spheres, in draw order.
+        The trees' (groups') spheres, in draw order.
     """
 
-    def __init__(self, tree: Tree, mesh, pad: float) -> None:
-        centres, radii = tree_spheres(tree, pad)
+    def __init__(self, tree: Tree, mesh, pad: float, groups: np.ndarray | None = None) -> None:
+        centres, radii = tree_spheres(tree, pad, groups)
         order = morton_order(centres[:, [0, 2]])
         self.centres, self.radii = centres[order], radii[order]
         self.rank = np.empty(len(order), np.int64)
         self.rank[order] = np.arange(len(order))
-        self._vertex_tree = object_trees(tree)[mesh.object]
+        self._vertex_tree = (object_trees(tree) if groups is None else groups)[mesh.object]
 
     @property
     def n_trees(self) -> int:

@@ -1,12 +1,19 @@
 """Fewer triangles: a lamina outlined by a few of its corners and no petiole, for the sun's
 shadow map (always) and for the trees of a scene far from the camera; tubes of half the sides,
 for a scene's far trees and shadow map; a scene's shadow casters by thickness, for a map to
-leave out twigs far thinner than its texel (docs/design.md §17, Drawing).
+leave out twigs far thinner than its texel; far grass one blade a clump (docs/design.md §17,
+Drawing).
 
 A far tree's leaves and bark hand over from the full mesh to the coarse one across a band of
 distance, node by node: each pixel of a leaf or branch in the band is drawn by one of the two,
 chosen by a 4 × 4 ordered dither against its node's place in the band (``LOD_FADE`` in
 ``shaders/tree.*``), so it is whole all the way and the switch does not pop.
+
+Far grass hands over the same way, but by weight, not by pixels: a blade there is a soft line
+under a pixel wide, whose pixels hold the share of them it covers. Across the grass's band a
+clump's copies (:func:`clump_copies`) fade out, node by node, and its simulated blade widens to
+:data:`CLUMP_WIDTH` times its width, so the clump's lines keep about their weight on screen;
+beyond the band the copies are not drawn.
 """
 
 from __future__ import annotations
@@ -15,7 +22,7 @@ import numpy as np
 
 from ..model.lamina import ear_clip
 from ..model.tree import BRANCH_SIDES, Tree
-from .mesh import MATERIAL_BARK, MATERIAL_LAMINA, TreeMesh
+from .mesh import BLADE_CLUMP, MATERIAL_BARK, MATERIAL_BLADE, MATERIAL_LAMINA, TreeMesh
 
 #: Corners of a lamina's outline kept for a far tree's leaves: six triangles, at a size where
 #: the leaf's teeth and curve are below a pixel.
@@ -31,6 +38,14 @@ CASTER_DIAMETERS = (0.04, 0.02, 0.01, 0.005)
 LOD_COARSE_PIXELS = 8.0
 #: ... its full ones where longer than this, and both, dithered, between.
 LOD_FULL_PIXELS = 12.0
+#: Grass draws its clumps whole where a blade is wider than this on screen (px), one blade a
+#: clump where narrower than this, and hands over between (:func:`blade_band`).
+BLADE_FULL_PIXELS = 1.0
+BLADE_COARSE_PIXELS = 0.5
+#: ... where its simulated blade is drawn this many times as wide, for its clump's blades
+#: together: the copies are shorter and overlap, and seen low the grass saturates (a meadow all
+#: one blade a clump is nearest the full clumps' at 1.5 seen from 10° and 35° up, at 2 from 60°).
+CLUMP_WIDTH = 1.5
 
 
 def coarse_laminas(mesh: TreeMesh, tree: Tree, corners: int) -> np.ndarray:
@@ -63,25 +78,49 @@ def median_leaf(tree: Tree) -> float:
     return float(np.median(lengths)) if len(lengths) else 0.0
 
 
-def lod_band(leaf: float, pixels_per_metre: float) -> tuple[float, float]:
+def median_blade(tree: Tree) -> float:
+    """The median width of the tree's grass blades at their nodes (metres; 0 without blades)."""
+    blade = np.asarray(tree.kind)[tree.node_object] == "blade"
+    return float(np.median(np.asarray(tree.node_diameter)[blade])) if blade.any() else 0.0
+
+
+def lod_band(size: float, pixels_per_metre: float, full: float = LOD_FULL_PIXELS,
+             coarse: float = LOD_COARSE_PIXELS) -> tuple[float, float]:
     """(near, far) metres from the eye over which a scene's leaves hand over from full to
-    coarse: where a leaf ``leaf`` metres long (:func:`median_leaf`) is :data:`LOD_FULL_PIXELS`
-    and :data:`LOD_COARSE_PIXELS` long on screen.
+    coarse: where a leaf ``size`` metres long (:func:`median_leaf`) is ``full`` and ``coarse``
+    pixels long on screen.
 
     Parameters
     ----------
-    leaf : float
+    size : float
     pixels_per_metre : float
         A metre's size on screen at one metre from the eye.
+    full, coarse : float
 
     Returns
     -------
     (float, float)
-        Nothing is coarse (1e30 m) for a scene without leaves.
+        Nothing is coarse (1e30 m) where ``size`` is 0 (no leaves).
     """
-    if leaf <= 0.0:
+    if size <= 0.0:
         return 1e30, 2e30
-    return leaf * pixels_per_metre / LOD_FULL_PIXELS, leaf * pixels_per_metre / LOD_COARSE_PIXELS
+    return size * pixels_per_metre / full, size * pixels_per_metre / coarse
+
+
+def blade_band(width: float, pixels_per_metre: float) -> tuple[float, float]:
+    """(near, far) metres from the eye over which the grass hands over from whole clumps to one
+    blade a clump: where a blade ``width`` metres wide (:func:`median_blade`) is
+    :data:`BLADE_FULL_PIXELS` and :data:`BLADE_COARSE_PIXELS` wide on screen (:func:`lod_band`)."""
+    return lod_band(width, pixels_per_metre, BLADE_FULL_PIXELS, BLADE_COARSE_PIXELS)
+
+
+def clump_copies(mesh: TreeMesh) -> np.ndarray:
+    """(T,) bool over ``mesh.indices``: the triangles of the blade clumps' copies, the last
+    ``BLADE_CLUMP - 1`` of each blade's :data:`~.mesh.BLADE_CLUMP` runs of triangles (the first
+    is the simulated blade's: mesh notes)."""
+    blade = mesh.material[mesh.indices[:, 0]] == MATERIAL_BLADE
+    obj = np.repeat(np.arange(len(mesh.object_triangles)), mesh.object_triangles)
+    return blade & (np.arange(len(blade)) - mesh.object_triangle_start[obj] >= mesh.object_triangles[obj] // BLADE_CLUMP)
 
 
 def coarse_tubes(mesh: TreeMesh, step: int = LOD_TUBE_STEP) -> np.ndarray:

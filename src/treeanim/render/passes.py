@@ -25,11 +25,20 @@ import numpy as np
 
 from ..model.scene import Scene as TreeScene
 from ..model.tree import Tree
-from .culling import TreeOrder
+from .culling import TreeOrder, blade_cells
 from .ground_maps import ground_texture
 from .leaf_maps import lamina_box, leaf_texture
-from .lod import LOD_LAMINA_CORNERS, coarse_laminas, coarse_tubes, lod_band, median_leaf
-from .mesh import PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh
+from .lod import (
+    LOD_LAMINA_CORNERS,
+    blade_band,
+    clump_copies,
+    coarse_laminas,
+    coarse_tubes,
+    lod_band,
+    median_blade,
+    median_leaf,
+)
+from .mesh import MATERIAL_BLADE, PARTS, VERTEX_ATTRIBUTES, VERTEX_FORMAT, TreeMesh
 from .overlays import LINE_ATTRIBUTES, LINE_FORMAT, Overlay
 from .scene import Scene, clip_ground
 from .shaders import load_program
@@ -55,6 +64,12 @@ class TreePass:
     2) draw the full and coarse meshes of the trees in the hand-over band, dithered. A lone
     tree is one range a part, always drawn whole.
 
+    The grass lies square by square of the ground instead (:func:`~.culling.blade_cells`, a
+    lone meadow's too): its simulated blades, then its clumps' copies (:func:`~.lod.clump_copies`),
+    drawn by two programs (``LOD_FADE`` 2 and 1) that hand a far clump over to its simulated
+    blade alone (:func:`~.lod.blade_band`); the squares out of view are not drawn, nor the
+    copies of those beyond the band.
+
     Parameters
     ----------
     ctx : moderngl.Context
@@ -67,6 +82,8 @@ class TreePass:
     Attributes
     ----------
     order : TreeOrder
+    cells : TreeOrder
+        The grass's squares.
     drawn : dict
         The last frame's draws: ``trees`` in view, ``triangles`` and ``draws`` (calls).
     """
@@ -76,7 +93,10 @@ class TreePass:
         self.programs: dict[tuple[str, int], tuple[moderngl.Program, moderngl.VertexArray | None]] = {}
         self.order = TreeOrder(tree, mesh, pad)
         self.many = self.order.n_trees > 1
-        self.leaf = median_leaf(tree)
+        self.leaf, self.blade = median_leaf(tree), median_blade(tree)
+        # a square's sphere holds its clumps' copies, which stand up to about a blade's height off their roots
+        blade_tip = np.max(tree.rest_positions[np.asarray(tree.kind)[tree.node_object] == "blade", 1], initial=0.0)
+        self.cells = TreeOrder(tree, mesh, pad + float(blade_tip), blade_cells(tree))
         self.drawn = {"trees": 0, "triangles": 0, "draws": 0}
         try:
             self.block = UniformBlock(ctx, "Tree")
@@ -85,19 +105,23 @@ class TreePass:
                 self.leaf_maps = leaf_texture(ctx, tree.lamina)
             self.block.set(bark_color=bark.color, bark=(bark.furrows, bark.depth, bark.interlace, bark.lenticels),
                            lamina_box=lamina_box(tree.lamina) if self.leaf_maps is not None else (1.0, 1.0),
-                           lod_band=(1e30, 2e30))
+                           lod_band=(1e30, 2e30), blade_band=(1e30, 2e30))
             tris, self.ranges, first = [], {}, 0
-            groups = [(name, mesh.part_indices(name)) for name in PARTS]
+            blade, copies = mesh.material[mesh.indices[:, 0]] == MATERIAL_BLADE, clump_copies(mesh)
+            groups = [(name, self.order, mesh.part_indices(name)) for name in ("LEAVES", "BARK")]
+            groups += [("BLADES", self.cells, mesh.indices[blade & ~copies]), ("BLADE_COPIES", self.cells, mesh.indices[copies])]
             if self.many:
-                groups += [("COARSE_LEAVES", coarse_laminas(mesh, tree, LOD_LAMINA_CORNERS)), ("COARSE_BARK", coarse_tubes(mesh))]
-            for name, t in groups:
-                t, self.ranges[name] = self.order.group(t, first)
+                groups += [("COARSE_LEAVES", self.order, coarse_laminas(mesh, tree, LOD_LAMINA_CORNERS)),
+                           ("COARSE_BARK", self.order, coarse_tubes(mesh))]
+            for name, order, t in groups:
+                t, self.ranges[name] = order.group(t, first)
                 tris.append(t)
                 first += self.ranges[name].total
             if mesh.triangle_count:
                 self.vbo = ctx.buffer(mesh.vertices.tobytes())
                 self.ibo = ctx.buffer(np.concatenate(tris).astype(np.uint32).tobytes())
-            variants = [(name, 0) for name in PARTS] + ([(n, f) for n in ("LEAVES", "BARK") for f in (1, 2)] if self.many else [])
+            variants = [("LEAVES", 0), ("BARK", 0), ("BLADES", 1), ("BLADES", 2)]
+            variants += [(n, f) for n in ("LEAVES", "BARK") for f in (1, 2)] if self.many else []
             for name, fade in variants:
                 prog = load_program(ctx, "tree.vert", "tree.frag", defines={"PART": list(PARTS).index(name), "LOD_FADE": fade})
                 vao = None
@@ -117,22 +141,31 @@ class TreePass:
     def view(self, view_proj: np.ndarray | None = None, eye=None, pixels_per_metre: float = 0.0) -> None:
         """Which trees the next frame's draws hold: of a scene, those whose sphere reaches into
         ``view_proj``'s volume, their leaves full or coarse by their distance from the ``eye``
-        and how long a leaf is on screen (:func:`~.lod.lod_band`); None: every tree, full."""
-        n = self.order.n_trees
+        and how long a leaf is on screen (:func:`~.lod.lod_band`); the grass's squares in view,
+        their clumps whole, or one blade each, by how wide a blade is on screen
+        (:func:`~.lod.blade_band`); None: every tree and blade, full."""
+        n, m = self.order.n_trees, self.cells.n_trees
         keep, full, coarse = np.ones(n, bool), np.ones(n, bool), np.zeros(n, bool)
-        if view_proj is not None and self.many:
-            keep = self.order.visible(view_proj)
-            band = lod_band(self.leaf, pixels_per_metre)
-            self.block.set(lod_band=band)
-            d = np.linalg.norm(self.order.centres - np.asarray(eye, float), axis=1)
-            full, coarse = d + self.order.radii <= band[0], d - self.order.radii >= band[1]
+        grass, clumps = np.ones(m, bool), np.ones(m, bool)
+        band = blade = (1e30, 2e30)
+        if view_proj is not None:
+            eye = np.asarray(eye, float)
+            if self.many:
+                keep = self.order.visible(view_proj)
+                band = lod_band(self.leaf, pixels_per_metre)
+                d = np.linalg.norm(self.order.centres - eye, axis=1)
+                full, coarse = d + self.order.radii <= band[0], d - self.order.radii >= band[1]
+            grass = self.cells.visible(view_proj)
+            blade = blade_band(self.blade, pixels_per_metre)
+            clumps = np.linalg.norm(self.cells.centres - eye, axis=1) - self.cells.radii < blade[1]
+        self.block.set(lod_band=band, blade_band=blade)
         both = keep & ~(full | coarse)
         # each part's draws: (ranges, program variant, trees)
         self._draws = {"LEAVES": [("LEAVES", 0, keep & full), ("COARSE_LEAVES", 0, keep & coarse),
                                   ("LEAVES", 1, both), ("COARSE_LEAVES", 2, both)],
                        "BARK": [("BARK", 0, keep & full), ("COARSE_BARK", 0, keep & coarse),
                                 ("BARK", 1, both), ("COARSE_BARK", 2, both)],
-                       "BLADES": [("BLADES", 0, keep)]}
+                       "BLADES": [("BLADES", 2, grass), ("BLADE_COPIES", 1, grass & clumps)]}
         self.drawn = {"trees": int(keep.sum()), "triangles": 0, "draws": 0}
 
     def draw(self, *parts: str, season: float) -> None:

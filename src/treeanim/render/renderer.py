@@ -35,6 +35,7 @@ import numpy as np
 
 from ..model.tree import Tree
 from .camera import OrbitCamera
+from .culling import frustum_planes
 from .lod import THIN_CASTER_TEXELS, caster_classes
 from .mesh import TreeMesh, build_mesh
 from .passes import BackgroundCache, GroundPass, OverlayPass, SkyPass, TreePass, release_all
@@ -303,16 +304,19 @@ class Renderer:
     def _cull(self, camera: OrbitCamera, vp: np.ndarray, pixels_per_metre: float) -> None:
         """A scene's draws for this view: the trees in it, far leaves coarse, and the shadow map
         fitted to the view and drawn with the trees in the sun's view of it, less twigs far
-        thinner than its texel. A lone tree is drawn whole, its shadow map fitted to it."""
+        thinner than its texel (none where the view sees nothing the map shades). A lone tree is
+        drawn whole (its grass: the squares in view, far clumps one blade), its shadow map
+        fitted to it, and drawn where the view sees anything it shades."""
         self._shadow_runs = None
-        if not self.tree_pass.many:
-            self.tree_pass.view()  # the frame's counts start afresh
-            return
         self.tree_pass.view(vp, camera.eye, pixels_per_metre)
+        if not self.tree_pass.many:
+            if self.scene.shadow and not self.shadow.sees(frustum_planes(vp)):
+                self._shadow_runs = []
+            return
         if self.scene.shadow:
             reach = max(VIEW_REACH * camera.distance, MIN_REACH)
             self.shadow.follow(view_slice(vp, camera.eye, camera.forward, reach))
-            visible = self.tree_pass.order.visible(self.shadow.matrix)
+            visible = self.tree_pass.order.visible(self.shadow.matrix) & self.shadow.seen
             thinnest = THIN_CASTER_TEXELS * self.shadow.texel
             self._shadow_runs = [run for thickest, ranges in self._casters if thickest > thinnest for run in ranges.runs(visible)]
 

@@ -49,14 +49,16 @@ def shader_source(name: str) -> str:
 def constants_glsl() -> str:
     """GLSL constants generated from Python: the materials and parts of
     :mod:`treeanim.render.mesh` (``PART_`` + name, numbered in order), ``DEPTH_THIN``,
-    ``LEAF_ALBEDO_SCALE`` (:mod:`treeanim.render.leaf_maps`) and
-    the colours of :mod:`treeanim.render.palette` (sRGB, as ``C_`` + name)."""
-    from . import leaf_maps, mesh, palette
+    ``CLUMP_WIDTH`` (:mod:`treeanim.render.lod`), ``LEAF_ALBEDO_SCALE``
+    (:mod:`treeanim.render.leaf_maps`) and the colours of :mod:`treeanim.render.palette` (sRGB,
+    as ``C_`` + name)."""
+    from . import leaf_maps, lod, mesh, palette
 
     names = ("BARK", "PETIOLE", "LAMINA", "BLADE")
     lines = [f"const int {n} = {getattr(mesh, 'MATERIAL_' + n)};" for n in names]
     lines += [f"const int PART_{n} = {i};" for i, n in enumerate(mesh.PARTS)]
     lines.append(f"const float DEPTH_THIN = {DEPTH_THIN!r};")
+    lines.append(f"const float CLUMP_WIDTH = {lod.CLUMP_WIDTH!r};")
     lines.append(f"const float LEAF_ALBEDO_SCALE = {leaf_maps.ALBEDO_SCALE!r};")
     lines += [f"const vec3 C_{n} = vec3({r!r}, {g!r}, {b!r});" for n, (r, g, b) in palette.COLOURS.items()]
     return "\n".join(lines) + "\n"

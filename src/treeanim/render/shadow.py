@@ -16,11 +16,9 @@ from scipy.spatial import ConvexHull, QhullError
 
 from ..model.tree import Tree
 from .culling import SWAY_MARGIN
-from .lod import coarse_laminas, coarse_tubes
+from .lod import clump_copies, coarse_laminas, coarse_tubes
 from .mesh import (
-    BLADE_CLUMP,
     MATERIAL_BARK,
-    MATERIAL_BLADE,
     MATERIAL_LAMINA,
     MATERIAL_PETIOLE,
     VERTEX_ATTRIBUTES,
@@ -29,7 +27,7 @@ from .mesh import (
     TreeMesh,
 )
 from .shaders import load_program
-from .shadow_view import EDGE_FADE, clip_convex, view_window, window_on_ground
+from .shadow_view import EDGE_FADE, clip_convex, seen_corners, view_window, window_on_ground
 from .uniforms import UniformBlock
 
 #: Attributes the shadow pass reads; the rest of each vertex is skipped.
@@ -68,13 +66,9 @@ def shadow_indices(mesh: TreeMesh, tree: Tree, coarse_bark: bool = False) -> np.
     (T', 3) uint32
         Indices into ``mesh.vertices``.
     """
-    material = mesh.material
-    first = material[mesh.indices[:, 0]]
-    obj = np.repeat(np.arange(len(mesh.object_triangles)), mesh.object_triangles)
-    copy = (first == MATERIAL_BLADE) & (np.arange(len(first)) - mesh.object_triangle_start[obj]
-                                        >= mesh.object_triangles[obj] // BLADE_CLUMP)
+    first = mesh.material[mesh.indices[:, 0]]
     bark = coarse_bark & (first == MATERIAL_BARK)
-    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA) & ~copy & ~bark],
+    keep = [mesh.indices[(first != MATERIAL_PETIOLE) & (first != MATERIAL_LAMINA) & ~clump_copies(mesh) & ~bark],
             coarse_laminas(mesh, tree, SHADOW_LAMINA_CORNERS), coarse_tubes(mesh) if coarse_bark else np.zeros((0, 3), np.uint32)]
     return np.ascontiguousarray(np.concatenate(keep), dtype=np.uint32)
 
@@ -241,6 +235,7 @@ class ShadowMap:
         self.texel = 1.0
         self.footprint = np.zeros((0, 2))
         self.window: tuple | None = None  # :meth:`follow`'s window; None: the whole tree's map
+        self.seen = True  # whether the view sees anything the map can shade (:meth:`follow`)
         self._fitted: tuple | None = None
         self.block.set(light_view_proj=self.matrix, shadow_texel=self.texel, shadow_on=1, shadow_edge=0.0)
         self.clear()
@@ -263,7 +258,7 @@ class ShadowMap:
         reach = grow + pad + FOOTPRINT_TEXELS * texel / self._sun[1]  # texels long on the ground
         self._whole = matrix, texel, ground_footprint(sun, points, reach)
         self._receivers = _receivers(self._sun, *self._box)
-        self.window = None
+        self.window, self.seen = None, True
         self._show(*self._whole, edge=0.0)
 
     def _show(self, matrix: np.ndarray, texel: float, footprint: np.ndarray, edge: float) -> None:
@@ -274,9 +269,12 @@ class ShadowMap:
         """Fit the map to what a view sees (after :meth:`fit`): the receivers inside
         ``slice_planes`` (:func:`~.shadow_view.view_slice`), snapped to the texel grid
         (:func:`~.shadow_view.view_window`), shadows fading out at its border; or the whole
-        tree's map where that is no larger."""
+        tree's map where that is no larger. Where the view sees none of the receivers,
+        :attr:`seen` is False: no caster need be drawn."""
         basis = sun_basis(self._sun)
-        window = view_window(basis, self._receivers, slice_planes, self.size, self._extent)
+        corners = seen_corners(self._receivers, slice_planes)
+        self.seen = bool(len(corners))
+        window = view_window(basis, corners, self.size, self._extent) if self.seen else self.window
         if window == self.window:
             return
         self.window = window
@@ -286,6 +284,11 @@ class ShadowMap:
         matrix, side = light_view_projection(self._sun, *self._box, window=window)
         footprint = clip_convex(self._whole[2], window_on_ground(basis, window))
         self._show(matrix, side / self.size, footprint, edge=EDGE_FADE)
+
+    def sees(self, planes: np.ndarray) -> bool:
+        """Whether the volume ``planes`` (6, 4) keep (a view's :func:`~.culling.frustum_planes`)
+        holds any of what the map shades (after :meth:`fit`)."""
+        return bool(len(seen_corners(self._receivers, planes)))
 
     def enable(self, on: bool) -> None:
         """Shadows on (the map drawn each frame by :meth:`draw`) or off (the map cleared, its

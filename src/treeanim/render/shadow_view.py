@@ -58,18 +58,22 @@ def view_slice(view_proj: np.ndarray, eye, forward, reach: float) -> np.ndarray:
     return planes
 
 
-def view_window(basis, receivers: tuple[np.ndarray, np.ndarray], slice_planes: np.ndarray, size: int,
-                whole: float) -> tuple[float, float, float, float] | None:
+def seen_corners(receivers: tuple[np.ndarray, np.ndarray], slice_planes: np.ndarray) -> np.ndarray:
+    """(V, 3) corners of the part of the box ``receivers`` (everything a shadow can fall on)
+    that the view's ``slice_planes`` (:func:`view_slice`) hold; none where the view sees none
+    of it."""
+    return polytope_vertices(np.vstack([box_planes(*receivers), slice_planes]))
+
+
+def view_window(basis, corners: np.ndarray, size: int, whole: float) -> tuple[float, float, float, float] | None:
     """The map's window across the sun's rays for a view, snapped to its texels.
 
     Parameters
     ----------
     basis : (right, up, forward)
         The sun's axes (:func:`~.shadow.sun_basis`).
-    receivers : ((3,) float, (3,) float)
-        The box that holds everything a shadow can fall on.
-    slice_planes : (6, 4) float
-        The view's frustum as far as shadows reach (:func:`view_slice`).
+    corners : (V, 3) float, V > 0
+        What the view sees of the receivers (:func:`seen_corners`).
     size : int
         The map's texels a side.
     whole : float
@@ -79,12 +83,9 @@ def view_window(basis, receivers: tuple[np.ndarray, np.ndarray], slice_planes: n
     -------
     (x0, x1, y0, y1) or None
         A square along the sun's right and up axes (metres), its side a power of
-        :data:`EXTENT_STEP` and its corner on the texel grid; None where the view sees none of
-        the receivers or the window would be no smaller than ``whole``.
+        :data:`EXTENT_STEP` and its corner on the texel grid; None where it would be no smaller
+        than ``whole``.
     """
-    corners = polytope_vertices(np.vstack([box_planes(*receivers), slice_planes]))
-    if not len(corners):
-        return None
     right, up = basis[0], basis[1]
     x, y = corners @ right, corners @ up
     side = max(np.ptp(x), np.ptp(y)) * (1.0 + 4.0 / size) + 1e-6

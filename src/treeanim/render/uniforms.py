@@ -60,6 +60,7 @@ BLOCKS: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("vec4", "bark", "furrows around a branch, furrow depth, interlacing, lenticels"),
         ("vec2", "lamina_box", "the lamina's half width and length: its uv over the leaf maps"),
         ("vec2", "lod_band", "metres from the eye where a scene's leaves hand over from full to coarse"),
+        ("vec2", "blade_band", "metres from the eye where grass hands over from whole clumps to one blade a clump"),
     ),
     # GroundPass's (ground.frag).
     "Ground": (
