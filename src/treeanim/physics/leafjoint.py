@@ -102,11 +102,20 @@ def _sin_series(x, x2):
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
 def _sincos(x):
-    """(sin x, cos x) to round-off, about three times faster than libm's pair for |x| ≤ 1.6
-    (Taylor series to x²³ and x²⁴: fixed chains of multiply-adds); libm's beyond."""
-    if abs(x) > 1.6:
-        return np.sin(x), np.cos(x)
+    """(sin x, cos x) to round-off, about three times faster than libm's pair for |x| ≤ 1.6:
+    Taylor series, fixed chains of multiply-adds (to x¹⁵ and x¹⁶ for |x| ≤ ½, errors below
+    10⁻¹⁹; to x²³ and x²⁴ up to 1.6, below 10⁻²⁰); libm's beyond."""
     x2 = x * x
+    if x2 <= 0.25:
+        s = x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (
+            1.0 / 362880.0 + x2 * (-1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0 + x2 * (
+                -1.0 / 1307674368000.0))))))))
+        c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (
+            -1.0 / 3628800.0 + x2 * (1.0 / 479001600.0 + x2 * (-1.0 / 87178291200.0 + x2 * (
+                1.0 / 20922789888000.0))))))))
+        return s, c
+    if x2 > 2.56:
+        return np.sin(x), np.cos(x)
     c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (
         -1.0 / 3628800.0 + x2 * (1.0 / 479001600.0 + x2 * (-1.0 / 87178291200.0 + x2 * (
             1.0 / 20922789888000.0 + x2 * (-1.0 / 6402373705728000.0 + x2 * (
@@ -122,20 +131,6 @@ def _sin_turn(x):
     x = np.pi - x if x > 0.5 * np.pi else x
     x = -np.pi - x if x < -0.5 * np.pi else x
     return _sin_series(x, x * x)
-
-
-@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _quat_matrix(qw, qx, qy, qz, G):
-    """G (3, 3): the rotation of the unit quaternion (qw, qx, qy, qz)."""
-    G[0, 0] = 1.0 - 2.0 * (qy * qy + qz * qz)
-    G[1, 1] = 1.0 - 2.0 * (qx * qx + qz * qz)
-    G[2, 2] = 1.0 - 2.0 * (qx * qx + qy * qy)
-    G[0, 1] = 2.0 * (qx * qy - qw * qz)
-    G[1, 0] = 2.0 * (qx * qy + qw * qz)
-    G[0, 2] = 2.0 * (qx * qz + qw * qy)
-    G[2, 0] = 2.0 * (qx * qz - qw * qy)
-    G[1, 2] = 2.0 * (qy * qz - qw * qx)
-    G[2, 1] = 2.0 * (qy * qz + qw * qx)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
@@ -394,7 +389,9 @@ def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, 
     node (the lamina) the whole turn.
     """
     last = -1
-    Qw = Qx = Qy = Qz = 0.0
+    Qw = Qx = Qy = Qz = Px = Py = Pz = xb = yb = zb = 0.0
+    r00 = r01 = r02 = r10 = r11 = r12 = r20 = r21 = r22 = 0.0
+    g00 = g01 = g02 = g10 = g11 = g12 = g20 = g21 = g22 = 0.0
     for b in bodies:
         j = body_node[b]
         for i in range(3):
@@ -412,54 +409,75 @@ def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, 
     for l in leaves:
         b = leaf_body[l]
         a = leaf_first[l]
-        e = leaf_first[l + 1]
-        k = e - a - 1
-        jb = body_node[b]
-        if b != last:  # the twig's rotation as a quaternion (kept while its leaves follow)
+        k = leaf_first[l + 1] - a - 1
+        if b != last:  # the twig's pose, its rotation as a quaternion (kept while its leaves follow)
             last = b
             Qw, Qx, Qy, Qz = _matrix_quat(R[b])
+            jb = body_node[b]
+            r00, r01, r02, r10, r11, r12, r20, r21, r22 = (R[b, 0, 0], R[b, 0, 1], R[b, 0, 2], R[b, 1, 0], R[b, 1, 1],
+                                                           R[b, 1, 2], R[b, 2, 0], R[b, 2, 1], R[b, 2, 2])
+            Px, Py, Pz = P[b, 0], P[b, 1], P[b, 2]
+            xb, yb, zb = Xrest[jb, 0], Xrest[jb, 1], Xrest[jb, 2]
         # the petiole's base on its twig
-        for i in range(3):
-            s = P[b, i]
-            for c in range(3):
-                s += R[b, i, c] * (Xrest[leaf_nodes[a], c] - Xrest[jb, c])
-            pos[leaf_nodes[a], i] = s
+        n0 = leaf_nodes[a]
+        x0, y0, z0 = Xrest[n0, 0], Xrest[n0, 1], Xrest[n0, 2]
+        dx, dy, dz = x0 - xb, y0 - yb, z0 - zb
+        sx = Px + r00 * dx + r01 * dy + r02 * dz
+        sy = Py + r10 * dx + r11 * dy + r12 * dz
+        sz = Pz + r20 * dx + r21 * dy + r22 * dz
+        pos[n0, 0], pos[n0, 1], pos[n0, 2] = sx, sy, sz
         # segment q turns by G_q = B^((q+1)/k)·T^((q+1)/k), the bend B and twist T each about
         # one axis: as quaternions whose half angles grow by one k-th a segment (angle addition),
-        # then the twig's turn on top (R·G_q, the quaternions' product)
+        # then the twig's turn on top: Q·(c_b + s_b·b)(c_t + s_t·a) = c_b·c_t·Q + c_b·s_t·Qa +
+        # s_b·c_t·Qb + s_b·s_t·Qba (Qa = Q·a, Qb = Q·b, Qba = Q·b·a, a and b pure quaternions)
         on = 1.0 if leaf_on[l] else 0.0
         ax, ay, az = leaf_E[l, 0, 0], leaf_E[l, 1, 0], leaf_E[l, 2, 0]
-        vx = on * (leaf_E[l, 0, 1] * leaf_th[l, 1] + leaf_E[l, 0, 2] * leaf_th[l, 2])
-        vy = on * (leaf_E[l, 1, 1] * leaf_th[l, 1] + leaf_E[l, 1, 2] * leaf_th[l, 2])
-        vz = on * (leaf_E[l, 2, 1] * leaf_th[l, 1] + leaf_E[l, 2, 2] * leaf_th[l, 2])
+        t1, t2 = on * leaf_th[l, 1], on * leaf_th[l, 2]
+        vx = leaf_E[l, 0, 1] * t1 + leaf_E[l, 0, 2] * t2
+        vy = leaf_E[l, 1, 1] * t1 + leaf_E[l, 1, 2] * t2
+        vz = leaf_E[l, 2, 1] * t1 + leaf_E[l, 2, 2] * t2
         beta = np.sqrt(vx * vx + vy * vy + vz * vz)
         if beta > 1e-12:
-            bx, by, bz = vx / beta, vy / beta, vz / beta
+            ib = 1.0 / beta
+            bx, by, bz = vx * ib, vy * ib, vz * ib
         else:
             bx, by, bz = 1.0, 0.0, 0.0
         sb1, cb1 = _sincos(0.5 * beta / k)
         st1, ct1 = _sincos(0.5 * on * leaf_th[l, 0] / k)
         cb, sb, ct, st = cb1, sb1, ct1, st1
-        ba = bx * ax + by * ay + bz * az
-        cx_, cy_, cz_ = _cross(bx, by, bz, ax, ay, az)
+        aw, ax_, ay_, az_ = _qmul_pure(Qw, Qx, Qy, Qz, ax, ay, az)
+        bw, bx_, by_, bz_ = _qmul_pure(Qw, Qx, Qy, Qz, bx, by, bz)
+        cw, cx_, cy_, cz_ = _qmul_pure(bw, bx_, by_, bz_, ax, ay, az)
         for q in range(k):
             if q > 0:
                 cb, sb = cb * cb1 - sb * sb1, sb * cb1 + cb * sb1
                 ct, st = ct * ct1 - st * st1, st * ct1 + ct * st1
-            qw = cb * ct - sb * st * ba
-            qx = cb * st * ax + ct * sb * bx + sb * st * cx_
-            qy = cb * st * ay + ct * sb * by + sb * st * cy_
-            qz = cb * st * az + ct * sb * bz + sb * st * cz_
-            n0 = leaf_nodes[a + q]
+            w0, w1, w2, w3 = cb * ct, cb * st, sb * ct, sb * st
+            g00, g01, g02, g10, g11, g12, g20, g21, g22 = _quat_rotation(
+                w0 * Qw + w1 * aw + w2 * bw + w3 * cw, w0 * Qx + w1 * ax_ + w2 * bx_ + w3 * cx_,
+                w0 * Qy + w1 * ay_ + w2 * by_ + w3 * cy_, w0 * Qz + w1 * az_ + w2 * bz_ + w3 * cz_)
+            _put3(rot, n0, g00, g01, g02, g10, g11, g12, g20, g21, g22)
             n1 = leaf_nodes[a + q + 1]
-            _quat_matrix(Qw * qw - Qx * qx - Qy * qy - Qz * qz, Qw * qx + Qx * qw + Qy * qz - Qz * qy,
-                         Qw * qy - Qx * qz + Qy * qw + Qz * qx, Qw * qz + Qx * qy - Qy * qx + Qz * qw, rot[n0])
-            for i in range(3):
-                s = pos[n0, i]
-                for c in range(3):
-                    s += rot[n0, i, c] * (Xrest[n1, c] - Xrest[n0, c])
-                pos[n1, i] = s
-            if q == k - 1:
-                for i in range(3):
-                    for c in range(3):
-                        rot[n1, i, c] = rot[n0, i, c]
+            x1, y1, z1 = Xrest[n1, 0], Xrest[n1, 1], Xrest[n1, 2]
+            dx, dy, dz = x1 - x0, y1 - y0, z1 - z0
+            sx += g00 * dx + g01 * dy + g02 * dz
+            sy += g10 * dx + g11 * dy + g12 * dz
+            sz += g20 * dx + g21 * dy + g22 * dz
+            pos[n1, 0], pos[n1, 1], pos[n1, 2] = sx, sy, sz
+            n0, x0, y0, z0 = n1, x1, y1, z1
+        _put3(rot, n0, g00, g01, g02, g10, g11, g12, g20, g21, g22)  # the lamina turns with its last segment
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _qmul_pure(qw, qx, qy, qz, ux, uy, uz):
+    """The quaternion product (qw, qx, qy, qz)·(0, ux, uy, uz)."""
+    cx, cy, cz = _cross(qx, qy, qz, ux, uy, uz)
+    return -(qx * ux + qy * uy + qz * uz), qw * ux + cx, qw * uy + cy, qw * uz + cz
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _put3(M, n, m00, m01, m02, m10, m11, m12, m20, m21, m22):
+    """M[n] = the 3×3 matrix of the nine terms, row by row."""
+    M[n, 0, 0], M[n, 0, 1], M[n, 0, 2] = m00, m01, m02
+    M[n, 1, 0], M[n, 1, 1], M[n, 1, 2] = m10, m11, m12
+    M[n, 2, 0], M[n, 2, 1], M[n, 2, 2] = m20, m21, m22
