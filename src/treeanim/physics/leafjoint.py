@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from .articulated import _cross
-from .compiled import njit
+from .compiled import inv_cbrt, njit
 
 __all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP", "FLUTTER_STROUHAL"]
 
@@ -291,7 +291,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
         ux, uy, uz = Wx - o[0], Wy - o[1], Wz - o[2]
         s = np.sqrt(ux * ux + uy * uy + uz * uz)
         un = ux * nx + uy * ny + uz * nz
-        c = cna[l] / np.cbrt(1.0 + cauchy[l] * s * s)  # the folded lamina's
+        c = cna[l] * inv_cbrt(1.0 + cauchy[l] * s * s)  # the folded lamina's
         fn = c * s * un
         # on the twig: the force's Plücker line a = (x × n, n) through the centroid x, and,
         # the next step taking them implicitly, the point terms α·aaᵀ + β·bbᵀ (b = (x × Û, Û))

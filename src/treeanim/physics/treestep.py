@@ -23,7 +23,7 @@ from typing import Sequence
 import numpy as np
 
 from .articulated import add_point, articulated_step, rot_log, theta_of
-from .compiled import njit
+from .compiled import inv_cbrt, njit
 from .kinematics import forward_kinematics, ground_contact
 from .leafjoint import leaf_step, pose_nodes
 from .structure import Structure
@@ -179,7 +179,7 @@ def _lump_force(b, h, R, Om, V, U, cd, cl, cauchy, x0, F, kap, Ka):
     s = np.sqrt(ux * ux + uy * uy + uz * uz)
     if s <= 0.0:
         return
-    cs = (cd + cl / np.cbrt(1.0 + cauchy * s * s)) * s
+    cs = (cd + cl * inv_cbrt(1.0 + cauchy * s * s)) * s
     fx, fy, fz = cs * ux, cs * uy, cs * uz
     F[b, 0] += y * fz - z * fy
     F[b, 1] += z * fx - x * fz
