@@ -6,7 +6,8 @@ from __future__ import annotations
 import numpy as np
 
 from .articulated import _cross
-from .compiled import inv_cbrt, njit
+from .compiled import njit
+from .scalar import inv_cbrt, sin_turn, sinc_cos, sincos
 
 __all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP", "FLUTTER_STROUHAL"]
 
@@ -91,49 +92,6 @@ def _secant_stiffness(tau, alpha, beta, gamma):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _sin_series(x, x2):
-    """sin x for |x| ≤ 1.6 (x2 = x²): its Taylor series to x²³ (error below 10⁻²⁰), a fixed
-    chain of multiply-adds, no branch to mispredict."""
-    return x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0 + x2 * (
-        -1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0 + x2 * (-1.0 / 1307674368000.0 + x2 * (
-            1.0 / 355687428096000.0 + x2 * (-1.0 / 121645100408832000.0 + x2 * (
-                1.0 / 51090942171709440000.0 + x2 * (-1.0 / 25852016738884976640000.0))))))))))))
-
-
-@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _sincos(x):
-    """(sin x, cos x) to round-off, about three times faster than libm's pair for |x| ≤ 1.6:
-    Taylor series, fixed chains of multiply-adds (to x¹⁵ and x¹⁶ for |x| ≤ ½, errors below
-    10⁻¹⁹; to x²³ and x²⁴ up to 1.6, below 10⁻²⁰); libm's beyond."""
-    x2 = x * x
-    if x2 <= 0.25:
-        s = x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (
-            1.0 / 362880.0 + x2 * (-1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0 + x2 * (
-                -1.0 / 1307674368000.0))))))))
-        c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (
-            -1.0 / 3628800.0 + x2 * (1.0 / 479001600.0 + x2 * (-1.0 / 87178291200.0 + x2 * (
-                1.0 / 20922789888000.0))))))))
-        return s, c
-    if x2 > 2.56:
-        return np.sin(x), np.cos(x)
-    c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (
-        -1.0 / 3628800.0 + x2 * (1.0 / 479001600.0 + x2 * (-1.0 / 87178291200.0 + x2 * (
-            1.0 / 20922789888000.0 + x2 * (-1.0 / 6402373705728000.0 + x2 * (
-                1.0 / 2432902008176640000.0 + x2 * (-1.0 / 1124000727777607680000.0 + x2 * (
-                    1.0 / 620448401733239439360000.0))))))))))))
-    return _sin_series(x, x2), c
-
-
-@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _sin_turn(x):
-    """sin x for x in [0, 2π), folded onto [−π/2, π/2] without branches (sin(π − x) = sin x)."""
-    x = x - 2.0 * np.pi if x > np.pi else x
-    x = np.pi - x if x > 0.5 * np.pi else x
-    x = -np.pi - x if x < -0.5 * np.pi else x
-    return _sin_series(x, x * x)
-
-
-@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
 def _quat_rotation(qw, qx, qy, qz):
     """The rotation of the unit quaternion (qw, qx, qy, qz): its nine terms, row by row."""
     return (1.0 - 2.0 * (qy * qy + qz * qz), 2.0 * (qx * qy - qw * qz), 2.0 * (qx * qz + qw * qy),
@@ -149,10 +107,9 @@ def _leaf_rotation(E, th0, th1, th2):
     vx = E[0, 1] * th1 + E[0, 2] * th2
     vy = E[1, 1] * th1 + E[1, 2] * th2
     vz = E[2, 1] * th1 + E[2, 2] * th2
-    beta = np.sqrt(vx * vx + vy * vy + vz * vz)
-    sb, cb = _sincos(0.5 * beta)
-    st, ct = _sincos(0.5 * th0)
-    sb = sb / beta if beta > 1e-12 else 0.5  # times the unnormalised axis v
+    sb, cb = sinc_cos(0.25 * (vx * vx + vy * vy + vz * vz))  # of the half angle β/2, β = |v|
+    sb *= 0.5  # sin(β/2)/β, times the unnormalised axis v
+    st, ct = sincos(0.5 * th0)
     qw = cb * ct - sb * st * (vx * ax + vy * ay + vz * az)
     cx, cy, cz = _cross(vx, vy, vz, ax, ay, az)
     qx = cb * st * ax + ct * sb * vx + sb * st * cx
@@ -268,7 +225,7 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
         if not on[l]:
             twist[l] = 0.0
             continue
-        twist1 = amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED) * _sin_turn(ph)
+        twist1 = amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED) * sin_turn(ph)
         twist[l] = twist1
         th0, th1, th2 = th[l, 0], th[l, 1], th[l, 2]
         # the leaf against its twig, G; the lever and the normal in the twig's axes, then in the world's
@@ -426,31 +383,28 @@ def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, 
         sy = Py + r10 * dx + r11 * dy + r12 * dz
         sz = Pz + r20 * dx + r21 * dy + r22 * dz
         pos[n0, 0], pos[n0, 1], pos[n0, 2] = sx, sy, sz
-        # segment q turns by G_q = B^((q+1)/k)·T^((q+1)/k), the bend B and twist T each about
-        # one axis: as quaternions whose half angles grow by one k-th a segment (angle addition),
-        # then the twig's turn on top: Q·(c_b + s_b·b)(c_t + s_t·a) = c_b·c_t·Q + c_b·s_t·Qa +
-        # s_b·c_t·Qb + s_b·s_t·Qba (Qa = Q·a, Qb = Q·b, Qba = Q·b·a, a and b pure quaternions)
+        # segment q turns by G_q = B^((q+1)/k)·T^((q+1)/k), the bend B (angle β about v/β) and
+        # the twist T (about a) as quaternions whose half angles grow by one k-th a segment
+        # (angle addition; the bend's sine kept as sin/β, so v needs no normalising), then the
+        # twig's turn on top: Q·(c_b + s_b·v)(c_t + s_t·a) = c_b·c_t·Q + c_b·s_t·Qa + s_b·c_t·Qv
+        # + s_b·s_t·Qva (Qa = Q·a, Qv = Q·v, Qva = Q·v·a; a and v as pure quaternions)
         on = 1.0 if leaf_on[l] else 0.0
         ax, ay, az = leaf_E[l, 0, 0], leaf_E[l, 1, 0], leaf_E[l, 2, 0]
         t1, t2 = on * leaf_th[l, 1], on * leaf_th[l, 2]
         vx = leaf_E[l, 0, 1] * t1 + leaf_E[l, 0, 2] * t2
         vy = leaf_E[l, 1, 1] * t1 + leaf_E[l, 1, 2] * t2
         vz = leaf_E[l, 2, 1] * t1 + leaf_E[l, 2, 2] * t2
-        beta = np.sqrt(vx * vx + vy * vy + vz * vz)
-        if beta > 1e-12:
-            ib = 1.0 / beta
-            bx, by, bz = vx * ib, vy * ib, vz * ib
-        else:
-            bx, by, bz = 1.0, 0.0, 0.0
-        sb1, cb1 = _sincos(0.5 * beta / k)
-        st1, ct1 = _sincos(0.5 * on * leaf_th[l, 0] / k)
+        b2 = vx * vx + vy * vy + vz * vz
+        sb1, cb1 = sinc_cos(b2 / (4 * k * k))  # of β/2k
+        sb1 /= 2 * k  # sin(β/2k)/β
+        st1, ct1 = sincos(0.5 * on * leaf_th[l, 0] / k)
         cb, sb, ct, st = cb1, sb1, ct1, st1
         aw, ax_, ay_, az_ = _qmul_pure(Qw, Qx, Qy, Qz, ax, ay, az)
-        bw, bx_, by_, bz_ = _qmul_pure(Qw, Qx, Qy, Qz, bx, by, bz)
+        bw, bx_, by_, bz_ = _qmul_pure(Qw, Qx, Qy, Qz, vx, vy, vz)
         cw, cx_, cy_, cz_ = _qmul_pure(bw, bx_, by_, bz_, ax, ay, az)
         for q in range(k):
             if q > 0:
-                cb, sb = cb * cb1 - sb * sb1, sb * cb1 + cb * sb1
+                cb, sb = cb * cb1 - b2 * sb * sb1, sb * cb1 + cb * sb1
                 ct, st = ct * ct1 - st * st1, st * ct1 + ct * st1
             w0, w1, w2, w3 = cb * ct, cb * st, sb * ct, sb * st
             g00, g01, g02, g10, g11, g12, g20, g21, g22 = _quat_rotation(

@@ -23,9 +23,10 @@ from typing import Sequence
 import numpy as np
 
 from .articulated import add_point, articulated_step, rot_log, theta_of
-from .compiled import inv_cbrt, njit
+from .compiled import njit
 from .kinematics import forward_kinematics, ground_contact
 from .leafjoint import leaf_step, pose_nodes
+from .scalar import inv_cbrt
 from .structure import Structure
 
 __all__ = ["TreeState", "Grab", "step", "pose", "energy", "sample_points"]
@@ -197,7 +198,7 @@ def _lump_force(b, h, R, Om, V, U, cd, cl, cauchy, x0, F, kap, Ka):
     _add_turn(b, h, Ka, Om, F, kap)
 
 
-@njit(cache=True, fastmath=True, error_model="numpy")
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
 def _turn_stiffness(b, h, cda, un, ux, uy, uz, ua, ax, ay, az, rx, ry, rz, fx, fy, fz, Om, F, kap, Ka):
     """The drag's stiffness against the segment's own turn, taken implicitly (backward Euler).
 
@@ -220,7 +221,7 @@ def _turn_stiffness(b, h, cda, un, ux, uy, uz, ua, ax, ay, az, rx, ry, rz, fx, f
     _add_turn(b, h, Ka, Om, F, kap)
 
 
-@njit(cache=True, fastmath=True, error_model="numpy")
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
 def _add_turn(b, h, Ka, Om, F, kap):
     """Take a turn stiffness Ka of body b implicitly (backward Euler): its symmetric part,
     made positive by Gershgorin's shift, joins the body's rotational inertia as h²K and its
