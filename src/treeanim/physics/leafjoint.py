@@ -7,7 +7,7 @@ import numpy as np
 
 from .articulated import _cross
 from .compiled import njit
-from .scalar import inv_cbrt, sin_turn, sinc_cos, sincos
+from .scalar import SERIES_MAX, inv_cbrt, sin_turn, sinc_cos, sinc_cos_series, sincos
 
 __all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP", "FLUTTER_STROUHAL"]
 
@@ -100,22 +100,60 @@ def _quat_rotation(qw, qx, qy, qz):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _leaf_rotation(E, th0, th1, th2):
-    """exp([θ₁b₁ + θ₂b₂]×)·exp(θ₀[a]×), the leaf against its twig (E: columns a, b₁, b₂),
-    composed as quaternions: its nine terms, row by row."""
-    ax, ay, az = E[0, 0], E[1, 0], E[2, 0]
-    vx = E[0, 1] * th1 + E[0, 2] * th2
-    vy = E[1, 1] * th1 + E[1, 2] * th2
-    vz = E[2, 1] * th1 + E[2, 2] * th2
-    sb, cb = sinc_cos(0.25 * (vx * vx + vy * vy + vz * vz))  # of the half angle β/2, β = |v|
-    sb *= 0.5  # sin(β/2)/β, times the unnormalised axis v
-    st, ct = sincos(0.5 * th0)
+def _leaf_rotation(ax, ay, az, vx, vy, vz, sb, cb, st, ct):
+    """exp([v]×)·exp(θ₀[a]×), the leaf against its twig (v = θ₁b₁ + θ₂b₂, β = |v|; E's columns
+    a, b₁, b₂), composed as quaternions from sb = sin(β/2)/β, cb = cos(β/2), st = sin(θ₀/2),
+    ct = cos(θ₀/2): its nine terms, row by row."""
     qw = cb * ct - sb * st * (vx * ax + vy * ay + vz * az)
     cx, cy, cz = _cross(vx, vy, vz, ax, ay, az)
     qx = cb * st * ax + ct * sb * vx + sb * st * cx
     qy = cb * st * ay + ct * sb * vy + sb * st * cy
     qz = cb * st * az + ct * sb * vz + sb * st * cz
     return _quat_rotation(qw, qx, qy, qz)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _lamina(geo, l, T0, T1, T2, series):
+    """Leaf l's rotation against its twig (θ = (T0, T1, T2)) applied to its lever r_c and normal
+    n (``geo``: :attr:`~treeanim.physics.structure.Structure.leaf_geometry`), and the larger
+    squared half angle; by the branch-free series where ``series`` (valid up to
+    :data:`~treeanim.physics.scalar.SERIES_MAX`)."""
+    ax, ay, az = geo[0, l], geo[3, l], geo[6, l]
+    vx = geo[1, l] * T1 + geo[2, l] * T2
+    vy = geo[4, l] * T1 + geo[5, l] * T2
+    vz = geo[7, l] * T1 + geo[8, l] * T2
+    x2, t2 = 0.25 * (vx * vx + vy * vy + vz * vz), 0.25 * T0 * T0
+    if series:
+        (sb, cb), (st, ct) = sinc_cos_series(x2), sinc_cos_series(t2)
+        st *= 0.5 * T0
+    else:
+        (sb, cb), (st, ct) = sinc_cos(x2), sincos(0.5 * T0)
+    g00, g01, g02, g10, g11, g12, g20, g21, g22 = _leaf_rotation(ax, ay, az, vx, vy, vz, 0.5 * sb, cb, st, ct)
+    r0, r1, r2, n0, n1, n2 = geo[9, l], geo[10, l], geo[11, l], geo[12, l], geo[13, l], geo[14, l]
+    return (g00 * r0 + g01 * r1 + g02 * r2, g10 * r0 + g11 * r1 + g12 * r2, g20 * r0 + g21 * r1 + g22 * r2,
+            g00 * n0 + g01 * n1 + g02 * n2, g10 * n0 + g11 * n1 + g12 * n2, g20 * n0 + g21 * n1 + g22 * n2,
+            max(x2, t2))
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _laminas(geo, th, A):
+    """A (6, L): every leaf's lever r_c and normal n turned by its rotation against its twig
+    (:func:`_lamina`), in its twig's axes, a row per component. The leaves run as vectors
+    (eight a time with AVX-512: five times faster than one by one), their series checked
+    after and the few beyond them taken one by one."""
+    L = th.shape[0]
+    T = np.empty((3, L))
+    for l in range(L):  # θ's columns as rows, so the next loop reads every operand contiguous
+        T[0, l], T[1, l], T[2, l] = th[l, 0], th[l, 1], th[l, 2]
+    beyond = 0
+    for l in range(L):
+        A[0, l], A[1, l], A[2, l], A[3, l], A[4, l], A[5, l], x2 = _lamina(geo, l, T[0, l], T[1, l], T[2, l], True)
+        beyond += x2 > SERIES_MAX
+    if beyond:  # a twist past 3.2 rad (a bend stops at 2.8): those leaves by libm's sines
+        for l in range(L):
+            if _lamina(geo, l, th[l, 0], th[l, 1], th[l, 2], True)[6] > SERIES_MAX:
+                A[0, l], A[1, l], A[2, l], A[3, l], A[4, l], A[5, l], _ = _lamina(geo, l, th[l, 0], th[l, 1],
+                                                                                th[l, 2], False)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
@@ -150,7 +188,7 @@ def _turn_stiffness(K, b, cs2, px, py, pz, nx, ny, nz, ex, ey, ez):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, cauchy, size, R, P, Om, V, U,
+def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, cauchy, size, R, P, Om, V, U,
               amp, phase, twist, th, thd, LF, LC, LK):
     """Advance every leaf's petiole joint (bend about two axes and twist) over one step, and
     give the force it passes to its twig for the next.
@@ -204,6 +242,8 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
     LF[:] = 0.0
     LC[:] = 0.0
     LK[:] = 0.0
+    A = np.empty((6, body.shape[0]))
+    _laminas(geo, th, A)
     f_max = min(MAX_FLUTTER_HZ, 0.25 / h)
     last = -1
     for l in range(body.shape[0]):
@@ -227,18 +267,10 @@ def leaf_step(h, on, body, base0, rc0, n0, E, k, J, dstr, cna, cswing, roll2, ca
             continue
         twist1 = amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED) * sin_turn(ph)
         twist[l] = twist1
-        th0, th1, th2 = th[l, 0], th[l, 1], th[l, 2]
-        # the leaf against its twig, G; the lever and the normal in the twig's axes, then in the world's
-        g00, g01, g02, g10, g11, g12, g20, g21, g22 = _leaf_rotation(E[l], th0, th1, th2)
-        q0, q1, q2 = rc0[l, 0], rc0[l, 1], rc0[l, 2]
-        a0 = g00 * q0 + g01 * q1 + g02 * q2
-        a1 = g10 * q0 + g11 * q1 + g12 * q2
-        a2 = g20 * q0 + g21 * q1 + g22 * q2
+        # the lever and the normal turned against the twig (A), in the world's axes
+        a0, a1, a2 = A[0, l], A[1, l], A[2, l]
         cx, cy, cz = r00 * a0 + r01 * a1 + r02 * a2, r10 * a0 + r11 * a1 + r12 * a2, r20 * a0 + r21 * a1 + r22 * a2
-        q0, q1, q2 = n0[l, 0], n0[l, 1], n0[l, 2]
-        a0 = g00 * q0 + g01 * q1 + g02 * q2
-        a1 = g10 * q0 + g11 * q1 + g12 * q2
-        a2 = g20 * q0 + g21 * q1 + g22 * q2
+        a0, a1, a2 = A[3, l], A[4, l], A[5, l]
         nx, ny, nz = r00 * a0 + r01 * a1 + r02 * a2, r10 * a0 + r11 * a1 + r12 * a2, r20 * a0 + r21 * a1 + r22 * a2
         q0, q1, q2 = base0[l, 0], base0[l, 1], base0[l, 2]
         bx, by, bz = r00 * q0 + r01 * q1 + r02 * q2, r10 * q0 + r11 * q1 + r12 * q2, r20 * q0 + r21 * q1 + r22 * q2

@@ -11,12 +11,15 @@ from numba.extending import intrinsic
 
 from .compiled import njit
 
-__all__ = ["sinc_cos", "sincos", "sin_turn", "inv_cbrt"]
+__all__ = ["sinc_cos", "sinc_cos_series", "sincos", "sin_turn", "inv_cbrt", "SERIES_MAX"]
+
+#: The largest x² :func:`sinc_cos_series` holds for (x ≤ 1.6).
+SERIES_MAX = 2.56
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
 def _sinc_long(x2):
-    """sin x / x for x² ≤ 2.56: its Taylor series to x²² (error below 10⁻²⁰)."""
+    """sin x / x for x² ≤ :data:`SERIES_MAX`: its Taylor series to x²² (error below 10⁻²⁰)."""
     return 1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0 + x2 * (
         -1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0 + x2 * (-1.0 / 1307674368000.0 + x2 * (
             1.0 / 355687428096000.0 + x2 * (-1.0 / 121645100408832000.0 + x2 * (
@@ -26,8 +29,8 @@ def _sinc_long(x2):
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
 def sinc_cos(x2):
     """(sin x / x, cos x) from x² alone (no square root, no division): Taylor series to x¹⁴
-    and x¹⁶ for x² ≤ ¼ (errors below 10⁻¹⁹), to x²² and x²⁴ for x² ≤ 2.56 (below 10⁻²⁰);
-    libm's beyond."""
+    and x¹⁶ for x² ≤ ¼ (errors below 10⁻¹⁹), :func:`sinc_cos_series` to x² ≤
+    :data:`SERIES_MAX`; libm's beyond."""
     if x2 <= 0.25:
         s = 1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (
             1.0 / 362880.0 + x2 * (-1.0 / 39916800.0 + x2 * (1.0 / 6227020800.0 + x2 * (
@@ -36,9 +39,16 @@ def sinc_cos(x2):
             -1.0 / 3628800.0 + x2 * (1.0 / 479001600.0 + x2 * (-1.0 / 87178291200.0 + x2 * (
                 1.0 / 20922789888000.0))))))))
         return s, c
-    if x2 > 2.56:
+    if x2 > SERIES_MAX:
         x = np.sqrt(x2)
         return np.sin(x) / x, np.cos(x)
+    return sinc_cos_series(x2)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def sinc_cos_series(x2):
+    """(sin x / x, cos x) for x² ≤ :data:`SERIES_MAX`: Taylor series to x²² and x²⁴ (errors
+    below 10⁻²⁰), without a branch, so a loop over many x runs as vectors."""
     c = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (
         -1.0 / 3628800.0 + x2 * (1.0 / 479001600.0 + x2 * (-1.0 / 87178291200.0 + x2 * (
             1.0 / 20922789888000.0 + x2 * (-1.0 / 6402373705728000.0 + x2 * (

@@ -307,7 +307,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.kb, s.kt, s.dk, out.R, out.P, out.Q, out.w,
                      out.Om, out.V, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.Ur, w.u, w.acc)
     ground_contact(s.parent, s.r0, s.seg0, s.floor, out.Q, out.w, out.R, out.P, out.Om, out.V)
-    leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
+    leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_geometry, s.leaf_E, s.leaf_k,
               s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, s.leaf_cauchy, s.leaf_size,
               out.R, out.P, out.Om, out.V, Ub, float(leaf_flutter), out.phase, out.twist, out.th, out.thd,
               out.leaf_F, out.leaf_C, out.leaf_K)
