@@ -256,8 +256,9 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
             Wx, Wy, Wz = Ux - V[b, 0], Uy - V[b, 1], Uz - V[b, 2]
             ox, oy, oz = Om[b, 0], Om[b, 1], Om[b, 2]
             u2 = Ux * Ux + Uy * Uy + Uz * Uz
+            fU, flutter = FLUTTER_STROUHAL * np.sqrt(u2), amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED)
         # the flutter: its phase and amplitude in the wind at the twig
-        f = min(FLUTTER_STROUHAL * np.sqrt(u2) / max(size[l], 1e-3), f_max)
+        f = min(fU / max(size[l], 1e-3), f_max)
         ph = phase[l] + 2.0 * np.pi * f * h  # less than 4π: f ≤ 1/(4h)
         ph = ph - 2.0 * np.pi if ph >= 2.0 * np.pi else ph  # exact (Sterbenz)
         phase[l] = ph
@@ -265,7 +266,7 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
         if not on[l]:
             twist[l] = 0.0
             continue
-        twist1 = amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED) * sin_turn(ph)
+        twist1 = flutter * sin_turn(ph)
         twist[l] = twist1
         # the lever and the normal turned against the twig (A), in the world's axes
         a0, a1, a2 = A[0, l], A[1, l], A[2, l]
