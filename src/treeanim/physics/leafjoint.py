@@ -243,6 +243,7 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
     LC[:] = 0.0
     LK[:] = 0.0
     A = np.empty((6, body.shape[0]))
+    C = np.empty((6, 3 * body.shape[0]))  # each petiole axis's step (_petioles)
     _laminas(geo, th, A)
     f_max = min(MAX_FLUTTER_HZ, 0.25 / h)
     last = -1
@@ -265,6 +266,7 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
         twist0 = twist[l]
         if not on[l]:
             twist[l] = 0.0
+            C[:4, 3 * l:3 * l + 3] = 0.0
             continue
         twist1 = flutter * sin_turn(ph)
         twist[l] = twist1
@@ -332,17 +334,35 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
                     ka = max(ka, _secant_stiffness(tau, eu * en, un - eu * en, ew))
                 K, f0, f1 = kk + ka, tau + ka * th[l, i], 0.0
                 d = dstr[l, i] + dair
-            t1, v = _axis_step(h, J[l, i], K, d, f0, f1, th[l, i], thd[l, i])
-            turn = t1 - th[l, i]
+            j = 3 * l + i
+            C[0, j], C[1, j], C[2, j], C[3, j] = K, d, f0, f1
+    _petioles(h, on, J, th, thd, C)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _petioles(h, on, J, th, thd, C):
+    """Step every petiole axis of the leaves ``on`` by :func:`_axis_step` from its K, d, f₀ and
+    f₁ (C's first four rows, a column per axis, θ's order), all axes as vectors (C's last two
+    rows take θ and θ̇ after it), then the guard (:data:`MAX_TURN`) and the petiole's stop
+    leaf by leaf."""
+    n = C.shape[1]
+    Jf, tf, vf = J.reshape(n), th.reshape(n), thd.reshape(n)
+    for j in range(n):
+        C[4, j], C[5, j] = _axis_step(h, Jf[j], C[0, j], C[1, j], C[2, j], C[3, j], tf[j], vf[j])
+    for l in range(on.shape[0]):
+        if not on[l]:
+            continue
+        for i in range(3):
+            turn, v = C[4, 3 * l + i] - th[l, i], C[5, 3 * l + i]
             if i > 0 and abs(turn) > MAX_TURN:  # the guard (see MAX_TURN): speed cut with it
                 v *= MAX_TURN / abs(turn)
                 turn = MAX_TURN if turn > 0.0 else -MAX_TURN
             th[l, i] += turn
             thd[l, i] = v
         # a petiole's stop
-        bend = np.sqrt(th[l, 1] ** 2 + th[l, 2] ** 2)
-        if bend > PETIOLE_STOP:
-            sc = PETIOLE_STOP / bend
+        bend2 = th[l, 1] ** 2 + th[l, 2] ** 2
+        if bend2 > PETIOLE_STOP * PETIOLE_STOP:
+            sc = PETIOLE_STOP / np.sqrt(bend2)
             th[l, 1] *= sc
             th[l, 2] *= sc
             thd[l, 1] *= sc
