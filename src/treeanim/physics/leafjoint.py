@@ -157,34 +157,48 @@ def _laminas(geo, th, A):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _add_outer(C, b, w, a0, a1, a2, a3, a4, a5):
-    """C[b] += w·aaᵀ for a = (a0 … a5), its upper triangle only."""
-    a = (a0, a1, a2, a3, a4, a5)
-    for i in range(6):
-        wi = w * a[i]
-        for j in range(i, 6):
-            C[b, i, j] += wi * a[j]
+def _add_outer(C, w, a0, a1, a2, a3, a4, a5):
+    """C + w·aaᵀ for a = (a0 … a5), C the upper triangle of a symmetric 6×6 (21 terms, row by row)."""
+    w0, w1, w2, w3, w4, w5 = w * a0, w * a1, w * a2, w * a3, w * a4, w * a5
+    return (C[0] + w0 * a0, C[1] + w0 * a1, C[2] + w0 * a2, C[3] + w0 * a3, C[4] + w0 * a4, C[5] + w0 * a5,
+            C[6] + w1 * a1, C[7] + w1 * a2, C[8] + w1 * a3, C[9] + w1 * a4, C[10] + w1 * a5,
+            C[11] + w2 * a2, C[12] + w2 * a3, C[13] + w2 * a4, C[14] + w2 * a5,
+            C[15] + w3 * a3, C[16] + w3 * a4, C[17] + w3 * a5, C[18] + w4 * a4, C[19] + w4 * a5, C[20] + w5 * a5)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _turn_stiffness(K, b, cs2, px, py, pz, nx, ny, nz, ex, ey, ez):
-    """K[b] += the symmetric part of Ka = −∂τ/∂φ made positive by Gershgorin's shift (as
-    :func:`~treeanim.physics.treestep._add_turn` takes a segment's), upper triangle only, for a
-    lamina's normal force F = c|U|²(Û·n)n at x on its twig, the twig turning by δφ
-    (δx = δφ × x, δn = δφ × n): the leaves' pull on a twig as it turns.
-    ∂τ/∂φ = c|U|²[(Û·n)(x nᵀ − n xᵀ) + p qᵀ] with p = x × n, q = n × Û (Û = (ex, ey, ez));
+def _turn_stiffness(K, cs2, px, py, pz, nx, ny, nz, ex, ey, ez):
+    """K + the symmetric part of Ka = −∂τ/∂φ made positive by Gershgorin's shift (as
+    :func:`~treeanim.physics.treestep._add_turn` takes a segment's), K its upper triangle
+    (k₀₀, k₁₁, k₂₂, k₀₁, k₀₂, k₁₂), for a lamina's normal force F = c|U|²(Û·n)n at x on its
+    twig, the twig turning by δφ (δx = δφ × x, δn = δφ × n): the leaves' pull on a twig as it
+    turns. ∂τ/∂φ = c|U|²[(Û·n)(x nᵀ − n xᵀ) + p qᵀ] with p = x × n, q = n × Û (Û = (ex, ey, ez));
     the first term is skew, so the symmetric part of Ka is −½c|U|²(p qᵀ + q pᵀ)."""
     qx, qy, qz = _cross(nx, ny, nz, ex, ey, ez)
     w = -0.5 * cs2
     k00, k11, k22 = 2.0 * w * px * qx, 2.0 * w * py * qy, 2.0 * w * pz * qz
     k01, k02, k12 = w * (px * qy + qx * py), w * (px * qz + qx * pz), w * (py * qz + qy * pz)
     shift = max(0.0, abs(k01) + abs(k02) - k00, abs(k01) + abs(k12) - k11, abs(k02) + abs(k12) - k22)
-    K[b, 0, 0] += k00 + shift
-    K[b, 1, 1] += k11 + shift
-    K[b, 2, 2] += k22 + shift
-    K[b, 0, 1] += k01
-    K[b, 0, 2] += k02
-    K[b, 1, 2] += k12
+    return K[0] + (k00 + shift), K[1] + (k11 + shift), K[2] + (k22 + shift), K[3] + k01, K[4] + k02, K[5] + k12
+
+
+@njit(cache=True, fastmath=True, error_model="numpy")
+def _add_twig(b, F, C, K, LF, LC, LK):
+    """Add a twig's sums (:func:`leaf_step`'s F, C and K) to its rows of LF, LC and LK."""
+    if b < 0:
+        return
+    n = 0
+    for i in range(6):
+        LF[b, i] += F[i]
+        for j in range(i, 6):
+            LC[b, i, j] += C[n]
+            n += 1
+    LK[b, 0, 0] += K[0]
+    LK[b, 1, 1] += K[1]
+    LK[b, 2, 2] += K[2]
+    LK[b, 0, 1] += K[3]
+    LK[b, 0, 2] += K[4]
+    LK[b, 1, 2] += K[5]
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -246,10 +260,15 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
     C = np.empty((6, 3 * body.shape[0]))  # each petiole axis's step (_petioles)
     _laminas(geo, th, A)
     f_max = min(MAX_FLUTTER_HZ, 0.25 / h)
+    z6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    z21 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    TF, TC, TK = z6, z21, z6  # the sums over the current twig's leaves, kept in registers
     last = -1
     for l in range(body.shape[0]):
         b = body[l]
         if b != last:  # the twig's kinematics, kept in registers while its leaves follow
+            _add_twig(last, TF, TC, TK, LF, LC, LK)
+            TF, TC, TK = z6, z21, z6
             last = b
             r00, r01, r02, r10, r11, r12, r20, r21, r22 = (R[b, 0, 0], R[b, 0, 1], R[b, 0, 2], R[b, 1, 0], R[b, 1, 1],
                                                            R[b, 1, 2], R[b, 2, 0], R[b, 2, 1], R[b, 2, 2])
@@ -289,19 +308,13 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
         # the next step taking them implicitly, the point terms α·aaᵀ + β·bbᵀ (b = (x × Û, Û))
         # and the force's stiffness against the twig's turn (:func:`_turn_stiffness`)
         mx, my, mz = _cross(xx, xy, xz, nx, ny, nz)
-        LF[b, 0] += fn * mx
-        LF[b, 1] += fn * my
-        LF[b, 2] += fn * mz
-        LF[b, 3] += fn * nx
-        LF[b, 4] += fn * ny
-        LF[b, 5] += fn * nz
+        TF = (TF[0] + fn * mx, TF[1] + fn * my, TF[2] + fn * mz, TF[3] + fn * nx, TF[4] + fn * ny, TF[5] + fn * nz)
         if c * s > 0.0:
             q = 1.0 / s
             ex, ey, ez = ux * q, uy * q, uz * q
             rx, ry, rz = _cross(xx, xy, xz, ex, ey, ez)
-            _add_outer(LC, b, c * s, mx, my, mz, nx, ny, nz)
-            _add_outer(LC, b, c * abs(un), rx, ry, rz, ex, ey, ez)
-            _turn_stiffness(LK, b, c * s * s, mx, my, mz, nx, ny, nz, ex, ey, ez)
+            TC = _add_outer(_add_outer(TC, c * s, mx, my, mz, nx, ny, nz), c * abs(un), rx, ry, rz, ex, ey, ez)
+            TK = _turn_stiffness(TK, c * s * s, mx, my, mz, nx, ny, nz, ex, ey, ez)
         # about the petiole's base the normal force's moment is fn·p (p = x_c × n, x_c the
         # centroid from the base) and its stiffness against a turn about an axis e (δx_c = e × x_c,
         # δn = e × n) is −c|U|(e·p)(e·w), w = n × U_rel; in the twig's axes, where E's are
@@ -336,6 +349,7 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
                 d = dstr[l, i] + dair
             j = 3 * l + i
             C[0, j], C[1, j], C[2, j], C[3, j] = K, d, f0, f1
+    _add_twig(last, TF, TC, TK, LF, LC, LK)
     _petioles(h, on, J, th, thd, C)
 
 
