@@ -226,8 +226,10 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
     Parameters
     ----------
     on : (L,) bool — leaves on the tree; body : (L,) int — the twig body each sits on.
-    base0, rc0, n0 : (L, 3) — rest offset of the petiole's base from its twig's joint, of the
-        lamina's centroid from the petiole's base, the lamina's rest normal.
+    base0, rc0 : (L, 3) — rest offset of the petiole's base from its twig's joint, of the
+        lamina's centroid from the petiole's base.
+    geo : (15, L) — E, rc0 and the lamina's rest normal, a row per component
+        (:attr:`~treeanim.physics.structure.Structure.leaf_geometry`).
     E : (L, 3, 3) — the leaf's axes (columns a, b₁, b₂) in rest axes.
     k, J, dstr : (L, 3) — stiffness, inertia and structural damping per axis.
     cna : (L,) — ½ρC_nA of the lamina in the wind (``physics.drag_leaf``).
@@ -450,6 +452,8 @@ def pose_nodes(bodies, leaves, body_node, body_tip, body_tip_node, Xrest, R, P, 
         sy = Py + r10 * dx + r11 * dy + r12 * dz
         sz = Pz + r20 * dx + r21 * dy + r22 * dz
         pos[n0, 0], pos[n0, 1], pos[n0, 2] = sx, sy, sz
+        if k == 0:
+            continue
         # segment q turns by G_q = B^((q+1)/k)·T^((q+1)/k), the bend B (angle β about v/β) and
         # the twist T (about a) as quaternions whose half angles grow by one k-th a segment
         # (angle addition; the bend's sine kept as sin/β, so v needs no normalising), then the
