@@ -27,6 +27,7 @@ k_b = EI·r/(ℓ(r − ℓ/2)), and twist k_t = k_b·ℓ/(r·EI/GJ) with a petio
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy.spatial import ConvexHull, QhullError
@@ -235,6 +236,14 @@ class Structure:
     lump_cl: np.ndarray     # (B,) the rigid leaves'
     lump_cauchy: np.ndarray  # (B,) the rigid leaves' mean scaled Cauchy number per (m/s)²
     lump_x0: np.ndarray     # (B, 3) the point it acts at (rest axes, from the body's joint)
+
+    @cached_property
+    def leaf_geometry(self) -> np.ndarray:
+        """(15, L) ``leaf_E`` (row by row), ``leaf_rc0`` and ``leaf_n0`` a row per component,
+        contiguous over the leaves, for the compiled pass that turns them all as vectors
+        (:func:`~treeanim.physics.leafjoint.leaf_step`)."""
+        L = len(self.leaf_body)
+        return np.ascontiguousarray(np.concatenate([self.leaf_E.reshape(L, 9), self.leaf_rc0, self.leaf_n0], axis=1).T)
 
     @classmethod
     def build(cls, tree, physics, present: np.ndarray) -> "Structure":

@@ -26,6 +26,7 @@ from .articulated import add_point, articulated_step, rot_log, theta_of
 from .compiled import njit
 from .kinematics import forward_kinematics, ground_contact
 from .leafjoint import leaf_step, pose_nodes
+from .scalar import inv_cbrt
 from .structure import Structure
 
 __all__ = ["TreeState", "Grab", "step", "pose", "energy", "sample_points"]
@@ -179,7 +180,7 @@ def _lump_force(b, h, R, Om, V, U, cd, cl, cauchy, x0, F, kap, Ka):
     s = np.sqrt(ux * ux + uy * uy + uz * uz)
     if s <= 0.0:
         return
-    cs = (cd + cl / np.cbrt(1.0 + cauchy * s * s)) * s
+    cs = (cd + cl * inv_cbrt(1.0 + cauchy * s * s)) * s
     fx, fy, fz = cs * ux, cs * uy, cs * uz
     F[b, 0] += y * fz - z * fy
     F[b, 1] += z * fx - x * fz
@@ -197,7 +198,7 @@ def _lump_force(b, h, R, Om, V, U, cd, cl, cauchy, x0, F, kap, Ka):
     _add_turn(b, h, Ka, Om, F, kap)
 
 
-@njit(cache=True, fastmath=True, error_model="numpy")
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
 def _turn_stiffness(b, h, cda, un, ux, uy, uz, ua, ax, ay, az, rx, ry, rz, fx, fy, fz, Om, F, kap, Ka):
     """The drag's stiffness against the segment's own turn, taken implicitly (backward Euler).
 
@@ -220,7 +221,7 @@ def _turn_stiffness(b, h, cda, un, ux, uy, uz, ua, ax, ay, az, rx, ry, rz, fx, f
     _add_turn(b, h, Ka, Om, F, kap)
 
 
-@njit(cache=True, fastmath=True, error_model="numpy")
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
 def _add_turn(b, h, Ka, Om, F, kap):
     """Take a turn stiffness Ka of body b implicitly (backward Euler): its symmetric part,
     made positive by Gershgorin's shift, joins the body's rotational inertia as h²K and its
@@ -306,7 +307,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
     articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.kb, s.kt, s.dk, out.R, out.P, out.Q, out.w,
                      out.Om, out.V, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.Ur, w.u, w.acc)
     ground_contact(s.parent, s.r0, s.seg0, s.floor, out.Q, out.w, out.R, out.P, out.Om, out.V)
-    leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_n0, s.leaf_E, s.leaf_k,
+    leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_geometry, s.leaf_E, s.leaf_k,
               s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, s.leaf_cauchy, s.leaf_size,
               out.R, out.P, out.Om, out.V, Ub, float(leaf_flutter), out.phase, out.twist, out.th, out.thd,
               out.leaf_F, out.leaf_C, out.leaf_K)
