@@ -114,7 +114,41 @@ def fit_to_tree(wind, rest_positions) -> None:
         wind.fit(box)
     else:
         wind.bounds = box
+    if hasattr(wind, "fit_cover"):
+        wind.fit_cover(canopy_cover(X))
 
-__all__ = ["fit_to_tree", "fbm_noise", "WindField", "WindParams", "WIND_MODELS", "DEFAULT_MODEL", "register_wind_model",
+
+def canopy_cover(rest_positions) -> float:
+    """The fraction of the ground under crowns, around a tree or over a scene: the plan area
+    its nodes cover (cells half its height wide: a gap narrower than that is sheltered, the
+    canopy's eddies are as large as its height) over its box widened by half its
+    height on every side (the ground whose wind it shelters).
+
+    A lone tree covers a quarter or less (the small and large cherries 0.2–0.3), an orchard
+    about half, a closed stand or a meadow's sward nearly all of it: the wind decays into a
+    closed canopy (Raupach's mixing layer), while a lone crown stands in the open wind.
+
+    Parameters
+    ----------
+    rest_positions : (N, 3) float
+        The nodes, y up, the ground at y = 0.
+
+    Returns
+    -------
+    float
+        In [0, 1].
+    """
+    X = np.asarray(rest_positions, float)
+    height = float(X[:, 1].max())
+    if not height > 0.0:
+        return 0.0
+    cell = 0.5 * height
+    lo = X[:, [0, 2]].min(axis=0) - 0.5 * height
+    span = X[:, [0, 2]].max(axis=0) + 0.5 * height - lo
+    ij = np.floor((X[:, [0, 2]] - lo) / cell).astype(np.int64)
+    covered = len(np.unique(ij[:, 0] * (int(span[1] / cell) + 2) + ij[:, 1])) * cell * cell
+    return float(min(covered / (span[0] * span[1]), 1.0))
+
+__all__ = ["fit_to_tree", "canopy_cover", "fbm_noise", "WindField", "WindParams", "WIND_MODELS", "DEFAULT_MODEL", "register_wind_model",
            "wind_model", "PhysicalWind", "PhysicalParams", "PaperWind", "PaperParams", "WIND_PRESETS", "wind_preset", "named_wind",
            "MODELS", "DEFAULT_BOUNDS", "MAX_SPEED", "SIGMA_RATIOS"]

@@ -79,12 +79,13 @@ def _surface_scale(h: float) -> float:
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _canopy(h: float, inv_top: float) -> tuple[float, float]:
+def _canopy(h: float, inv_top: float, cover: float) -> tuple[float, float]:
     """(mean speed, σ) over their values at the canopy top, at height ``h`` (m), ``inv_top``
-    one over the canopy height: the log law above the canopy (σ constant there), exponential
-    decay inside it."""
+    one over the canopy height, ``cover`` the canopy's cover (0–1): the log law above the
+    canopy (σ constant there), exponential decay inside it, at a rate in proportion to the
+    cover (a lone tree's crown stands in the open wind)."""
     z = min(max(h, 0.0), _COORD_CLIP) * inv_top
-    inside = min(z, 1.0) - 1.0  # ≤ 0
+    inside = cover * (min(z, 1.0) - 1.0)  # ≤ 0
     sigma = math.exp(SIGMA_ATTENUATION * inside)
     if z > 1.0:
         return math.log((z - DISPLACEMENT) / ROUGHNESS) / _LOG_TOP, sigma
@@ -92,18 +93,18 @@ def _canopy(h: float, inv_top: float) -> tuple[float, float]:
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _canopy_means(h: np.ndarray, inv_top: float) -> np.ndarray:
+def _canopy_means(h: np.ndarray, inv_top: float, cover: float) -> np.ndarray:
     """The mean of :func:`_canopy` at each of the heights ``h`` (1-D)."""
     out = np.empty(h.shape[0])
     for i in range(h.shape[0]):
-        out[i] = _canopy(h[i], inv_top)[0]
+        out[i] = _canopy(h[i], inv_top, cover)[0]
     return out
 
 
-def _canopy_mean(h: np.ndarray, top: float) -> np.ndarray:
+def _canopy_mean(h: np.ndarray, top: float, cover: float) -> np.ndarray:
     """Mean speed over the speed at the canopy top ``top`` at heights ``h`` (m)."""
     h = np.asarray(h, float)
-    return _canopy_means(h.reshape(-1), 1.0 / top).reshape(h.shape)
+    return _canopy_means(h.reshape(-1), 1.0 / top, cover).reshape(h.shape)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
@@ -201,7 +202,7 @@ def _along(p: np.ndarray, i: int, m: np.ndarray, row: int = 0) -> float:
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _sample_points(p, out, frame, cell, travel, evolution, table, inv_top, sigma_scale, mean_scale,
+def _sample_points(p, out, frame, cell, travel, evolution, table, inv_top, cover, sigma_scale, mean_scale,
                    gusts, streams):
     """The physical wind at the points ``p`` into ``out``, world m/s: one pass over the points.
 
@@ -267,7 +268,7 @@ def _sample_points(p, out, frame, cell, travel, evolution, table, inv_top, sigma
         if strength > 0.0:
             gust = _gust(qa, qc, cell, lane, gusts, streams[1], lanes, first, ys)
         u, v, w = _eddies(table, qa, qb, qc, travel, evolution, streams[0])
-        mean, sigma = _canopy(p[i, 1], inv_top)
+        mean, sigma = _canopy(p[i, 1], inv_top, cover)
         sigma *= sigma_scale
         mean *= strength * gust + 1.0
         mean *= mean_scale
@@ -287,7 +288,7 @@ def _sample_physical(wind: PhysicalWind, p: np.ndarray, t: float, out: np.ndarra
     cell = length / _CELLS_PER_L
     table = _physical_table(wind.beta_u, wind.beta_vw, wind.seed)
     _sample_points(np.ascontiguousarray(p), out, wind._frame, cell, _travel(a / cell), _evolution(s), table,
-                   1.0 / wind.canopy_height, wind.turbulence * wind.speed, wind.speed / SIGMA_RATIOS[0],
+                   1.0 / wind.canopy_height, wind.canopy_cover, wind.turbulence * wind.speed, wind.speed / SIGMA_RATIOS[0],
                    _gust_params(wind, g), (_stream(wind.seed, 20), _stream(wind.seed, 31)))
 
 
@@ -310,6 +311,10 @@ class PhysicalParams(WindParams):
                                            "height, at least 1 m.")] | None = None
     canopy_height: Annotated[float, _length("Canopy height h: the height of speed and of "
                                             "the canopy profile; None: the top of the bounds.")] | None = None
+    canopy_cover: Annotated[float, Param(0.0, 1.0, help="Fraction of the ground under crowns: 1 a closed "
+                                         "stand, into which the wind decays; 0 a lone tree, whose "
+                                         "crown stands in the open wind; None: measured from the tree "
+                                         "or scene (physics.wind.canopy_cover).")] | None = None
     gust_strength: Annotated[float, Param(0.0, MAX_GUST_STRENGTH, help="Mean peak speed of a gust above the "
                                           "mean, as a fraction of it.")] = 0.3
     gust_rate: Annotated[float, Param(0.0, MAX_GUST_RATE, unit="per minute", fmt="%.1f",
@@ -368,6 +373,7 @@ class PhysicalWind(WindField):
         # advances linearly from t0 at its current rate (see _changing).
         self._clock = (0.0, 0.0, 0.0, 0.0)
         self._t_last = 0.0
+        self._auto_cover = 1.0
         super().__init__(*args, **kwargs)
 
     @property
@@ -398,6 +404,21 @@ class PhysicalWind(WindField):
     def canopy_height(self, value) -> None:
         self._set(canopy_height=value)
 
+    @property
+    def canopy_cover(self) -> float:
+        """Fraction of the ground under crowns (0–1): the wind decays into the canopy at a rate
+        in proportion to it. Set None for what ``fit_cover`` measured (1 until then)."""
+        return self._auto_cover if self._params.canopy_cover is None else self._params.canopy_cover
+
+    @canopy_cover.setter
+    def canopy_cover(self, value) -> None:
+        self._set(canopy_cover=value)
+
+    def fit_cover(self, cover: float) -> None:
+        """The cover measured from the tree or scene the field is fitted to (a Simulation
+        calls it with :func:`~treeanim.physics.wind.canopy_cover`), used while ``canopy_cover`` is None."""
+        self._auto_cover = min(max(float(cover), 0.0), 1.0)
+
     def _clocks(self, t: float) -> tuple[float, float, float]:
         """(travel a in m, evolution s in cycles, gust count g) at time t."""
         t0, a0, s0, g0 = self._clock
@@ -413,9 +434,9 @@ class PhysicalWind(WindField):
 
     def _profile(self, h: np.ndarray) -> np.ndarray:
         """ln((h − d)/z0) / ln((h_c − d)/z0) above the canopy height h_c (d = 0.7 h_c,
-        z0 = 0.1 h_c) and exp(a(h/h_c − 1)) inside it, with a = 1/(0.3 ln 3) ≈ 3.03 so the two
-        meet smoothly; 1 at h_c."""
-        return _canopy_mean(h, self.canopy_height)
+        z0 = 0.1 h_c) and exp(c·a(h/h_c − 1)) inside it, with a = 1/(0.3 ln 3) ≈ 3.03 so the two
+        meet smoothly under a closed canopy (cover c = 1); 1 at h_c."""
+        return _canopy_mean(h, self.canopy_height, self.canopy_cover)
 
     def sample(self, points, t: float) -> np.ndarray:
         """:meth:`WindField.sample`; the time is kept (calm too): a later change of a rate
