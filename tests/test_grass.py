@@ -52,9 +52,12 @@ def test_blades_sway_in_a_breeze_and_lie_over_in_a_gale(meadow, breeze_and_gale)
     assert sway[5.0] > 0.02, sway
     assert drop[5.0] < 0.1, drop
     assert lean[5.0] > 0.01, lean
-    # A gale: the meadow lies over downwind, the tips lose a third of their height or more.
+    # A gale: the meadow lies over downwind, the tips lose a third of their height or more
+    # and lie downwind by half of it (a lying blade leans at most its length: where the wind
+    # reaches into the sward's gaps, a breeze already leans it 15°, so lean does not grow as
+    # fast as the wind's force)
     assert drop[30.0] > 0.3, drop
-    assert lean[30.0] > 2.5 * lean[5.0], lean  # a lying blade leans at most its length: the drop says it lies
+    assert lean[30.0] > 0.5 * np.median(height), lean
     assert sway[30.0] > sway[5.0], sway
 
 

@@ -15,6 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import signal
 
+import treeanim as ta
 from treeanim.physics.wind import WIND_PRESETS, WindField, wind_preset
 
 H = 10.0  # the default canopy height (top of the default bounds)
@@ -160,6 +161,29 @@ def test_canopy_profile_log_law_above_and_decay_inside():
     # the intensity rises into the canopy, along-wind σ falls
     sd = series(wind, pts, 300.0, 2.0)[..., 0].std(axis=0).reshape(len(h), 3).mean(axis=1)
     assert sd[0] < sd[5] and sd[0] / x[0] > sd[5] / x[5]
+
+
+def test_a_lone_crown_stands_in_the_open_wind_and_a_closed_stand_shelters_its_inside():
+    """The wind decays into a canopy at a rate in proportion to its cover: a lone tree's crown
+    (a quarter of the ground around it) meets most of the wind, a closed stand's inside little."""
+    from treeanim.physics.wind import canopy_cover
+
+    lone = {name: canopy_cover(ta.load_preset(name).rest_positions) for name in ("small_cherry", "large_cherry",
+                                                                                    "tulip_poplar")}
+    woodland = canopy_cover(ta.load_scene("woodland").rest_positions)
+    assert max(lone.values()) < 0.35 and woodland > 0.6, (lone, woodland)
+    h = np.array([0.3, 0.5, 0.8]) * H
+    for cover in (0.0, 0.3, 1.0):
+        wind = WindField(speed=6.0, canopy_height=H, canopy_cover=cover)
+        np.testing.assert_allclose(wind.profile(h), np.exp(cover * (h / H - 1) / (0.3 * np.log(3.0))), rtol=1e-12)
+    # a Simulation measures its tree's cover: mid-crown gets 0.7 of the top's wind or more
+    tree = ta.load_preset("large_cherry")
+    sim = ta.Simulation(tree, wind=WindField(speed=6.0))
+    assert sim.wind.canopy_cover == pytest.approx(lone["large_cherry"])
+    top = tree.rest_positions[:, 1].max()
+    assert sim.wind.profile(0.6 * top) > 0.7 > WindField(speed=6.0, canopy_height=top).profile(0.6 * top)
+    with pytest.raises(ValueError, match="canopy_cover"):
+        WindField(speed=6.0, canopy_cover=1.5)
 
 
 # ----------------------------------------------------------------------------- direction
