@@ -279,8 +279,10 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
             ox, oy, oz = Om[b, 0], Om[b, 1], Om[b, 2]
             u2 = Ux * Ux + Uy * Uy + Uz * Uz
             fU, flutter = FLUTTER_STROUHAL * np.sqrt(u2), amp * u2 / (u2 + FLUTTER_SPEED * FLUTTER_SPEED)
-        # the flutter: its phase and amplitude in the wind at the twig
-        f = min(fU / max(size[l], 1e-3), f_max)
+        # the flutter: its phase and amplitude in the wind at the twig, slowed to a quarter of
+        # the step rate where it is faster (:data:`MAX_FLUTTER_HZ`)
+        f_leaf = min(fU / max(size[l], 1e-3), MAX_FLUTTER_HZ)
+        f = min(f_leaf, f_max)
         ph = phase[l] + 2.0 * np.pi * f * h  # less than 4π: f ≤ 1/(4h)
         ph = ph - 2.0 * np.pi if ph >= 2.0 * np.pi else ph  # exact (Sterbenz)
         phase[l] = ph
@@ -289,7 +291,11 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
             twist[l] = 0.0
             C[:4, 3 * l:3 * l + 3] = 0.0
             continue
-        twist1 = flutter * sin_turn(ph)
+        # slowed, it is scaled by f/f_leaf: a lamina's bends follow its twist within their
+        # settling (some 0.03 s in a gale), and twist and bends each take a 12 Hz flutter about
+        # half as far as a 2.5 Hz one; unscaled, a 1/10 s step's slowed flutter swung the
+        # laminas' bends from side to side from one step to the next
+        twist1 = flutter * sin_turn(ph) * (f / f_leaf if f < f_leaf else 1.0)
         twist[l] = twist1
         # the lever and the normal turned against the twig (A), in the world's axes
         a0, a1, a2 = A[0, l], A[1, l], A[2, l]
