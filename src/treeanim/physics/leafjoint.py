@@ -15,8 +15,8 @@ __all__ = ["leaf_step", "pose_nodes", "MAX_TURN", "PETIOLE_STOP", "FLUTTER_STROU
 #: air's moment on the lamina linearised about the step's start (its slope near the flow, its
 #: chord to where the lamina lets go far from it, :func:`_secant_stiffness`), exact at both
 #: ends along the axis but not across the axes nor as the lamina's own speed changes the air
-#: on it; a turn this large leaves that model. In a 30 m/s wind it binds on 0.06 % of the
-#: large cherry's leaf steps at 1/60 s, each a lamina swinging round into the flow, 8 % at
+#: on it; a turn this large leaves that model. In a 30 m/s wind it binds on 0.07 % of the
+#: large cherry's leaf steps at 1/60 s, each a lamina swinging round into the flow, 5 % at
 #: 1/10 s, where the wind at a twig changes by up to 10 m/s and 25° from step to step. The
 #: twist, linear (driven by the flutter, damped by the air against the lamina's roll), has no
 #: such limit.
