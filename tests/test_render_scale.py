@@ -80,6 +80,17 @@ def pixels_per_metre(cam):
     return 0.5 * H / np.tan(np.radians(cam.fov_y / 2))
 
 
+def band_sweep(monkeypatch, offscreen, r, cam, name, band, scales):
+    """Render ``cam`` with the pass's hand-over band ``name`` replaced by ``band(s)`` for each
+    scale s: (the largest change of a step in any 7 × 7 pixels, the triangles drawn at each)."""
+    frames, triangles = [], []
+    for s in scales:
+        monkeypatch.setattr(passes_module, name, lambda *args, s=s: band(s))
+        frames.append(render(offscreen, cam))
+        triangles.append(r.drawn["triangles"])
+    return max(uniform_filter(np.abs(b - a).max(axis=2), 7).max() for a, b in zip(frames, frames[1:])), triangles
+
+
 def test_trees_out_of_view_are_not_drawn(offscreen, near_grove):
     r = load(offscreen, near_grove)
     render(offscreen, OrbitCamera(target=(0.0, 1.0, 0.0), distance=30.0, elevation=30.0))
@@ -134,13 +145,7 @@ def test_the_switch_to_coarse_trees_does_not_pop(offscreen, near_grove, monkeypa
     near, far = passes_module.lod_band(r.tree_pass.leaf, 0.5 * H / np.tan(np.radians(cam.fov_y / 2)))
 
     def sweep(band):
-        frames, triangles = [], []
-        for s in np.linspace(0.6, 2.0, 29):
-            monkeypatch.setattr(passes_module, "lod_band", lambda leaf, ppm: band(s))
-            frames.append(render(offscreen, cam))
-            triangles.append(r.drawn["triangles"])
-        # the largest change of a step in any 7 x 7 pixels
-        return max(uniform_filter(np.abs(b - a).max(axis=2), 7).max() for a, b in zip(frames, frames[1:])), triangles
+        return band_sweep(monkeypatch, offscreen, r, cam, "lod_band", band, np.linspace(0.6, 2.0, 29))
 
     faded, triangles = sweep(lambda s: (near * s, far * s))
     switched, _ = sweep(lambda s: (far * s - 1e-3, far * s))
@@ -246,12 +251,7 @@ def test_the_switch_to_one_blade_a_clump_does_not_pop(offscreen, meadow, monkeyp
     near, far = passes_module.blade_band(r.tree_pass.blade, pixels_per_metre(cam))
 
     def sweep(band):
-        frames, triangles = [], []
-        for s in np.linspace(0.3, 2.0, 35):
-            monkeypatch.setattr(passes_module, "blade_band", lambda width, ppm: band(s))
-            frames.append(render(offscreen, cam))
-            triangles.append(r.drawn["triangles"])
-        return max(uniform_filter(np.abs(b - a).max(axis=2), 7).max() for a, b in zip(frames, frames[1:])), triangles
+        return band_sweep(monkeypatch, offscreen, r, cam, "blade_band", band, np.linspace(0.3, 2.0, 35))
 
     faded, triangles = sweep(lambda s: (near * s, far * s))
     switched, _ = sweep(lambda s: (far * s - 1e-3, far * s))
