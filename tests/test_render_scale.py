@@ -80,15 +80,21 @@ def pixels_per_metre(cam):
     return 0.5 * H / np.tan(np.radians(cam.fov_y / 2))
 
 
-def band_sweep(monkeypatch, offscreen, r, cam, name, band, scales):
-    """Render ``cam`` with the pass's hand-over band ``name`` replaced by ``band(s)`` for each
-    scale s: (the largest change of a step in any 7 × 7 pixels, the triangles drawn at each)."""
-    frames, triangles = [], []
-    for s in scales:
-        monkeypatch.setattr(passes_module, name, lambda *args, s=s: band(s))
-        frames.append(render(offscreen, cam))
-        triangles.append(r.drawn["triangles"])
-    return max(uniform_filter(np.abs(b - a).max(axis=2), 7).max() for a, b in zip(frames, frames[1:])), triangles
+def band_sweeps(monkeypatch, offscreen, r, cam, name, near, far, scales):
+    """Render ``cam`` with the pass's hand-over band ``name`` moved to (near·s, far·s) for each
+    scale s, then as a switch at far·s: the largest change of a step in any 7 × 7 pixels of
+    each sweep, and the triangles drawn at each step of the first."""
+    def sweep(band):
+        frames, triangles = [], []
+        for s in scales:
+            monkeypatch.setattr(passes_module, name, lambda *args, s=s: band(s))
+            frames.append(render(offscreen, cam))
+            triangles.append(r.drawn["triangles"])
+        return max(uniform_filter(np.abs(b - a).max(axis=2), 7).max() for a, b in zip(frames, frames[1:])), triangles
+
+    faded, triangles = sweep(lambda s: (near * s, far * s))
+    switched, _ = sweep(lambda s: (far * s - 1e-3, far * s))
+    return faded, switched, triangles
 
 
 def test_trees_out_of_view_are_not_drawn(offscreen, near_grove):
@@ -144,11 +150,7 @@ def test_the_switch_to_coarse_trees_does_not_pop(offscreen, near_grove, monkeypa
     cam = OrbitCamera(target=(0.0, 1.4, 8.0), distance=3.0, elevation=4.0)
     near, far = passes_module.lod_band(r.tree_pass.leaf, 0.5 * H / np.tan(np.radians(cam.fov_y / 2)))
 
-    def sweep(band):
-        return band_sweep(monkeypatch, offscreen, r, cam, "lod_band", band, np.linspace(0.6, 2.0, 29))
-
-    faded, triangles = sweep(lambda s: (near * s, far * s))
-    switched, _ = sweep(lambda s: (far * s - 1e-3, far * s))
+    faded, switched, triangles = band_sweeps(monkeypatch, offscreen, r, cam, "lod_band", near, far, np.linspace(0.6, 2.0, 29))
     assert triangles[0] < 0.8 * triangles[-1]  # the band swept past the trees
     assert faded < 0.6 * switched and faded < 12.0
 
@@ -250,11 +252,7 @@ def test_the_switch_to_one_blade_a_clump_does_not_pop(offscreen, meadow, monkeyp
     cam = OrbitCamera(target=(0.0, 0.2, 0.0), distance=5.0, elevation=10.0)
     near, far = passes_module.blade_band(r.tree_pass.blade, pixels_per_metre(cam))
 
-    def sweep(band):
-        return band_sweep(monkeypatch, offscreen, r, cam, "blade_band", band, np.linspace(0.3, 2.0, 35))
-
-    faded, triangles = sweep(lambda s: (near * s, far * s))
-    switched, _ = sweep(lambda s: (far * s - 1e-3, far * s))
+    faded, switched, triangles = band_sweeps(monkeypatch, offscreen, r, cam, "blade_band", near, far, np.linspace(0.3, 2.0, 35))
     assert triangles[0] < 0.5 * triangles[-1]  # the band swept past the meadow
     assert faded < 0.5 * switched and faded < 12.0
 
