@@ -349,8 +349,8 @@ class PhysicalWind(WindField):
     f^−β spectrum, a canopy profile and gusts; see :mod:`treeanim.physics.wind`.
 
     Settings: :class:`PhysicalParams` (``turbulence`` = σ_u/U, ``length_scale``,
-    ``canopy_height``, ``gust_strength``, ``gust_rate``, ``beta_u``, ``beta_vw``, ``seed``) and
-    :class:`WindField`'s. Only the top of ``bounds`` is used: the canopy height when
+    ``canopy_height``, ``canopy_cover``, ``gust_strength``, ``gust_rate``, ``beta_u``,
+    ``beta_vw``, ``seed``) and :class:`WindField`'s. Only the top of ``bounds`` is used: the canopy height when
     ``canopy_height`` is None; the turbulence stays in metres whatever the box.
 
     Notes
