@@ -63,9 +63,9 @@ def _axis_step(h, J, K, d, f0, f1, th, om):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _secant_stiffness(tau, alpha, beta, gamma):
-    """The air's stiffness against a lamina's bend far from the flow: its moment τ(0)/δ* over
-    the turn δ* to where it lets go, or 0 where it never does.
+def _release_turn(tau, alpha, beta, gamma):
+    """The turn δ* to where the air lets a lamina's bend far from the flow go (∞ where it
+    never does): the air's chord stiffness against the bend is its moment τ(0)/δ*.
 
     Turning the lamina by δ about an axis e carries its normal and its lever alike, so the
     moment about e is τ(δ) = c|U|(e·p)·(α + β cos δ + γ sin δ), α = (e·U)(e·n), β = U·n − α,
@@ -79,7 +79,7 @@ def _secant_stiffness(tau, alpha, beta, gamma):
     sg = 1.0 if tau > 0.0 else -1.0
     rho = np.sqrt(beta * beta + gamma * gamma)
     if rho <= abs(alpha):
-        return 0.0
+        return np.inf
     # α + β cos t + σγ sin t = α + ρ cos(t − ψ) = 0 for the smallest t > 0
     psi = np.arctan2(sg * gamma, beta)
     a = np.arccos(-alpha / rho)
@@ -260,7 +260,7 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
     LC[:] = 0.0
     LK[:] = 0.0
     A = np.empty((6, body.shape[0]))
-    C = np.empty((6, 3 * body.shape[0]))  # each petiole axis's step (_petioles)
+    C = np.empty((7, 3 * body.shape[0]))  # each petiole axis's step (_petioles)
     _laminas(geo, th, A)
     f_max = min(MAX_FLUTTER_HZ, 0.25 / h)
     z6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -334,7 +334,7 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
         lever2 = rc0[l, 0] ** 2 + rc0[l, 1] ** 2 + rc0[l, 2] ** 2
         dair = max(cswing[l], c) * s * lever2  # the air against the lamina's own swing
         for i in range(3):
-            kk = k[l, i]
+            kk, guard = k[l, i], MAX_TURN
             if i == 0:
                 # the twist: nil for a force at the centroid, which lies on the lamina's axis;
                 # the flutter drives it (its torque a ramp over the step), the lamina's halves
@@ -353,11 +353,13 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
                     ex, ey, ez = r00 * e0 + r01 * e1 + r02 * e2, r10 * e0 + r11 * e1 + r12 * e2, r20 * e0 + r21 * e1 + r22 * e2
                     eu = ex * ux + ey * uy + ez * uz
                     en = ex * nx + ey * ny + ez * nz
-                    ka = max(ka, _secant_stiffness(tau, eu * en, un - eu * en, ew))
+                    dstar = _release_turn(tau, eu * en, un - eu * en, ew)
+                    ka = max(ka, abs(tau) / dstar)
+                    guard = max(guard, dstar)  # the chord is exact as far as the air's balance
                 K, f0, f1 = kk + ka, tau + ka * th[l, i], 0.0
                 d = dstr[l, i] + dair
             j = 3 * l + i
-            C[0, j], C[1, j], C[2, j], C[3, j] = K, d, f0, f1
+            C[0, j], C[1, j], C[2, j], C[3, j], C[6, j] = K, d, f0, f1, guard
     _add_twig(last, TF, TC, TK, LF, LC, LK)
     _petioles(h, on, J, th, thd, C)
 
@@ -377,9 +379,10 @@ def _petioles(h, on, J, th, thd, C):
             continue
         for i in range(3):
             turn, v = C[4, 3 * l + i] - th[l, i], C[5, 3 * l + i]
-            if i > 0 and abs(turn) > MAX_TURN:  # the guard (see MAX_TURN): speed cut with it
-                v *= MAX_TURN / abs(turn)
-                turn = MAX_TURN if turn > 0.0 else -MAX_TURN
+            g = C[6, 3 * l + i]
+            if i > 0 and abs(turn) > g:  # the guard (see MAX_TURN): speed cut with it
+                v *= g / abs(turn)
+                turn = g if turn > 0.0 else -g
             th[l, i] += turn
             thd[l, i] = v
         # a petiole's stop
