@@ -357,7 +357,8 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
                     en = ex * nx + ey * ny + ez * nz
                     dstar = _release_turn(tau, eu * en, un - eu * en, ew)
                     ka = max(ka, abs(tau) / dstar)
-                    guard = max(guard, dstar)  # the chord is exact as far as the air's balance
+                    if np.isfinite(dstar):  # the chord is exact as far as the air's balance
+                        guard = max(guard, dstar)
                 K, f0, f1 = kk + ka, tau + ka * th[l, i], 0.0
                 d = dstr[l, i] + dair
             j = 3 * l + i
