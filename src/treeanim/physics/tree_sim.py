@@ -296,15 +296,16 @@ class TreeSim:
         """Held objects and the forces asked of them (a copy)."""
         return {i: f.copy() for i, (_, _, _, f) in self._pulls.items()}
 
-    def _strength(self, b: int, ofs: np.ndarray) -> tuple[float, float]:
+    def _strength(self, b: int, ofs: np.ndarray) -> tuple[float, float, float]:
         """At the point ``ofs`` (rest, from body b's joint): the tree's compliance (m/N, every
-        joint on the way to the root bending) and the largest force no joint on the way breaks
-        under (N)."""
+        joint on the way to the root bending), the largest force no joint on the way breaks
+        under (N) and the slowest swing of a joint on the way (rad/s)."""
         st = self._s
         X = self._tree.rest_positions
         p = X[st.node[b]] + ofs
-        compliance, f_max, j = 0.0, np.inf, b
+        compliance, f_max, w, j = 0.0, np.inf, np.inf, b
         while j >= 0:
+            w = min(w, float(st.omega_j[j]))
             r = p - X[st.node[j]]
             lever = float(np.linalg.norm(r))
             kb = float(np.trace(st.K[j]) - st.axis[j] @ st.K[j] @ st.axis[j]) / 2.0
@@ -312,7 +313,7 @@ class TreeSim:
             if lever > 1e-9:
                 f_max = min(f_max, WOOD_RUPTURE * np.pi * st.diameter[j] ** 3 / 32.0 / lever)
             j = int(st.parent[j])
-        return compliance, f_max
+        return compliance, f_max, w
 
     def drag(self, i: int, target: np.ndarray, s: float = 1.0, stiffness: float = GRAB_STIFFNESS) -> None:
         """Hold the point at fraction ``s`` along object ``i`` with a stiff spring toward the
@@ -323,9 +324,11 @@ class TreeSim:
         b, ofs = self._point(i, s)
         target = np.asarray(target, float).copy()
         target[1] = max(target[1], GROUND_CLEARANCE)
-        compliance, f_max = self._strength(b, ofs)
+        compliance, f_max, w = self._strength(b, ofs)
         k = stiffness / max(compliance, 1e-30)
-        m = float(self._s.subtree_mass[b])
+        # its damper critical in the slowest swing the point moves in (the tree's, for a limb):
+        # the mass the spring sees there, 1/(compliance·ω²), at least what the body carries
+        m = max(float(self._s.subtree_mass[b]), 1.0 / (compliance * w * w))
         g = Grab(body=b, offset=ofs, target=target, k=k, c=2.0 * np.sqrt(k * m), f_max=float(f_max), mass=m)
         self._grabs[i] = (g, s, float(stiffness))
         self._relevel()
