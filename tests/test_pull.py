@@ -112,6 +112,18 @@ def test_a_drag_past_the_woods_strength_settles_without_swinging_the_tree_throug
     assert 0.9 < x[-1] <= 1.0
 
 
+def test_a_drag_at_the_trunks_foot_where_nothing_moves_is_held_finite():
+    """The point at fraction 0 of the trunk sits on its root joint: the tree's compliance
+    there is 0 (a drag's damper divided by it once, hypothesis found)."""
+    for name in ("beam", "small_cherry"):
+        sim = ta.Simulation(ta.load_preset(name), wind=None)
+        sim.drag(0, sim.tree.rest_positions[0] + np.array([0.3, 0.2, 0.0]), 0.0)
+        for dt in (1 / 60, 0.5):
+            sim.step(dt)
+        assert np.isfinite(sim.positions).all()
+        np.testing.assert_allclose(sim.positions[0], sim.tree.rest_positions[0], atol=1e-9)
+
+
 def test_the_tree_model_holds_several_drags_each_with_its_own_spring():
     sim = ta.Simulation(ta.load_preset("small_cherry"), wind=None)
     tree = sim.tree

@@ -327,8 +327,11 @@ class TreeSim:
         compliance, f_max, w = self._strength(b, ofs)
         k = stiffness / max(compliance, 1e-30)
         # its damper critical in the slowest swing the point moves in (the tree's, for a limb):
-        # the mass the spring sees there, 1/(compliance·ω²), at least what the body carries
-        m = max(float(self._s.subtree_mass[b]), 1.0 / (compliance * w * w))
+        # the mass the spring sees there, 1/(compliance·ω²), at least what the body carries (all
+        # of it where the point cannot move: at a root's joint the compliance is 0)
+        m, cw = float(self._s.subtree_mass[b]), compliance * w * w
+        if cw > 0.0:
+            m = max(m, 1.0 / cw)
         g = Grab(body=b, offset=ofs, target=target, k=k, c=2.0 * np.sqrt(k * m), f_max=float(f_max), mass=m)
         self._grabs[i] = (g, s, float(stiffness))
         self._relevel()
