@@ -148,14 +148,20 @@ def _inv3(A, out):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
+def _resolved(x2):
+    """(1 + x⁴)⁻¹ for x² = (h·|ω|)², x the radians a whirl turns in a step: the share of it
+    the step's linearisation holds for (a turn of a radian or more a step it overshoots)."""
+    return 1.0 / (1.0 + x2 * x2)
+
+
+@njit(cache=True, fastmath=True, error_model="numpy", inline="always")
 def _whirl_theta(h, w, t1, t2):
     """A joint's θ for its bends and twist this step: its swing's (:func:`theta_of`), raised
-    to ½ + ½·y⁴/(y⁴ + 1) if more, y = h·|w| the radians it turns in the step. A whirl of a
-    radian or more a step (a grass blade's tip whipping in a gust's wake at 1/30 s) leaves
-    the step's linearisation, which then gains energy on the trapezoidal rule; a swing the
-    step resolves turns far less."""
-    y2 = h * h * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-    tw = 0.5 + 0.5 * y2 * y2 / (y2 * y2 + 1.0)
+    to 1 − ½·:func:`_resolved` (½ + ½·y⁴/(y⁴ + 1)) if more, y = h·|w| the radians it turns in
+    the step. A whirl of a radian or more a step (a grass blade's tip whipping in a gust's
+    wake at 1/30 s) leaves the step's linearisation, which then gains energy on the
+    trapezoidal rule; a swing the step resolves turns far less."""
+    tw = 1.0 - 0.5 * _resolved(h * h * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]))
     return max(t1, tw), max(t2, tw)
 
 
@@ -307,13 +313,11 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
         rx, ry, rz = P[b, 0] - P[p, 0], P[b, 1] - P[p, 1], P[b, 2] - P[p, 2]
         # the joint's velocity-product acceleration over the step, h·c = h·ν_b ×ₘ S·ω_rel
         # (kept in acc until the outward pass): (ω_p × ω_rel, v_b × ω_rel); pa += Ia·h·c.
-        # Explicit, so weighted as _add_bias's by (1 + x⁴)⁻¹, x = h·|ω| (a whirl of a radian
-        # or more a step it would overshoot)
+        # Explicit, so weighted as _add_bias's by :func:`_resolved`, x = h·|ω|
         o0, o1, o2 = Om[p, 0], Om[p, 1], Om[p, 2]
         c0, c1, c2 = _cross(o0, o1, o2, wr0, wr1, wr2)
         c3, c4, c5 = _cross(V[b, 0], V[b, 1], V[b, 2], wr0, wr1, wr2)
-        x2 = h * h * (o0 * o0 + o1 * o1 + o2 * o2 + wr0 * wr0 + wr1 * wr1 + wr2 * wr2)
-        hc = h / (1.0 + x2 * x2)
+        hc = h * _resolved(h * h * (o0 * o0 + o1 * o1 + o2 * o2 + wr0 * wr0 + wr1 * wr1 + wr2 * wr2))
         acc[b, 0], acc[b, 1], acc[b, 2] = hc * c0, hc * c1, hc * c2
         acc[b, 3], acc[b, 4], acc[b, 5] = hc * c3, hc * c4, hc * c5
         for i in range(6):
@@ -426,8 +430,7 @@ def _add_bias(h, b, kap, Om, V, IA, pA, Ib, mom):
     tr = Ib[0, 0] + Ib[1, 1] + Ib[2, 2]
     if tr > 0.0:  # (a body whose inertia underflows has no sweep to speak of)
         x2 += (vx * vx + vy * vy + vz * vz) * Ib[3, 3] / tr
-    x2 *= h * h
-    h = h / (1.0 + x2 * x2)
+    h *= _resolved(x2 * h * h)
     n0, n1, n2, p0, p1, p2 = mom[0], mom[1], mom[2], mom[3], mom[4], mom[5]
     a = _cross(wx, wy, wz, n0, n1, n2)
     c = _cross(vx, vy, vz, p0, p1, p2)
