@@ -366,7 +366,7 @@ class Viewer(ViewerInput, ViewerActions, ViewerTuning, ViewerHold, ViewerTimelin
         pos = sim.positions
         key = (id(r), id(pos), sim.time, id(sim.shown), highlight)
         if key != self._uploaded:  # the pose is unchanged while paused or between steps
-            r.update(pos, sim.rotations, present=sim.shown, highlight=highlight)
+            r.update(pos, sim.rotations, present=sim.shown, highlight=highlight, wind=sim.wind, time=sim.time)
             self._uploaded = key
         target = self.window.framebuffer
         if target is None:  # minimised since the viewer last heard of the size

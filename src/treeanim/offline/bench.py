@@ -78,7 +78,7 @@ def bench_row(key: str, off, width: int, height: int, frames: int, steps: int, w
     for k in range(frames + 2):
         frame()
         t0 = time.perf_counter()
-        off.update(sim.positions, sim.rotations, sim.shown)
+        off.update(sim.positions, sim.rotations, sim.shown, wind=sim.wind, time=sim.time)
         off.render(cam, season=season)  # draws, resolves and reads the pixels back: the GPU is done
         if k >= 2:  # the first frames compile and upload
             ren_ms.append((time.perf_counter() - t0) * 1e3)

@@ -172,7 +172,7 @@ def run_render(job: RenderJob, tree, sim, log=print) -> RenderResult:
         viewer_detail(sim, tree, cam, job.height)
 
         def shoot() -> np.ndarray:
-            off.update(sim.positions, sim.rotations, sim.shown)
+            off.update(sim.positions, sim.rotations, sim.shown, wind=sim.wind, time=sim.time)
             return off.render(cam, season=job.season)
 
         if target.kind == "still":

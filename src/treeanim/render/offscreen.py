@@ -116,10 +116,10 @@ class OffscreenRenderer:
             self.renderer = Renderer(self.ctx, tree, scene=scene, **kw)
         return self.renderer
 
-    def update(self, positions, rotations, present=None, highlight=None) -> None:
+    def update(self, positions, rotations, present=None, highlight=None, wind=None, time: float = 0.0) -> None:
         """:meth:`Renderer.update` of the loaded renderer, with the context current."""
         with self.ctx:
-            self._loaded().update(positions, rotations, present=present, highlight=highlight)
+            self._loaded().update(positions, rotations, present=present, highlight=highlight, wind=wind, time=time)
 
     def _loaded(self, renderer: Renderer | None = None) -> Renderer:
         r = renderer or self.renderer

@@ -43,6 +43,7 @@ from .scene import Scene
 from .shaders import DEPTH_FOOTPRINT, DEPTH_GROUND
 from .shadow import ShadowMap, shadow_indices
 from .shadow_view import MIN_REACH, VIEW_REACH, view_slice
+from .turf import TurfPass
 from .uniforms import SAMPLERS, UniformBlock
 
 #: Width in texels of the node and object textures (GL 3.3 guarantees 1024).
@@ -102,6 +103,7 @@ class Renderer:
         # failure part-way through (a shader that does not compile, an out-of-memory buffer).
         self.light = self.view = self.node_texture = self.object_texture = None
         self.tree_pass = self.shadow = self.sky_pass = self.background = self.overlay_pass = self.ground_pass = None
+        self.turf_pass = None
         try:
             self.light = UniformBlock(ctx, "Light")
             self.view = UniformBlock(ctx, "View")
@@ -135,6 +137,7 @@ class Renderer:
             self.background = BackgroundCache(ctx)
             self.overlay_pass = OverlayPass(ctx)
             self.ground_pass = GroundPass(ctx, tree, (lo, hi))
+            self.turf_pass = TurfPass(ctx, (lo, hi))
 
             self._present: np.ndarray | None = None  # None: derived from the season at draw time
             self._present_season: float | None = None
@@ -185,7 +188,7 @@ class Renderer:
 
     # ------------------------------------------------------------------ per frame
     def update(self, positions: np.ndarray, rotations: np.ndarray, present: np.ndarray | None = None,
-               highlight=None) -> None:
+               highlight=None, wind=None, time: float = 0.0) -> None:
         """Upload the pose for the next draws.
 
         Parameters
@@ -199,7 +202,11 @@ class Renderer:
             ``season`` passed to :meth:`draw` (``Tree.leaves_present``).
         highlight : None, int, sequence of int, or bool (scalar or (M,))
             Objects drawn highlighted (e.g. the grabbed one).
+        wind : WindField or None
+            The wind on the turf at ``time`` (s), which leans the ground's grass
+            (:class:`~.turf.TurfPass`; ``Simulation.wind`` and ``Simulation.time``); None: still.
         """
+        self.turf_pass.blow(wind, time)
         rows = self._node_rows
         rows[:, 0:3] = positions
         rows[:, 3:12] = np.reshape(rotations, (-1, 9))
@@ -294,6 +301,8 @@ class Renderer:
             self.background.draw()
         else:
             self._draw_background(camera, vp)
+        if self._ground_shown(camera):
+            self.turf_pass.draw(vp)
         # Blended: twigs and blades thinner than a pixel are drawn faint over what lies behind.
         ctx.enable(moderngl.BLEND)
         ctx.blend_func = moderngl.SRC_ALPHA, moderngl.ONE_MINUS_SRC_ALPHA
@@ -346,5 +355,5 @@ class Renderer:
         if self._released:
             return
         self._released = True
-        release_all(self.overlay_pass, self.background, self.ground_pass, self.sky_pass, self.shadow, self.tree_pass,
+        release_all(self.overlay_pass, self.background, self.turf_pass, self.ground_pass, self.sky_pass, self.shadow, self.tree_pass,
                     self.node_texture, self.object_texture, self.light, self.view)

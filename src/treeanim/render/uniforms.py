@@ -70,6 +70,11 @@ BLOCKS: dict[str, tuple[tuple[str, str, str], ...]] = {
         ("float", "trunk_radius", "contact shadow round the trunk's foot (0: none)"),
         ("float", "grid", "0: no grid; else grid line strength (1 m cells)"),
     ),
+    # TurfPass's (turf.frag).
+    "Turf": (
+        ("vec4", "turf_grid", "the wind grid's corner (world x, z), its side and texels a side (m, count)"),
+        ("float", "turf_lean", "wind speed (m/s) at which the turf leans 45 degrees"),
+    ),
     # SkyPass's (sky.frag).
     "Sky": (
         ("int", "show_sky", "0: flat horizon colour"),
@@ -100,6 +105,7 @@ SAMPLERS: dict[str, Sampler] = {
     "leaf_maps": Sampler("sampler2D", 4, "the lamina's albedo, translucency and relief (leaf_maps.py)"),
     "draft": Sampler("sampler2D", 5, "draft mode's smaller picture, scaled up (app/draft.py)"),
     "ground_maps": Sampler("sampler2D", 6, "the ground's tufts, patches, grain and tint (ground_maps.py)"),
+    "turf_wind": Sampler("sampler2D", 7, "the wind over the turf: rg = its x and z components, m/s (turf.py)"),
 }
 
 #: std140 base alignment and size (bytes) of each member type.

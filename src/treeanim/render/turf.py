@@ -1,0 +1,108 @@
+"""The turf in the wind: the ground's grass leaned by the simulated wind, so a gust crossing a
+meadow reads as a bright or dark patch travelling downwind (honami).
+
+The ground (``ground.frag``) is upright turf, drawn once while the view holds still
+(:class:`~.passes.BackgroundCache`). Each frame :meth:`TurfPass.blow` samples the wind field
+that drives the trees (``WindField.sample``, the same field and time) on a square grid at the
+turf's height over the scene and its surroundings, and :meth:`TurfPass.draw` lays a pass
+(``turf.frag``) over the ground there that scales each pixel by how blades leaned by that wind
+catch the sun: the blades lean downwind as drag bends them (``atan((U / U45)²)``), and a blade
+is a fibre (Kajiya-Kay): its diffuse light and its waxy sheen depend on its direction, the
+sun's and the eye's, against an upright blade's. A gust leans the turf over and changes its
+brightness where it passes, and the patch moves with the gust at the wind's speed.
+"""
+
+from __future__ import annotations
+
+import moderngl
+import numpy as np
+
+from .passes import release_all
+from .scene import clip_ground
+from .shaders import DEPTH_FOOTPRINT, load_program
+from .uniforms import SAMPLERS, UniformBlock
+
+#: Samples of the wind a side of the grid.
+GRID = 64
+#: The grid's side over the scene's (its box across x and z), and its least side (m).
+REACH, MIN_SIDE = 1.6, 40.0
+#: Height (m) at which the turf feels the wind: a meadow's blades, 0.2 to 0.45 m tall.
+TURF_HEIGHT = 0.3
+#: Wind speed (m/s) at the turf's height that leans its blades 45 degrees: a gale's (about
+#: 3.5 m/s there under 19 m/s above a young woodland) lays short grass half over.
+LEAN_45 = 4.0
+
+
+class TurfPass:
+    """The turf's sheen in the wind over a square round the scene.
+
+    Parameters
+    ----------
+    ctx : moderngl.Context
+    bounds : ((3,) float, (3,) float)
+        The scene's box at rest: the grid covers :data:`REACH` times its width, centred on it.
+    """
+
+    def __init__(self, ctx: moderngl.Context, bounds) -> None:
+        self.ctx = ctx
+        self.texture = self.prog = self.vbo = self.vao = self.block = None
+        lo, hi = (np.asarray(b, float) for b in bounds)
+        side = max(REACH * float(np.max((hi - lo)[[0, 2]])), MIN_SIDE)
+        self.corner = 0.5 * (lo + hi)[[0, 2]] - 0.5 * side
+        self.side = side
+        axis = np.linspace(0.0, side, GRID)
+        x, z = np.meshgrid(self.corner[0] + axis, self.corner[1] + axis)
+        self.points = np.column_stack([x.ravel(), np.full(x.size, TURF_HEIGHT), z.ravel()])
+        self.blowing = False
+        try:
+            self.block = UniformBlock(ctx, "Turf")
+            self.block.set(turf_grid=(*self.corner, side, GRID), turf_lean=LEAN_45)
+            self.texture = ctx.texture((GRID, GRID), 2, dtype="f4")
+            self.texture.repeat_x = self.texture.repeat_y = False
+            self.prog = load_program(ctx, "ground.vert", "turf.frag")
+            self.vbo = ctx.buffer(reserve=1024, dynamic=True)
+            self.vao = ctx.vertex_array(self.prog, [(self.vbo, "4f", "in_clip")])
+        except BaseException:
+            self.release()
+            raise
+
+    def blow(self, wind, time: float) -> None:
+        """Sample ``wind`` (a ``WindField``, or None: no sheen) at ``time`` (s) over the grid."""
+        self.blowing = wind is not None and not wind.calm
+        if self.blowing:
+            v = np.asarray(wind.sample(self.points, time), np.float32)
+            self.texture.write(np.ascontiguousarray(v[:, [0, 2]]).tobytes())
+
+    def draw(self, view_proj: np.ndarray) -> None:
+        """Scale the ground in the bound framebuffer over the grid (depth test on: where the
+        ground was drawn, behind everything else), when the wind blows.
+
+        Parameters
+        ----------
+        view_proj : (4, 4) float
+            World → clip (:meth:`OrbitCamera.view_projection`).
+        """
+        if not self.blowing:
+            return
+        x0, z0 = self.corner
+        square = np.array([[x0, z0], [x0 + self.side, z0], [x0 + self.side, z0 + self.side], [x0, z0 + self.side]])
+        tris = clip_ground(square, view_proj, DEPTH_FOOTPRINT)
+        if not len(tris):
+            return
+        ctx = self.ctx
+        self.vbo.write(tris.tobytes())
+        self.block.use()
+        self.texture.use(SAMPLERS["turf_wind"].unit)
+        ctx.enable(moderngl.BLEND)
+        ctx.blend_func = moderngl.DST_COLOR, moderngl.SRC_ALPHA
+        ctx.depth_func = "<="
+        ctx.depth_mask = False
+        self.vao.render(moderngl.TRIANGLES, vertices=len(tris))
+        ctx.depth_mask = True
+        ctx.depth_func = "<"
+        ctx.disable(moderngl.BLEND)
+
+    def release(self) -> None:
+        """Free the GL objects (idempotent)."""
+        release_all(self.vao, self.vbo, self.prog, self.texture, self.block)
+        self.vao = self.vbo = self.prog = self.texture = self.block = None
