@@ -6,6 +6,7 @@
 
 #include "common.glsl"
 #include "pixel.glsl"
+#include "ground.glsl"
 
 out vec4 f_color;
 
@@ -39,7 +40,12 @@ void main() {
     float sun = dot(u_sun_color, vec3(0.3333)) * max(u_sun_dir.y, 0.0) * sun_visibility(world, up);
     float sky = dot(hemisphere(up), vec3(0.3333));
     gain = mix(1.0, gain, sun / max(sun + sky, 1e-6));
-    gain = mix(1.0, gain, smoothstep(0.0, 0.1, edge) * (1.0 - haze(world)));
+    // Bare soil has no blades; the grid's edge and the haze fade the sheen out.
+    float broad;
+    vec4 fine, wide;
+    ground_maps(world.xz, length(fwidth(world.xz)), broad, fine, wide);
+    float turf = 1.0 - bare_soil(broad, fine, wide);
+    gain = mix(1.0, gain, turf * smoothstep(0.0, 0.1, edge) * (1.0 - haze(world)));
     // The frame holds display values, the linear colour to the power 1 / 2.2 (pixel.glsl).
     f_color = vec4(0.5 * pow(clamp(gain, 0.0, 4.0), 1.0 / 2.2));
 }

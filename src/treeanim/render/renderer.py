@@ -137,7 +137,7 @@ class Renderer:
             self.background = BackgroundCache(ctx)
             self.overlay_pass = OverlayPass(ctx)
             self.ground_pass = GroundPass(ctx, tree, (lo, hi))
-            self.turf_pass = TurfPass(ctx, (lo, hi))
+            self.turf_pass = TurfPass(ctx, (lo, hi), self.ground_pass.maps)
 
             self._present: np.ndarray | None = None  # None: derived from the season at draw time
             self._present_season: float | None = None

@@ -41,10 +41,14 @@ class TurfPass:
     ctx : moderngl.Context
     bounds : ((3,) float, (3,) float)
         The scene's box at rest: the grid covers :data:`REACH` times its width, centred on it.
+    maps : moderngl.Texture
+        The ground's maps (:func:`~.ground_maps.ground_texture`, the ground pass's): where the
+        ground is bare soil, which has no blades.
     """
 
-    def __init__(self, ctx: moderngl.Context, bounds) -> None:
+    def __init__(self, ctx: moderngl.Context, bounds, maps: moderngl.Texture) -> None:
         self.ctx = ctx
+        self.maps = maps
         self.texture = self.prog = self.vbo = self.vao = self.block = None
         lo, hi = (np.asarray(b, float) for b in bounds)
         side = max(REACH * float(np.max((hi - lo)[[0, 2]])), MIN_SIDE)
@@ -93,6 +97,7 @@ class TurfPass:
         self.vbo.write(tris.tobytes())
         self.block.use()
         self.texture.use(SAMPLERS["turf_wind"].unit)
+        self.maps.use(SAMPLERS["ground_maps"].unit)
         ctx.enable(moderngl.BLEND)
         ctx.blend_func = moderngl.DST_COLOR, moderngl.SRC_ALPHA
         ctx.depth_func = "<="
