@@ -27,10 +27,9 @@ void main() {
     // Texel centres: the grid's samples lie on its texels' centres, its edge fades out.
     vec2 w = texture(u_turf_wind, (0.5 + uv * (u_turf_grid.w - 1.0)) / u_turf_grid.w).rg;
     float edge = min(min(uv.x, 1.0 - uv.x), min(uv.y, 1.0 - uv.y));
-    // Drag bends a blade as U²: it leans atan((U / U45)²) downwind (45 degrees at U45).
+    // The blades lean downwind atan((U / U45)^n), as the meadow's simulated ones (turf.py).
     float u = length(w);
-    float q = u / u_turf_lean;
-    float lean = atan(q * q);
+    float lean = atan(pow(u / u_turf_lean.x, u_turf_lean.y));
     vec2 d = w / max(u, 1e-6);
     vec3 blade = vec3(d.x * sin(lean), cos(lean), d.y * sin(lean));
     vec3 up = vec3(0.0, 1.0, 0.0);

@@ -4,14 +4,18 @@ travels downwind at the wind's speed (a gust seen crossing a meadow)."""
 
 from __future__ import annotations
 
+from importlib.resources import files
+
 import numpy as np
 import pytest
 
+import treeanim as ta
 from conftest import rest_pose
+from treeanim.model.load import load_tree
 from treeanim.physics.wind import WindField
 from treeanim.render.camera import OrbitCamera
 from treeanim.render.scene import Scene
-from treeanim.render.turf import TURF_HEIGHT
+from treeanim.render.turf import LEAN_45, LEAN_EXPONENT, TURF_HEIGHT
 
 SIDE = 240
 #: Looking down on the ground round the tree, 29 m across, the wind along +x (image right).
@@ -37,8 +41,8 @@ def shots(offscreen, tree):
     return shot
 
 
-def gale():
-    wind = WindField.from_preset("gale")
+def gale(**settings):
+    wind = WindField.from_preset("gale", **settings)
     wind.canopy_height = 2.5   # a young woodland's
     return wind
 
@@ -75,3 +79,24 @@ def test_the_pattern_travels_downwind_at_the_wind_speed(shots):
 def test_no_wind_leaves_the_ground_as_it_was(shots):
     calm = WindField.from_preset("calm", speed=0.0)
     assert np.array_equal(shots(None, 0.0), shots(calm, 3.0))
+
+
+def test_the_turf_leans_as_the_meadows_simulated_blades_do():
+    """The turf's law of lean against the meadow's blades simulated in a steady gale over a
+    young woodland."""
+    tree = load_tree(files("treeanim.presets") / "scenes" / "plants" / "meadow.toml")
+    sim = ta.Simulation(tree, wind=gale(turbulence=0.0, gust_strength=0.0))
+    base, tip = tree.object_start, tree.object_start + tree.object_count - 1
+
+    def lean(P):
+        d = P[tip] - P[base]
+        return np.degrees(np.arctan2(d[:, 0], d[:, 1]))
+
+    leans = []
+    for k in range(120):   # 4 s; the last 2 s averaged
+        sim.step(1 / 30)
+        if k >= 60:
+            leans.append(np.mean(lean(sim.positions) - lean(sim.rest_positions)))
+    blades = np.mean(leans)
+    U = sim.wind.sample(np.array([[0.0, TURF_HEIGHT, 0.0]]), sim.time)[0, 0]
+    assert blades == pytest.approx(np.degrees(np.arctan((U / LEAN_45) ** LEAN_EXPONENT)), abs=5.0)

@@ -73,7 +73,7 @@ BLOCKS: dict[str, tuple[tuple[str, str, str], ...]] = {
     # TurfPass's (turf.frag).
     "Turf": (
         ("vec4", "turf_grid", "the wind grid's corner (world x, z), its side and texels a side (m, count)"),
-        ("float", "turf_lean", "wind speed (m/s) at which the turf leans 45 degrees"),
+        ("vec2", "turf_lean", "the blades' lean atan((U / x)^y): U45 (m/s), the exponent"),
     ),
     # SkyPass's (sky.frag).
     "Sky": (
