@@ -6,7 +6,7 @@ A script, not a test::
     python benchmarks/bench_scene_render.py [--frames 6] [--size 960x540] [--samples 0] [SCENE ...]
 
 Per scene: load, 5 steps in a 5 m/s wind, then for each camera ``frames`` frames of pose upload,
-draw and read back (one skipped); prints the median wall and CPU ms a frame (CPU counts a
+draw and read back (one skipped; with ``--turf`` the wind on the turf too); prints the median wall and CPU ms a frame (CPU counts a
 software rasteriser's worker threads), the shadow map's texel, and, where the renderer counts
 them, the trees and triangles it drew (``Renderer.drawn``). It runs any version of treeanim on the import path.
 """
@@ -37,6 +37,7 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=6)
     ap.add_argument("--size", default="960x540")
     ap.add_argument("--samples", type=int, default=0)
+    ap.add_argument("--turf", action="store_true", help="the wind on the turf too (Renderer.update's wind)")
     ap.add_argument("--save", default="", help="folder to save each view's last frame as SCENE_VIEW.png")
     a = ap.parse_args()
     import treeanim as ta
@@ -55,7 +56,8 @@ def main() -> None:
                 for i in range(a.frames + 1):
                     sim.step(1 / 30)
                     t0, c0 = time.perf_counter(), time.process_time()
-                    off.update(sim.positions, sim.rotations, sim.present)
+                    turf = {"wind": sim.wind, "time": sim.time} if a.turf else {}
+                    off.update(sim.positions, sim.rotations, sim.present, **turf)
                     img = off.render(cam)
                     if i:
                         wall.append(1e3 * (time.perf_counter() - t0))
