@@ -31,6 +31,7 @@ def luminance(img):
 @pytest.fixture(scope="module")
 def shots(offscreen, tree):
     """``shot(wind, t)``: the luminance of the view at time ``t`` with ``wind`` on the turf."""
+    size = offscreen.width, offscreen.height
     offscreen.resize(SIDE, SIDE)
     offscreen.load(tree, scene=Scene(shadow=False, sun_direction=SUN))
 
@@ -38,7 +39,8 @@ def shots(offscreen, tree):
         offscreen.update(*rest_pose(tree), wind=wind, time=t)
         return luminance(offscreen.render(CAMERA))
 
-    return shot
+    yield shot
+    offscreen.resize(*size)
 
 
 def gale(**settings):
