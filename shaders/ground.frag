@@ -23,7 +23,7 @@ vec3 ground_color(vec2 xz, float px) {
     float dt = max(length(xz - u_ground_centre.xz) - u_trunk_radius, 0.0) / max(1.5 * u_trunk_radius, 1e-6);
     float contact = 1.0 - 0.6 * exp(-dt * dt) * step(1e-6, u_trunk_radius);
     vec3 light = hemisphere(up) * sky + u_sun_color * max(u_sun_dir.y, 0.0) * sun;
-    return ground_albedo(xz, px) * light * contact;
+    return ground_albedo(xz, px).rgb * light * contact;
 }
 
 void main() {

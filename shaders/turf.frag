@@ -2,7 +2,7 @@
 // The turf's sheen in the wind (render/turf.py): drawn over the ground already in the frame (the
 // ground's colours are upright turf's), it scales each pixel by how the turf's blades, leaned by
 // the simulated wind there, catch the sun. The blending (DST_COLOR, SRC_ALPHA) makes the pixel
-// dst * (rgb + a): f_color holds half the gain in each, so the gain reaches from 0 to 2.
+// dst * (rgb + a): a gain from 0 to 2 for each channel.
 
 #include "common.glsl"
 #include "pixel.glsl"
@@ -11,12 +11,15 @@
 out vec4 f_color;
 
 // Kajiya-Kay's fibre: the sun on a blade along `t` (unit) seen along `v` (towards the eye): its
-// diffuse share sin(t, sun) and a sheen round the cone of mirror directions (sin(t, h)^p,
-// h the half vector). Grass blades are waxy: the sheen is a third of the light at its peak.
-float fibre(vec3 t, vec3 v) {
+// diffuse share sin(t, sun), tinted by the grass's albedo, and a sheen round the cone of mirror
+// directions, sin(t, h)^16 (h the half vector), white: a blade's waxy cuticle reflects
+// SHEEN of the light there, as a dielectric does near grazing incidence.
+const float SHEEN = 0.06;
+
+vec3 fibre(vec3 t, vec3 v, vec3 albedo) {
     float tl = dot(t, u_sun_dir);
     float th = dot(t, normalize(u_sun_dir + v));
-    return sqrt(max(1.0 - tl * tl, 0.0)) + 0.5 * pow(max(1.0 - th * th, 0.0), 16.0);
+    return albedo * sqrt(max(1.0 - tl * tl, 0.0)) + SHEEN * pow(max(1.0 - th * th, 0.0), 8.0);
 }
 
 void main() {
@@ -33,18 +36,16 @@ void main() {
     vec2 d = w / max(u, 1e-6);
     vec3 blade = vec3(d.x * sin(lean), cos(lean), d.y * sin(lean));
     vec3 up = vec3(0.0, 1.0, 0.0);
-    vec3 v = -dir;
-    float gain = fibre(blade, v) / max(fibre(up, v), 0.1);
+    vec4 ground = ground_albedo(world.xz, length(fwidth(world.xz)));
+    vec3 gain = fibre(blade, -dir, ground.rgb) / max(fibre(up, -dir, ground.rgb), 1e-4);
     // Only the sun's share of the ground's light is the blades': the sky's comes from all round.
     float sun = dot(u_sun_color, vec3(0.3333)) * max(u_sun_dir.y, 0.0) * sun_visibility(world, up);
     float sky = dot(hemisphere(up), vec3(0.3333));
-    gain = mix(1.0, gain, sun / max(sun + sky, 1e-6));
     // Bare soil has no blades; the grid's edge and the haze fade the sheen out.
-    float broad;
-    vec4 fine, wide;
-    ground_maps(world.xz, length(fwidth(world.xz)), broad, fine, wide);
-    float turf = 1.0 - bare_soil(broad, fine, wide);
-    gain = mix(1.0, gain, turf * smoothstep(0.0, 0.1, edge) * (1.0 - haze(world)));
+    float turf = (1.0 - ground.a) * smoothstep(0.0, 0.1, edge) * (1.0 - haze(world));
+    gain = mix(vec3(1.0), gain, turf * sun / max(sun + sky, 1e-6));
     // The frame holds display values, the linear colour to the power 1 / 2.2 (pixel.glsl).
-    f_color = vec4(0.5 * pow(clamp(gain, 0.0, 4.0), 1.0 / 2.2));
+    vec3 g = pow(clamp(gain, 0.0, 4.0), vec3(1.0 / 2.2));
+    float common_part = clamp(max(max(g.r, g.g), g.b) - 1.0, 0.0, min(min(g.r, g.g), g.b));
+    f_color = vec4(g - common_part, common_part);
 }
