@@ -19,7 +19,7 @@ import numpy as np
 
 from .passes import release_all
 from .scene import clip_ground
-from .shaders import DEPTH_FOOTPRINT, load_program
+from .shaders import DEPTH_TURF, load_program
 from .uniforms import SAMPLERS, UniformBlock
 
 #: Samples of the wind a side of the grid.
@@ -92,7 +92,7 @@ class TurfPass:
             return
         x0, z0 = self.corner
         square = np.array([[x0, z0], [x0 + self.side, z0], [x0 + self.side, z0 + self.side], [x0, z0 + self.side]])
-        tris = clip_ground(square, view_proj, DEPTH_FOOTPRINT)
+        tris = clip_ground(square, view_proj, DEPTH_TURF)
         if not len(tris):
             return
         ctx = self.ctx
