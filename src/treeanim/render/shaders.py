@@ -23,7 +23,6 @@ from .uniforms import bind_program, uniforms_glsl
 DEPTH_THIN = 0.99999
 DEPTH_TURF = 0.999992
 DEPTH_FOOTPRINT = 0.999994
-DEPTH_TURF = 0.999992
 DEPTH_GROUND = 0.999997
 
 _INCLUDE = re.compile(r'^\s*#include\s+"([^"]+)"\s*$', re.MULTILINE)
