@@ -155,18 +155,23 @@ def _resolved(x2):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _whirl_theta(h, w, t1, t2):
+def _whirl_theta(h, w, kick, t1, t2):
     """A joint's θ for its bends and twist this step: its swing's (:func:`theta_of`), raised
-    to 1 − ½·:func:`_resolved` (½ + ½·y⁴/(y⁴ + 1)) if more, y = h·|w| the radians it turns in
-    the step. A whirl of a radian or more a step (a grass blade's tip whipping in a gust's
-    wake at 1/30 s) leaves the step's linearisation, which then gains energy on the
-    trapezoidal rule; a swing the step resolves turns far less."""
-    tw = 1.0 - 0.5 * _resolved(h * h * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]))
+    to 1 − ½·:func:`_resolved` (½ + ½·y⁴/(y⁴ + 1)) if more, y the radians it turns in the
+    step, h·|w|, or ``kick`` = h·|Δw| (its change of velocity over the last step) if more.
+    A whirl of a radian or more a step (a grass blade's tip whipping in a gust's wake at
+    1/30 s) leaves the step's linearisation, which then gains energy on the trapezoidal rule;
+    a swing the step resolves turns far less. A swing of amplitude A changes w by about A·x²
+    a step (x = ωh) against its speed A·x/h: a large kick marks a swing faster than the step
+    (a grass blade's chain modes at 1/10 s, which rang at the step rate and, passing energy
+    between the springs and the segments, gained up to a fifth of it every other step)."""
+    y2 = max(h * h * (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]), kick * kick)
+    tw = 1.0 - 0.5 * _resolved(y2)
     return max(t1, tw), max(t2, tw)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dkk, R, P, Q, w, Om, V,
+def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dkk, R, P, Q, w, kick, Om, V,
                      F, kap, IA, pA, Dinv, Ucol, Urow, u, acc):
     """One implicit step of every body (the articulated-body algorithm, three passes).
 
@@ -188,6 +193,9 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
         stiffness (s): K = k_b(1 − aaᵀ) + k_t·aaᵀ about the segment's axis a, D = dkk·K.
     R, P, Q, w : the state (see :func:`~treeanim.physics.kinematics.forward_kinematics`); Q
         and w are advanced in place, R and P are left for forward kinematics to redo.
+    kick : (B,) float
+        h·|Δw|, each joint's change of velocity over the last step as the radians it would turn
+        in a step (:func:`_whirl_theta`); written.
     F : (B, 6)
         External spatial force on each body (moment about its joint, force), world.
     kap : (B, 6, 6)
@@ -272,7 +280,7 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
         az = Rm[2, 0] * axis[b, 0] + Rm[2, 1] * axis[b, 1] + Rm[2, 2] * axis[b, 2]
         aw = (ax, ay, az)
         k1, k2, dk = kb[b], kt[b], dkk[b]
-        t1, t2 = _whirl_theta(h, w[b], theta[b], theta_t[b])
+        t1, t2 = _whirl_theta(h, w[b], kick[b], theta[b], theta_t[b])
         tw0 = Rm[0, 0] * th[0] + Rm[0, 1] * th[1] + Rm[0, 2] * th[2]
         tw1 = Rm[1, 0] * th[0] + Rm[1, 1] * th[1] + Rm[1, 2] * th[2]
         tw2 = Rm[2, 0] * th[0] + Rm[2, 1] * th[1] + Rm[2, 2] * th[2]
@@ -358,7 +366,7 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
         else:
             l0, l1, l2 = d0, d1, d2
         # Θ in the parent's rest axes: θ_b + (θ_t − θ_b)·a aᵀ
-        t1, t2 = _whirl_theta(h, w[b], theta[b], theta_t[b])
+        t1, t2 = _whirl_theta(h, w[b], kick[b], theta[b], theta_t[b])
         al = (axis[b, 0] * l0 + axis[b, 1] * l1 + axis[b, 2] * l2) * (t2 - t1)
         e0 = h * (w[b, 0] + t1 * l0 + al * axis[b, 0])
         e1 = h * (w[b, 1] + t1 * l1 + al * axis[b, 1])
@@ -366,6 +374,7 @@ def articulated_step(h, theta, theta_t, axis, parent, r0, m0, h0, J0, kb, kt, dk
         w[b, 0] += l0
         w[b, 1] += l1
         w[b, 2] += l2
+        kick[b] = h * np.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
         rot_exp(e0, e1, e2, Rm)
         for i in range(3):
             for j in range(3):

@@ -50,7 +50,7 @@ HYSTERESIS = 0.15
 SEGMENT_DRAG = 3.0 * np.pi / 16.0
 #: The same of a lamina's normal force, ⟨cos²⟩ over the sphere.
 LEAF_DRAG = 1.0 / 3.0
-_BODY_STATE = ("Q", "w", "R", "P", "Om", "V", "leaf_F", "leaf_C", "leaf_K")  # TreeState's per-body arrays (the
+_BODY_STATE = ("Q", "w", "R", "P", "Om", "V", "leaf_F", "leaf_C", "leaf_K", "kick")  # TreeState's per-body arrays (the
 # others are per leaf)
 
 
@@ -267,6 +267,7 @@ class Reduced:
         todo = changed[parts.body_tree]
         _freeze(~on & todo, ~leaf_on & changed[parts.leaf_tree], s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om,
                 st.V, st.leaf_F, st.leaf_C, st.leaf_K, st.thd)
+        st.kick[~on & todo] = 0.0
         anc = _anchors(s.parent, on)
         self.carried = self.frozen[anc[self.frozen] >= 0]  # (the rest stands still from now on)
         moving = anc >= 0

@@ -50,6 +50,7 @@ class TreeState:
     leaf_K: np.ndarray  # (B, 3, 3) their stiffness against the twig's turn (N·m; times h²)
     phase: np.ndarray   # (L,) flutter phase (rad)
     twist: np.ndarray   # (L,) the flutter's twist (rad)
+    kick: np.ndarray    # (B,) h·|Δw|, each joint's last change of velocity as radians a step (articulated._whirl_theta)
 
     @classmethod
     def rest(cls, s: Structure, seed: int = 0) -> "TreeState":
@@ -59,7 +60,8 @@ class TreeState:
                  P=np.empty((B, 3)), Om=np.empty((B, 3)), V=np.empty((B, 3)),
                  th=np.zeros((L, 3)), thd=np.zeros((L, 3)), leaf_F=np.zeros((B, 6)),
                  leaf_C=np.zeros((B, 6, 6)), leaf_K=np.zeros((B, 3, 3)),
-                 phase=np.random.default_rng([int(seed), 0x1EAF]).uniform(0, 2 * np.pi, L), twist=np.zeros(L))
+                 phase=np.random.default_rng([int(seed), 0x1EAF]).uniform(0, 2 * np.pi, L), twist=np.zeros(L),
+                 kick=np.zeros(B))
         forward_kinematics(s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om, st.V)
         return st
 
@@ -305,7 +307,7 @@ def step(s: Structure, st: TreeState, out: TreeState, wind: np.ndarray, dt: floa
         _grab_force(s, g, out, dt, w)
     tb, tt = _thetas(s, dt, work)
     articulated_step(dt, tb, tt, s.axis, s.parent, s.r0, s.m0, s.h0, s.J0, s.kb, s.kt, s.dk, out.R, out.P, out.Q, out.w,
-                     out.Om, out.V, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.Ur, w.u, w.acc)
+                     out.kick, out.Om, out.V, w.F, w.kap, w.IA, w.pA, w.Dinv, w.U, w.Ur, w.u, w.acc)
     ground_contact(s.parent, s.r0, s.seg0, s.floor, out.Q, out.w, out.R, out.P, out.Om, out.V)
     leaf_step(dt, s.leaf_on, s.leaf_body, s.leaf_base0, s.leaf_rc0, s.leaf_geometry, s.leaf_E, s.leaf_k,
               s.leaf_J, s.leaf_d, s.leaf_cna, s.leaf_cswing, s.leaf_roll2, s.leaf_cauchy, s.leaf_size,
