@@ -10,16 +10,14 @@
 
 out vec4 f_color;
 
-// Kajiya-Kay's fibre: the sun on a blade along `t` (unit) seen along `v` (towards the eye): its
-// diffuse share sin(t, sun), tinted by the grass's albedo, and a sheen round the cone of mirror
-// directions, sin(t, h)^16 (h the half vector), white: a blade's waxy cuticle reflects
-// SHEEN of the light there, as a dielectric does near grazing incidence.
-const float SHEEN = 0.06;
-
-vec3 fibre(vec3 t, vec3 v, vec3 albedo) {
+// Kajiya-Kay's fibre, its diffuse part: the sun on a blade along `t` (unit), sin(t, sun). The
+// ground (ground.frag) is lit as diffuse turf, no sheen, so a leaned blade's light is that of an
+// upright one times the ratio of their diffuse parts, the same in every channel: a gust shades
+// the grass lighter or darker, never another hue. (A white waxy sheen on the blades, 0.06 of a
+// Kajiya-Kay lobe, tinted the gale's turf pale cyan, a colour no still ground shows.)
+float fibre(vec3 t) {
     float tl = dot(t, u_sun_dir);
-    float th = dot(t, normalize(u_sun_dir + v));
-    return albedo * sqrt(max(1.0 - tl * tl, 0.0)) + SHEEN * pow(max(1.0 - th * th, 0.0), 8.0);
+    return sqrt(max(1.0 - tl * tl, 0.0));
 }
 
 void main() {
@@ -37,12 +35,12 @@ void main() {
     vec3 blade = vec3(d.x * sin(lean), cos(lean), d.y * sin(lean));
     vec3 up = vec3(0.0, 1.0, 0.0);
     vec4 ground = ground_albedo(world.xz, length(fwidth(world.xz)));
-    vec3 gain = fibre(blade, -dir, ground.rgb) / max(fibre(up, -dir, ground.rgb), 1e-4);
+    vec3 gain = vec3(fibre(blade) / max(fibre(up), 1e-4));
     // Only the sun's share of the ground's light is the blades': the sky's comes from all round.
     float sun = dot(u_sun_color, vec3(0.3333)) * max(u_sun_dir.y, 0.0) * sun_visibility(world, up);
     float sky = dot(hemisphere(up), vec3(0.3333));
     // Bare soil has no blades; the grid's edge and the haze fade the sheen out.
-    float turf = (1.0 - ground.a) * smoothstep(0.0, 0.1, edge) * (1.0 - haze(world));
+    float turf = (1.0 - ground.a) * smoothstep(0.0, 0.3, edge) * (1.0 - haze(world));
     gain = mix(vec3(1.0), gain, turf * sun / max(sun + sky, 1e-6));
     // The frame holds display values, the linear colour to the power 1 / 2.2 (pixel.glsl).
     vec3 g = pow(clamp(gain, 0.0, 4.0), vec3(1.0 / 2.2));

@@ -7,9 +7,9 @@ that drives the trees (``WindField.sample``, the same field and time) on a squar
 turf's height over the scene and its surroundings, and :meth:`TurfPass.draw` lays a pass
 (``turf.frag``) over the ground there that scales each pixel by how blades leaned by that wind
 catch the sun: the blades lean downwind as the meadow's simulated ones do (:data:`LEAN_45`),
-and a blade is a fibre (Kajiya-Kay): its diffuse light and its waxy sheen depend on its
-direction, the sun's and the eye's, against an upright blade's. A gust leans the turf over and changes its
-brightness where it passes, and the patch moves with the gust at the wind's speed.
+and a blade is a fibre (Kajiya-Kay): its diffuse light depends on its direction and the
+sun's, against an upright blade's. A gust leans the turf over and changes its brightness where
+it passes, and the patch moves with the gust at the wind's speed.
 """
 
 from __future__ import annotations
@@ -24,8 +24,9 @@ from .uniforms import SAMPLERS, UniformBlock
 
 #: Samples of the wind a side of the grid.
 GRID = 64
-#: The grid's side over the scene's (its box across x and z), and its least side (m).
-REACH, MIN_SIDE = 1.6, 40.0
+#: The grid's side over the scene's (its box across x and z), and its least side (m): its
+#: outer 30 % fades out (turf.frag), so round a lone tree the gusts show 30 m and more away.
+REACH, MIN_SIDE = 1.6, 80.0
 #: Height (m) at which the turf feels the wind: a meadow's blades, 0.2 to 0.45 m tall.
 TURF_HEIGHT = 0.3
 #: How the turf's blades lean in a wind U at its height: tan(lean) = (U / U45)^n, U45 in m/s;
