@@ -74,8 +74,9 @@ class TurfPass:
             raise
 
     def blow(self, wind, time: float) -> None:
-        """Sample ``wind`` (a ``WindField``, or None: no sheen) at ``time`` (s) over the grid."""
-        self.blowing = wind is not None and not wind.calm
+        """Sample ``wind`` (anything with ``sample(points, t)``, as ``Simulation`` takes; None or a
+        calm ``WindField``: no pass) at ``time`` (s) over the grid."""
+        self.blowing = wind is not None and not getattr(wind, "calm", False)
         if self.blowing:
             v = np.asarray(wind.sample(self.points, time), np.float32)
             self.texture.write(np.ascontiguousarray(v[:, [0, 2]]).tobytes())
