@@ -79,6 +79,23 @@ def test_leaves_flutter_above_2_hz_more_in_stronger_wind_each_in_its_own_phase()
     assert np.median(off) < 0.2, np.median(off)
 
 
+def test_in_a_gale_the_leaves_flutter_as_far_as_in_a_fresh_breeze():
+    # Before (issue 26): the air's damping of a lamina's roll, which grows with the wind, held
+    # back the flutter it drives: in a steady wind the tulip poplar's laminas twisted 0.21 rad
+    # (mean |twist|) at 10 m/s, 0.04 at 20 and 0.02 at 30 m/s, as if a gale were calmer. The
+    # flutter is the air's own motion of the lamina; the air damps departures from it.
+    twist = {}
+    for U in (10.0, 30.0):
+        sim = ta.Simulation(ta.load_preset("tulip_poplar"), wind=Uniform((U, 0.0, 0.0)))
+        rolls = []
+        for k in range(120):
+            sim.step(1 / 60)
+            if k >= 60:
+                rolls.append(np.abs(sim.state.tree.th[:, 0]))
+        twist[U] = float(np.mean(rolls))
+    assert twist[30.0] > 0.8 * twist[10.0], twist
+
+
 @pytest.mark.parametrize("name", ["tulip_poplar", "small_cherry"])
 def test_no_leaf_snaps_through_in_a_gale_at_any_frame_rate(name):
     # Before (issue #12): in a 30 m/s gale the tulip poplar's leaves turned up to 180° in one

@@ -340,9 +340,11 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
             if i == 0:
                 # the twist: nil for a force at the centroid, which lies on the lamina's axis;
                 # the flutter drives it (its torque a ramp over the step), the lamina's halves
-                # swinging through the air damp it
-                K, f0, f1 = kk, kk * twist0, kk * (twist1 - twist0)
-                d = dstr[l, i] + cswing[l] * s * roll2[l]
+                # swinging through the air damp it, against the flutter, which is the air's own
+                # motion of the lamina: the air damps the roll's departure from it
+                droll = cswing[l] * s * roll2[l]
+                K, f0, f1 = kk, kk * twist0 + droll * (twist1 - twist0) / h, kk * (twist1 - twist0)
+                d = dstr[l, i] + droll
             else:
                 # a bend: the air's moment linearised about the step's start, its stiffness
                 # taken implicitly where it restores (a lamina weathervaning into the flow)
