@@ -251,7 +251,7 @@ def test_leaves_back_on_the_tree_leave_the_ground_and_the_paper_drops_them_unsee
 
 
 def test_a_petiole_axis_step_never_gains_energy_and_is_third_order():
-    """leafjoint._axis_step, J·θ̈ + d·θ̇ + K·θ = f₀ + f₁·t/h over one step: unforced, the
+    """leafjoint._axis_step, J·θ̈ + d·θ̇ + K·θ = f₀ + f₁·t/h + g/h over one step: unforced, the
     energy ½(Kθ² + Jθ̇²) never grows at any step, stiffness, damping or inertia (10⁻⁶ to 10⁶ s,
     a leaf's settings at their bounds); its local error falls as h⁴; a free body's ramp is
     exact."""
@@ -262,7 +262,7 @@ def test_a_petiole_axis_step_never_gains_energy_and_is_third_order():
         h, J, K = 10 ** rng.uniform(-6, 6), 10 ** rng.uniform(-17, 0), 10 ** rng.uniform(-14, 3)
         d = 10 ** rng.uniform(-12, 2) * rng.integers(0, 2)
         th, om = rng.normal(), rng.normal() * np.sqrt(K / J)
-        th1, om1 = _axis_step(h, J, K, d, 0.0, 0.0, th, om)
+        th1, om1 = _axis_step(h, J, K, d, 0.0, 0.0, 0.0, th, om)
         assert K * th1**2 + J * om1**2 <= (K * th**2 + J * om**2) * (1 + 1e-12), (h, J, K, d)
 
     J, w, zeta = 2e-6, 2 * np.pi * 12.0, 0.3  # a petiole's bend
@@ -270,8 +270,12 @@ def test_a_petiole_axis_step_never_gains_energy_and_is_third_order():
 
     def error(h):  # from θ = 1 at rest: the exact free swing e^(−ζωt)(cos ω_d t + ζω/ω_d sin ω_d t)
         exact = np.exp(-zeta * w * h) * (np.cos(wd * h) + zeta * w / wd * np.sin(wd * h))
-        return abs(_axis_step(h, J, J * w * w, 2 * zeta * w * J, 0.0, 0.0, 1.0, 0.0)[0] - exact)
+        return abs(_axis_step(h, J, J * w * w, 2 * zeta * w * J, 0.0, 0.0, 0.0, 1.0, 0.0)[0] - exact)
 
     assert 13.0 < error(1e-3) / error(5e-4) < 18.0, error(1e-3) / error(5e-4)
-    th, om = _axis_step(0.1, 2.0, 0.0, 0.0, 4.0, 6.0, 0.5, 1.0)  # θ̈ = 2 + 30t: θ = ½ + t + t² + 5t³
+    th, om = _axis_step(0.1, 2.0, 0.0, 0.0, 4.0, 6.0, 0.0, 0.5, 1.0)  # θ̈ = 2 + 30t: θ = ½ + t + t² + 5t³
     assert np.allclose([th, om], [0.5 + 0.1 + 0.01 + 0.005, 1.0 + 0.2 + 0.15], rtol=1e-14)
+    th, om = _axis_step(0.1, 2.0, 0.0, 0.0, 4.0, 6.0, 0.2, 0.5, 1.0)  # and g/h = 2 more: θ̈ = 3 + 30t
+    assert np.allclose([th, om], [0.5 + 0.1 + 0.015 + 0.005, 1.0 + 0.3 + 0.15], rtol=1e-14)
+    # g is an impulse: a step of 10⁻³²⁰ s takes it whole, with no division by h
+    assert np.isfinite(_axis_step(1e-320, 2e-6, 1.0, 1e-3, 0.0, 0.0, 1e-9, 0.0, 0.0)).all()

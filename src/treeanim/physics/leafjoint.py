@@ -40,8 +40,9 @@ FLUTTER_SPEED = 4.0
 
 
 @njit(cache=True, fastmath=True, error_model="numpy", inline="always")
-def _axis_step(h, J, K, d, f0, f1, th, om):
-    """One step of J·θ̈ + d·θ̇ + K·θ = f0 + f1·t/h from (θ, θ̇) = (th, om): (θ, θ̇) after it.
+def _axis_step(h, J, K, d, f0, f1, g, th, om):
+    """One step of J·θ̈ + d·θ̇ + K·θ = f0 + f1·t/h + g/h from (θ, θ̇) = (th, om): (θ, θ̇) after it
+    (g: a constant force's impulse over the step, given as such so that no step divides by h).
 
     The 2-stage Radau IIA method, in closed form. On this linear system it is the exact flow
     with exp(Z) taken as its (1, 2) Padé approximant R(Z) = (1 − ⅔Z + Z²/6)⁻¹(1 + Z/3)
@@ -54,7 +55,7 @@ def _axis_step(h, J, K, d, f0, f1, th, om):
     """
     hJ = h / J
     a, q = K * hJ, d * hJ
-    ph0, ph1 = hJ * f0, hJ * f1
+    ph0, ph1 = hJ * f0 + g / J, hJ * f1
     y0 = th + h * (om / 3.0 - (ph0 + ph1) / 6.0)
     y1 = om - (a * th + q * om) / 3.0 + ph0 * (1.0 + q / 6.0) + ph1 * (0.5 + q / 6.0)
     p = a * h
@@ -262,7 +263,7 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
     LC[:] = 0.0
     LK[:] = 0.0
     A = np.empty((6, body.shape[0]))
-    C = np.empty((7, 3 * body.shape[0]))  # each petiole axis's step (_petioles)
+    C = np.empty((8, 3 * body.shape[0]))  # each petiole axis's step (_petioles)
     _laminas(geo, th, A)
     f_max = 0.25 / h  # a quarter of the step rate (the flutter is at most MAX_FLUTTER_HZ anyway)
     z6 = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -293,6 +294,7 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
         if not on[l]:
             twist[l] = 0.0
             C[:4, 3 * l:3 * l + 3] = 0.0
+            C[7, 3 * l:3 * l + 3] = 0.0
             continue
         # slowed, it is scaled by f/f_leaf: a lamina's bends follow its twist within their
         # settling (some 0.03 s in a gale), and twist and bends each take a 12 Hz flutter about
@@ -343,7 +345,7 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
                 # swinging through the air damp it, against the flutter, which is the air's own
                 # motion of the lamina: the air damps the roll's departure from it
                 droll = cswing[l] * s * roll2[l]
-                K, f0, f1 = kk, kk * twist0 + droll * (twist1 - twist0) / h, kk * (twist1 - twist0)
+                K, f0, f1, g = kk, kk * twist0, kk * (twist1 - twist0), droll * (twist1 - twist0)
                 d = dstr[l, i] + droll
             else:
                 # a bend: the air's moment linearised about the step's start, its stiffness
@@ -361,10 +363,10 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
                     ka = max(ka, abs(tau) / dstar)
                     if np.isfinite(dstar):  # the chord is exact as far as the air's balance
                         guard = max(guard, dstar)
-                K, f0, f1 = kk + ka, tau + ka * th[l, i], 0.0
+                K, f0, f1, g = kk + ka, tau + ka * th[l, i], 0.0, 0.0
                 d = dstr[l, i] + dair
             j = 3 * l + i
-            C[0, j], C[1, j], C[2, j], C[3, j], C[6, j] = K, d, f0, f1, guard
+            C[0, j], C[1, j], C[2, j], C[3, j], C[6, j], C[7, j] = K, d, f0, f1, guard, g
     _add_twig(last, TF, TC, TK, LF, LC, LK)
     _petioles(h, on, J, th, thd, C)
 
@@ -378,7 +380,7 @@ def _petioles(h, on, J, th, thd, C):
     n = C.shape[1]
     Jf, tf, vf = J.reshape(n), th.reshape(n), thd.reshape(n)
     for j in range(n):
-        C[4, j], C[5, j] = _axis_step(h, Jf[j], C[0, j], C[1, j], C[2, j], C[3, j], tf[j], vf[j])
+        C[4, j], C[5, j] = _axis_step(h, Jf[j], C[0, j], C[1, j], C[2, j], C[3, j], C[7, j], tf[j], vf[j])
     for l in range(on.shape[0]):
         if not on[l]:
             continue
