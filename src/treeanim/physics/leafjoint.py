@@ -293,8 +293,7 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
         twist0 = twist[l]
         if not on[l]:
             twist[l] = 0.0
-            C[:4, 3 * l:3 * l + 3] = 0.0
-            C[7, 3 * l:3 * l + 3] = 0.0
+            C[:5, 3 * l:3 * l + 3] = 0.0
             continue
         # slowed, it is scaled by f/f_leaf: a lamina's bends follow its twist within their
         # settling (some 0.03 s in a gale), and twist and bends each take a 12 Hz flutter about
@@ -366,30 +365,30 @@ def leaf_step(h, on, body, base0, rc0, geo, E, k, J, dstr, cna, cswing, roll2, c
                 K, f0, f1, g = kk + ka, tau + ka * th[l, i], 0.0, 0.0
                 d = dstr[l, i] + dair
             j = 3 * l + i
-            C[0, j], C[1, j], C[2, j], C[3, j], C[6, j], C[7, j] = K, d, f0, f1, guard, g
+            C[0, j], C[1, j], C[2, j], C[3, j], C[4, j], C[7, j] = K, d, f0, f1, g, guard
     _add_twig(last, TF, TC, TK, LF, LC, LK)
     _petioles(h, on, J, th, thd, C)
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
 def _petioles(h, on, J, th, thd, C):
-    """Step every petiole axis of the leaves ``on`` by :func:`_axis_step` from its K, d, f₀ and
-    f₁ (C's first four rows, a column per axis, θ's order), all axes as vectors (C's last two
-    rows take θ and θ̇ after it), then the guard (:data:`MAX_TURN`) and the petiole's stop
-    leaf by leaf."""
+    """Step every petiole axis of the leaves ``on`` by :func:`_axis_step` from its K, d, f₀, f₁
+    and g (C's rows 0–4, a column per axis, θ's order), all axes as vectors (rows 5 and 6 take
+    θ and θ̇ after it), then the guard (row 7, at least :data:`MAX_TURN`) and the petiole's
+    stop leaf by leaf."""
     n = C.shape[1]
     Jf, tf, vf = J.reshape(n), th.reshape(n), thd.reshape(n)
     for j in range(n):
-        C[4, j], C[5, j] = _axis_step(h, Jf[j], C[0, j], C[1, j], C[2, j], C[3, j], C[7, j], tf[j], vf[j])
+        C[5, j], C[6, j] = _axis_step(h, Jf[j], C[0, j], C[1, j], C[2, j], C[3, j], C[4, j], tf[j], vf[j])
     for l in range(on.shape[0]):
         if not on[l]:
             continue
         for i in range(3):
-            turn, v = C[4, 3 * l + i] - th[l, i], C[5, 3 * l + i]
-            g = C[6, 3 * l + i]
-            if i > 0 and abs(turn) > g:  # the guard (see MAX_TURN): speed cut with it
-                v *= g / abs(turn)
-                turn = g if turn > 0.0 else -g
+            turn, v = C[5, 3 * l + i] - th[l, i], C[6, 3 * l + i]
+            guard = C[7, 3 * l + i]
+            if i > 0 and abs(turn) > guard:  # the guard (see MAX_TURN): speed cut with it
+                v *= guard / abs(turn)
+                turn = guard if turn > 0.0 else -guard
             th[l, i] += turn
             thd[l, i] = v
         # a petiole's stop
