@@ -60,6 +60,7 @@ class TurfPass:
         axis = np.linspace(0.0, side, GRID)
         x, z = np.meshgrid(self.corner[0] + axis, self.corner[1] + axis)
         self.points = np.column_stack([x.ravel(), np.full(x.size, TURF_HEIGHT), z.ravel()])
+        self._blown = None  # (wind, time) not yet sampled into the texture
         self.blowing = False
         try:
             self.block = UniformBlock(ctx, "Turf")
@@ -75,11 +76,10 @@ class TurfPass:
 
     def blow(self, wind, time: float) -> None:
         """Sample ``wind`` (anything with ``sample(points, t)``, as ``Simulation`` takes; None or a
-        calm ``WindField``: no pass) at ``time`` (s) over the grid."""
+        calm ``WindField``: no pass) at ``time`` (s) over the grid, when the next :meth:`draw`
+        sees the grid (a view with no turf in it samples nothing)."""
         self.blowing = wind is not None and not getattr(wind, "calm", False)
-        if self.blowing:
-            v = np.asarray(wind.sample(self.points, time), np.float32)
-            self.texture.write(np.ascontiguousarray(v[:, [0, 2]]).tobytes())
+        self._blown = (wind, time) if self.blowing else None
 
     def draw(self, view_proj: np.ndarray) -> None:
         """Scale the ground in the bound framebuffer over the grid (depth test on: where the
@@ -97,6 +97,11 @@ class TurfPass:
         tris = clip_ground(square, view_proj, DEPTH_TURF)
         if not len(tris):
             return
+        if self._blown is not None:
+            wind, time = self._blown
+            v = np.asarray(wind.sample(self.points, time), np.float32)
+            self.texture.write(np.ascontiguousarray(v[:, [0, 2]]).tobytes())
+            self._blown = None
         ctx = self.ctx
         self.vbo.write(tris.tobytes())
         self.block.use()
