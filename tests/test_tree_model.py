@@ -189,6 +189,29 @@ def test_sway_grows_at_least_as_the_speed_to_the_power_1_3():
     assert sway[20.0] / sway[5.0] >= 4.0**1.3, sway
 
 
+@pytest.mark.parametrize("preset", ["small_cherry", "large_cherry", "tulip_poplar"])
+def test_the_leaves_load_grows_as_vogels_reconfigured_foliage(preset):
+    """REALISM.md: a crown's foliage streamlines, its drag growing as U^(2+b) with b ≈ −0.5 … −1
+    (Vogel 1989, measured at 10 and 20 m/s). The trunk's lean in a steady wind is its wind
+    moment over its stiffness, so the lean in leaf less the lean bare is the leaves' share."""
+    tree = ta.load_preset(preset)
+    top = tree.object_start[0] + tree.object_count[0] - 1
+    lean = {}
+    for season in (0.0, 1.0):
+        for U in (5.0, 20.0):
+            sim = ta.Simulation(tree, wind=Uniform((U, 0.0, 0.0)), season=season)
+            d = []
+            for k in range(120):
+                sim.step(1 / 30)
+                if k >= 60:
+                    d.append(sim.tip_position(0)[0] - tree.rest_positions[top, 0])
+            lean[season, U] = np.mean(d)
+    leaves = {U: lean[0.0, U] - lean[1.0, U] for U in (5.0, 20.0)}
+    assert leaves[5.0] > 0.0, lean
+    b = np.log(leaves[20.0] / leaves[5.0]) / np.log(4.0) - 2.0
+    assert -1.0 <= b <= -0.5, (b, lean)
+
+
 @pytest.mark.parametrize("falling", [False, True], ids=["summer", "leaves falling"])
 def test_the_state_is_copied_and_restored_exactly(falling):
     tree = ta.load_preset("small_cherry")
