@@ -5,12 +5,12 @@ A script, not a test::
     python benchmarks/bench_drag.py [--presets small_cherry ...] [--speeds 3 5 10 20 30] [--turbulence 0.3]
 
 For each preset and speed it holds a steady, uniform wind along x over the tree (no gusts, no
-turbulence) for two seconds of 1/60 s steps and averages the air's force along x on every
-body (wood, and the leaves' forces on their twigs) over the last second, in leaf (summer)
-and bare (winter). With ``--turbulence I`` the wind is the default physical wind of that
-turbulence intensity instead (its gusts and profile too, the same seed in leaf and bare),
-averaged over eight seconds after two. It reports the force on the whole tree, on its trunk (object 0), on the
-crown's wood (winter, less the trunk) and on the foliage (summer less winter), the exponent
+turbulence) for two seconds of 1/60 s steps and averages the air's force along x on every body
+(wood, and the leaves' forces on their twigs) over the last second, in leaf (summer) and bare
+(winter). With ``--turbulence I`` the wind is the default physical wind of that turbulence
+intensity instead (its gusts and profile too, the same seed in leaf and bare), averaged over
+eight seconds after two. It reports the force on the whole tree, on its trunk (object 0), on
+the crown's wood (winter, less the trunk) and on the foliage (summer less winter), the exponent
 2 + b of F ∝ U^(2+b) between successive speeds for the whole tree, the crown (all but the
 trunk) and the foliage alone, how far F/U² falls from 5 to 20 m/s, and the crown's drag
 coefficient on its outline at rest (the convex hull of the tree across the wind, ½ρU²·C_d·A).
