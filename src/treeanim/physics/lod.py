@@ -128,12 +128,13 @@ def carry(bodies, parent, r0, Q, w, R, P, Om, V):
 
 
 @njit(cache=True, fastmath=True, error_model="numpy")
-def _freeze(bodies, leaves, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V, leaf_F, leaf_C, leaf_K, thd):
-    """Freeze the ``bodies`` (bool: no relative velocity, placed on their parents; their
-    leaves pass them no force) and the ``leaves`` (bool: at rest)."""
+def _freeze(bodies, leaves, parent, r0, st_Q, st_w, st_R, st_P, st_Om, st_V, kick, leaf_F, leaf_C, leaf_K, thd):
+    """Freeze the ``bodies`` (bool: no relative velocity nor change of it, placed on their
+    parents; their leaves pass them no force) and the ``leaves`` (bool: at rest)."""
     for b in range(len(bodies)):
         if bodies[b]:
             st_w[b, :] = 0.0
+            kick[b] = 0.0
             leaf_F[b, :] = 0.0
             leaf_C[b, :, :] = 0.0
             leaf_K[b, :, :] = 0.0
@@ -266,8 +267,7 @@ class Reduced:
         changed = np.ones(len(levels), bool) if was is None else levels != was
         todo = changed[parts.body_tree]
         _freeze(~on & todo, ~leaf_on & changed[parts.leaf_tree], s.parent, s.r0, st.Q, st.w, st.R, st.P, st.Om,
-                st.V, st.leaf_F, st.leaf_C, st.leaf_K, st.thd)
-        st.kick[~on & todo] = 0.0
+                st.V, st.kick, st.leaf_F, st.leaf_C, st.leaf_K, st.thd)
         anc = _anchors(s.parent, on)
         self.carried = self.frozen[anc[self.frozen] >= 0]  # (the rest stands still from now on)
         moving = anc >= 0
