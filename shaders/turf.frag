@@ -1,8 +1,8 @@
 #version 330 core
-// The turf's sheen in the wind (render/turf.py): drawn over the ground already in the frame (the
+// The turf in the wind (render/turf.py): drawn over the ground already in the frame (the
 // ground's colours are upright turf's), it scales each pixel by how the turf's blades, leaned by
 // the simulated wind there, catch the sun. The blending (DST_COLOR, SRC_ALPHA) makes the pixel
-// dst * (rgb + a): a gain from 0 to 2 for each channel.
+// dst * (rgb + a): a grey gain g from 0 to 2 as rgb = min(g, 1), a = max(g - 1, 0).
 
 #include "common.glsl"
 #include "pixel.glsl"
@@ -35,15 +35,15 @@ void main() {
     vec3 blade = vec3(d.x * sin(lean), cos(lean), d.y * sin(lean));
     vec3 up = vec3(0.0, 1.0, 0.0);
     vec4 ground = ground_albedo(world.xz, length(fwidth(world.xz)));
-    vec3 gain = vec3(fibre(blade) / max(fibre(up), 1e-4));
+    float gain = fibre(blade) / max(fibre(up), 1e-4);
     // Only the sun's share of the ground's light is the blades': the sky's comes from all round.
     float sun = dot(u_sun_color, vec3(0.3333)) * max(u_sun_dir.y, 0.0) * sun_visibility(world, up);
     float sky = dot(hemisphere(up), vec3(0.3333));
-    // Bare soil has no blades; the grid's edge and the haze fade the sheen out.
+    // Bare soil has no blades; the grid's edge and the haze fade the turf's gain out.
     float turf = (1.0 - ground.a) * smoothstep(0.0, 0.3, edge) * (1.0 - haze(world));
-    gain = mix(vec3(1.0), gain, turf * sun / max(sun + sky, 1e-6));
+    gain = mix(1.0, gain, turf * sun / max(sun + sky, 1e-6));
     // The frame holds display values, the linear colour to the power 1 / 2.2 (pixel.glsl).
-    vec3 g = pow(clamp(gain, 0.0, 4.0), vec3(1.0 / 2.2));
-    float common_part = clamp(max(max(g.r, g.g), g.b) - 1.0, 0.0, min(min(g.r, g.g), g.b));
-    f_color = vec4(g - common_part, common_part);
+    float g = pow(clamp(gain, 0.0, 4.0), 1.0 / 2.2);
+    float over = clamp(g - 1.0, 0.0, g);
+    f_color = vec4(vec3(g - over), over);
 }

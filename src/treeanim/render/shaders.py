@@ -17,7 +17,7 @@ from .uniforms import bind_program, uniforms_glsl
 
 #: Where the renderer draws in the depth range (NDC z), behind every surface of the tree: twigs
 #: thinner than a few pixels (they lose to every solid surface, see shaders/tree.vert), then the
-#: turf's sheen over all the ground (:mod:`.turf`), the ground over the shadow's footprint, then the
+#: turf in the wind over all the ground (:mod:`.turf`), the ground over the shadow's footprint, then the
 #: rest of the ground (the sky: 1). Each 25 steps or more of a 24-bit depth buffer from the next,
 #: far above the rounding of their interpolation.
 DEPTH_THIN = 0.99999

@@ -37,7 +37,7 @@ LEAN_45, LEAN_EXPONENT = 5.0, 1.14
 
 
 class TurfPass:
-    """The turf's sheen in the wind over a square round the scene.
+    """The turf in the wind over a square round the scene.
 
     Parameters
     ----------
